@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs what dvr needs on a fresh Debian 12 machine: the Vulkan loader, Mesa's
+# lavapipe (CPU Vulkan), the validation layers, glslang/shaderc/SPIRV-Tools (static
+# archives that build.rs links), and Xvfb for window tests. Idempotent: it installs
+# only what is missing, so the README's commands can call it every time.
+set -euo pipefail
+
+packages=(
+  mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers vulkan-tools
+  libshaderc-dev glslang-dev glslang-tools spirv-tools
+  pkg-config cmake
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo_cmd=""
+  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+if ! command -v cargo >/dev/null 2>&1; then
+  echo "setup: cargo not found; install Rust from https://rustup.rs" >&2
+  exit 1
+fi
