@@ -1,1 +1,15 @@
-include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+//! dvr engine: everything the applications share. Layers, each knowing only those below:
+//! `gpu` (device, memory, pipelines, timestamps) → `graph` (explicit render graph) →
+//! `passes` (one GPU pass per file) and `denoise` (each denoiser's passes and history) →
+//! `renderer` (the frame). CPU-side data (`volume`, `transfer`, `scene`, `metrics`) feeds
+//! them.
+
+pub mod error;
+pub mod gpu;
+pub mod graph;
+pub mod shaders;
+
+pub use error::{EngineError, Result};
+pub mod denoise;
+pub mod passes;
+pub mod renderer;

@@ -1,0 +1,51 @@
+//! `accum`: progressive accumulation while nothing changes; any camera, light or TF
+//! change starts over. Converges to the reference on static scenes, lags on animated ones.
+
+use super::{DenoiseInputs, Denoiser};
+use crate::error::Result;
+use crate::gpu::GpuContext;
+use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::passes::accumulate::Accumulate;
+
+pub struct Accum {
+    pass: Accumulate,
+}
+
+impl Accum {
+    pub fn new(ctx: &GpuContext) -> Result<Self> {
+        Ok(Self {
+            pass: Accumulate::new(ctx)?,
+        })
+    }
+}
+
+impl Denoiser for Accum {
+    fn name(&self) -> &str {
+        "accum"
+    }
+
+    fn add<'f>(
+        &'f self,
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        frame: &mut Frame<'f>,
+        input: &DenoiseInputs,
+    ) -> Result<ImageHandle> {
+        if input.changes.any() {
+            graph.reset_history("accum.");
+        }
+        self.pass.add(
+            ctx,
+            graph,
+            frame,
+            "accum",
+            input.noisy,
+            input.spp as f32,
+            input.size,
+        )
+    }
+
+    fn destroy(&mut self, ctx: &GpuContext) {
+        self.pass.destroy(ctx);
+    }
+}

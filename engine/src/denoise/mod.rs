@@ -1,0 +1,76 @@
+//! Denoisers. Each is a few render-graph passes plus the history resources it owns,
+//! behind one trait; all read the same noisy frame and the same features and motion, so
+//! differences between methods are the denoisers' alone.
+
+mod accum;
+mod passthrough;
+
+pub use accum::Accum;
+pub use passthrough::Passthrough;
+
+use crate::error::{EngineError, Result};
+use crate::gpu::GpuContext;
+use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
+use crate::passes::surface_features::FeatureImages;
+use crate::passes::Extent;
+
+/// What changed since the previous frame (drives resets of history-based methods).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Changes {
+    pub camera: bool,
+    pub lights: bool,
+    pub transfer_function: bool,
+}
+
+impl Changes {
+    pub fn any(&self) -> bool {
+        self.camera || self.lights || self.transfer_function
+    }
+}
+
+/// Everything a denoiser may read this frame.
+#[derive(Clone, Copy, Debug)]
+pub struct DenoiseInputs {
+    pub uniforms: BufferHandle,
+    /// This frame's noisy HDR radiance (rgba32f).
+    pub noisy: ImageHandle,
+    /// Luminance moments (x mean, y second moment).
+    pub moments: ImageHandle,
+    pub features: FeatureImages,
+    /// Motion to the previous frame in pixels: xy from the first collision, zw from features.
+    pub motion: ImageHandle,
+    pub size: Extent,
+    pub spp: u32,
+    pub changes: Changes,
+}
+
+pub trait Denoiser {
+    /// The name used on the command line and in reports.
+    fn name(&self) -> &str;
+    /// Adds the denoiser's passes; returns its HDR output image.
+    fn add<'f>(
+        &'f self,
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        frame: &mut Frame<'f>,
+        input: &DenoiseInputs,
+    ) -> Result<ImageHandle>;
+    fn destroy(&mut self, ctx: &GpuContext);
+}
+
+/// Names accepted by `--denoiser`.
+pub const NAMES: &[&str] = &["none", "accum"];
+
+/// Builds a denoiser by name.
+pub fn create(ctx: &GpuContext, name: &str) -> Result<Box<dyn Denoiser>> {
+    Ok(match name {
+        "none" => Box::new(Passthrough),
+        "accum" => Box::new(Accum::new(ctx)?),
+        other => {
+            return Err(EngineError::Pass {
+                pass: "denoise".into(),
+                problem: format!("unknown denoiser {other:?}; available: {}", NAMES.join(", ")),
+            })
+        }
+    })
+}

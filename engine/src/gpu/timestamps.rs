@@ -1,0 +1,113 @@
+//! GPU timestamps around every pass. Each frame slot owns a query pool; results are read
+//! when the slot comes round again (its fence has signalled), so timing never stalls the
+//! frame being recorded. The pass name is the key everywhere: debug label, timestamp pair,
+//! profiler row.
+
+use super::context::GpuContext;
+use crate::error::{Result, VkContext};
+use ash::vk;
+
+/// Most passes one frame may time.
+pub const MAX_TIMED_PASSES: u32 = 128;
+
+/// GPU time of one pass in one frame.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PassTiming {
+    pub pass: String,
+    /// Start, relative to the first timestamp of the frame, in milliseconds.
+    pub start_ms: f64,
+    pub ms: f64,
+}
+
+pub struct TimestampPool {
+    pool: vk::QueryPool,
+    names: Vec<String>,
+    period_ns: f64,
+}
+
+impl TimestampPool {
+    pub fn new(ctx: &GpuContext) -> Result<Self> {
+        let info = vk::QueryPoolCreateInfo::default()
+            .query_type(vk::QueryType::TIMESTAMP)
+            .query_count(MAX_TIMED_PASSES * 2);
+        let pool = unsafe { ctx.device.create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
+        Ok(Self {
+            pool,
+            names: Vec::new(),
+            period_ns: ctx.info.timestamp_period,
+        })
+    }
+
+    /// Resets the pool at the start of a frame's command buffer.
+    pub fn reset(&mut self, ctx: &GpuContext, cmd: vk::CommandBuffer) {
+        self.names.clear();
+        unsafe {
+            ctx.device
+                .cmd_reset_query_pool(cmd, self.pool, 0, MAX_TIMED_PASSES * 2)
+        };
+    }
+
+    /// Writes the opening timestamp of `pass`; returns false when the pool is full
+    /// (the pass then runs untimed).
+    pub fn begin(&mut self, ctx: &GpuContext, cmd: vk::CommandBuffer, pass: &str) -> bool {
+        let index = self.names.len() as u32;
+        if index >= MAX_TIMED_PASSES {
+            return false;
+        }
+        self.names.push(pass.to_string());
+        unsafe {
+            ctx.device.cmd_write_timestamp2(
+                cmd,
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                self.pool,
+                index * 2,
+            )
+        };
+        true
+    }
+
+    pub fn end(&mut self, ctx: &GpuContext, cmd: vk::CommandBuffer) {
+        let index = self.names.len() as u32 - 1;
+        unsafe {
+            ctx.device.cmd_write_timestamp2(
+                cmd,
+                vk::PipelineStageFlags2::ALL_COMMANDS,
+                self.pool,
+                index * 2 + 1,
+            )
+        };
+    }
+
+    /// Reads the results of the last recorded frame. Call only after its fence signalled.
+    pub fn read(&self, ctx: &GpuContext) -> Result<Vec<PassTiming>> {
+        if self.names.is_empty() {
+            return Ok(Vec::new());
+        }
+        let mut raw = vec![0u64; self.names.len() * 2];
+        unsafe {
+            ctx.device.get_query_pool_results(
+                self.pool,
+                0,
+                &mut raw,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+        }
+        .vk("vkGetQueryPoolResults")?;
+        let t0 = raw[0];
+        let to_ms = |ticks: u64| ticks as f64 * self.period_ns * 1e-6;
+        Ok(self
+            .names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| PassTiming {
+                pass: name.clone(),
+                start_ms: to_ms(raw[2 * i].saturating_sub(t0)),
+                ms: to_ms(raw[2 * i + 1].saturating_sub(raw[2 * i])),
+            })
+            .collect())
+    }
+
+    pub fn destroy(&mut self, ctx: &GpuContext) {
+        unsafe { ctx.device.destroy_query_pool(self.pool, None) };
+    }
+}

@@ -1,0 +1,277 @@
+//! What a pass sees while it records: its declared resources and nothing else.
+
+use super::access::Access;
+use super::resources::{BufferHandle, ImageHandle, Res};
+use super::RenderGraph;
+use crate::error::{EngineError, Result};
+use crate::gpu::{ComputePipeline, GpuContext};
+use ash::vk;
+
+/// A resource bound to a shader variable.
+#[derive(Clone, Copy, Debug)]
+pub enum Bind {
+    /// Storage image, or sampled with the linear clamp sampler.
+    Image(ImageHandle),
+    /// Sampled with the nearest clamp sampler.
+    ImageNearest(ImageHandle),
+    Buffer(BufferHandle),
+}
+
+impl From<ImageHandle> for Bind {
+    fn from(h: ImageHandle) -> Self {
+        Bind::Image(h)
+    }
+}
+
+impl From<BufferHandle> for Bind {
+    fn from(h: BufferHandle) -> Self {
+        Bind::Buffer(h)
+    }
+}
+
+pub struct PassContext<'a> {
+    pub ctx: &'a GpuContext,
+    pub cmd: vk::CommandBuffer,
+    graph: &'a RenderGraph,
+    pass: &'a str,
+    declared: &'a [(Res, Access)],
+    samplers: [vk::Sampler; 2],
+}
+
+impl<'a> PassContext<'a> {
+    pub(crate) fn new(
+        ctx: &'a GpuContext,
+        cmd: vk::CommandBuffer,
+        graph: &'a RenderGraph,
+        pass: &'a str,
+        declared: &'a [(Res, Access)],
+        samplers: [vk::Sampler; 2],
+    ) -> Self {
+        Self {
+            ctx,
+            cmd,
+            graph,
+            pass,
+            declared,
+            samplers,
+        }
+    }
+
+    fn err(&self, problem: String) -> EngineError {
+        EngineError::Pass {
+            pass: self.pass.to_string(),
+            problem,
+        }
+    }
+
+    fn access_of(&self, r: Res) -> Result<Access> {
+        self.declared
+            .iter()
+            .find(|(d, _)| *d == r)
+            .map(|(_, a)| *a)
+            .ok_or_else(|| {
+                let name = match r {
+                    Res::Image(h) => self.graph.image_name(h).to_string(),
+                    Res::Buffer(h) => self.graph.buffers[h.0 as usize].name.clone(),
+                };
+                self.err(format!("uses {name:?}, which it did not declare"))
+            })
+    }
+
+    /// The Vulkan image of a declared image (for transfer commands).
+    pub fn image(&self, h: ImageHandle) -> Result<vk::Image> {
+        self.access_of(Res::Image(h))?;
+        Ok(self.graph.images[h.0 as usize].image.image)
+    }
+
+    /// The Vulkan buffer of a declared buffer.
+    pub fn buffer(&self, h: BufferHandle) -> Result<vk::Buffer> {
+        self.access_of(Res::Buffer(h))?;
+        Ok(self.graph.buffers[h.0 as usize].buffer.buffer)
+    }
+
+    /// Binds `bindings` to the shader variables of the same names, pushes `push` and
+    /// dispatches. Every reflected binding must be bound, every bound name must exist,
+    /// and each resource's declared access must suit the descriptor type.
+    pub fn dispatch<P: bytemuck::Pod>(
+        &mut self,
+        pipeline: &ComputePipeline,
+        bindings: &[(&str, Bind)],
+        push: &P,
+        groups: [u32; 3],
+    ) -> Result<()> {
+        for (name, _) in bindings {
+            if !pipeline.reflection.bindings.iter().any(|b| b.name == *name) {
+                return Err(self.err(format!(
+                    "shader {} has no binding named {name:?} (has: {:?})",
+                    pipeline.name,
+                    pipeline.reflection.bindings.iter().map(|b| &b.name).collect::<Vec<_>>()
+                )));
+            }
+        }
+        let mut image_infos = Vec::with_capacity(bindings.len());
+        let mut buffer_infos = Vec::with_capacity(bindings.len());
+        let mut plan = Vec::with_capacity(pipeline.reflection.bindings.len());
+        for b in &pipeline.reflection.bindings {
+            let Some((_, bind)) = bindings.iter().find(|(n, _)| *n == b.name) else {
+                return Err(self.err(format!(
+                    "shader {} binding {:?} (binding {}) is not bound",
+                    pipeline.name, b.name, b.binding
+                )));
+            };
+            let (res, sampler) = match *bind {
+                Bind::Image(h) => (Res::Image(h), self.samplers[0]),
+                Bind::ImageNearest(h) => (Res::Image(h), self.samplers[1]),
+                Bind::Buffer(h) => (Res::Buffer(h), vk::Sampler::null()),
+            };
+            let access = self.access_of(res)?;
+            let ok = match b.ty {
+                vk::DescriptorType::STORAGE_IMAGE => {
+                    matches!(res, Res::Image(_)) && access.is_storage()
+                }
+                vk::DescriptorType::COMBINED_IMAGE_SAMPLER | vk::DescriptorType::SAMPLED_IMAGE => {
+                    matches!(res, Res::Image(_)) && access == Access::Sampled
+                }
+                vk::DescriptorType::UNIFORM_BUFFER => {
+                    matches!(res, Res::Buffer(_)) && access == Access::Uniform
+                }
+                vk::DescriptorType::STORAGE_BUFFER => {
+                    matches!(res, Res::Buffer(_)) && access.is_storage()
+                }
+                _ => false,
+            };
+            if !ok {
+                return Err(self.err(format!(
+                    "binding {:?} is a {:?} but the pass declared {access:?} on it",
+                    b.name, b.ty
+                )));
+            }
+            match res {
+                Res::Image(h) => {
+                    let layout = access.info().layout;
+                    image_infos.push(
+                        vk::DescriptorImageInfo::default()
+                            .image_view(self.graph.images[h.0 as usize].image.view)
+                            .image_layout(layout)
+                            .sampler(sampler),
+                    );
+                    plan.push((b.binding, b.ty, true, image_infos.len() - 1));
+                }
+                Res::Buffer(h) => {
+                    buffer_infos.push(
+                        vk::DescriptorBufferInfo::default()
+                            .buffer(self.graph.buffers[h.0 as usize].buffer.buffer)
+                            .offset(0)
+                            .range(vk::WHOLE_SIZE),
+                    );
+                    plan.push((b.binding, b.ty, false, buffer_infos.len() - 1));
+                }
+            }
+        }
+        let writes: Vec<_> = plan
+            .iter()
+            .map(|&(binding, ty, is_image, i)| {
+                let w = vk::WriteDescriptorSet::default()
+                    .dst_binding(binding)
+                    .descriptor_type(ty);
+                if is_image {
+                    w.image_info(std::slice::from_ref(&image_infos[i]))
+                } else {
+                    w.buffer_info(std::slice::from_ref(&buffer_infos[i]))
+                }
+            })
+            .collect();
+        let bytes = bytemuck::bytes_of(push);
+        if bytes.len() as u32 != pipeline.reflection.push_constant_size
+            && pipeline.reflection.push_constant_size != 0
+        {
+            return Err(self.err(format!(
+                "push constants are {} bytes but shader {} declares {}",
+                bytes.len(),
+                pipeline.name,
+                pipeline.reflection.push_constant_size
+            )));
+        }
+        let d = &self.ctx.device;
+        unsafe {
+            d.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
+            if !writes.is_empty() {
+                self.ctx.push_descriptor.cmd_push_descriptor_set(
+                    self.cmd,
+                    vk::PipelineBindPoint::COMPUTE,
+                    pipeline.layout,
+                    0,
+                    &writes,
+                );
+            }
+            if pipeline.reflection.push_constant_size > 0 {
+                d.cmd_push_constants(
+                    self.cmd,
+                    pipeline.layout,
+                    vk::ShaderStageFlags::COMPUTE,
+                    0,
+                    bytes,
+                );
+            }
+            d.cmd_dispatch(self.cmd, groups[0], groups[1], groups[2]);
+        }
+        Ok(())
+    }
+
+    /// Copies a declared buffer (TransferSrc) into a declared image (TransferDst).
+    pub fn copy_buffer_to_image(&mut self, src: BufferHandle, dst: ImageHandle) -> Result<()> {
+        let buffer = self.buffer(src)?;
+        let image = self.image(dst)?;
+        let desc = self.graph.image_desc(dst);
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(color_layers())
+            .image_extent(extent(desc.extent));
+        unsafe {
+            self.ctx.device.cmd_copy_buffer_to_image(
+                self.cmd,
+                buffer,
+                image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            )
+        };
+        Ok(())
+    }
+
+    /// Copies a declared image (TransferSrc) into a declared buffer (TransferDst).
+    pub fn copy_image_to_buffer(&mut self, src: ImageHandle, dst: BufferHandle) -> Result<()> {
+        let image = self.image(src)?;
+        let buffer = self.buffer(dst)?;
+        let desc = self.graph.image_desc(src);
+        let region = vk::BufferImageCopy::default()
+            .image_subresource(color_layers())
+            .image_extent(extent(desc.extent));
+        unsafe {
+            self.ctx.device.cmd_copy_image_to_buffer(
+                self.cmd,
+                image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                buffer,
+                &[region],
+            )
+        };
+        Ok(())
+    }
+}
+
+fn color_layers() -> vk::ImageSubresourceLayers {
+    vk::ImageSubresourceLayers {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        mip_level: 0,
+        base_array_layer: 0,
+        layer_count: 1,
+    }
+}
+
+fn extent(e: [u32; 3]) -> vk::Extent3D {
+    vk::Extent3D {
+        width: e[0],
+        height: e[1],
+        depth: e[2],
+    }
+}

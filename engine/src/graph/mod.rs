@@ -1,0 +1,468 @@
+//! The explicit render graph. Each frame the application declares passes; each pass
+//! declares the images and buffers it touches and how ([`Access`]). At execution the
+//! graph derives every barrier and layout transition from those declarations (nothing
+//! else in the engine issues barriers), clears newly allocated resources, wraps each pass
+//! in a debug label and a timestamp pair keyed by the pass name, and swaps history
+//! resources at the end of the frame. A pass records commands through a [`PassContext`]
+//! that refuses resources the pass did not declare.
+
+pub mod access;
+mod context;
+mod resources;
+
+pub use access::{Access, Barrier, ResourceState};
+pub use context::{Bind, PassContext};
+pub use resources::{BufferHandle, History, ImageHandle, Res};
+
+use crate::error::{EngineError, Result};
+use crate::gpu::timestamps::TimestampPool;
+use crate::gpu::{GpuBuffer, GpuContext, GpuImage, ImageDesc};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use resources::{BufferSlot, HistorySlot, ImageSlot};
+use std::collections::HashMap;
+
+type RecordFn<'f> = Box<dyn FnOnce(&mut PassContext) -> Result<()> + 'f>;
+
+/// One declared pass of the frame being built.
+pub struct Pass<'f> {
+    name: String,
+    accesses: Vec<(Res, Access)>,
+    record: Option<RecordFn<'f>>,
+}
+
+/// Declares a pass's accesses. Reads take the handle; so do writes, but they are
+/// listed separately so a reader sees at a glance what a pass produces.
+pub struct PassBuilder {
+    accesses: Vec<(Res, Access)>,
+}
+
+impl PassBuilder {
+    pub fn sampled(&mut self, h: ImageHandle) -> &mut Self {
+        self.accesses.push((Res::Image(h), Access::Sampled));
+        self
+    }
+    pub fn read(&mut self, h: impl Into<Res>) -> &mut Self {
+        self.accesses.push((h.into(), Access::StorageRead));
+        self
+    }
+    pub fn write(&mut self, h: impl Into<Res>) -> &mut Self {
+        self.accesses.push((h.into(), Access::StorageWrite));
+        self
+    }
+    pub fn read_write(&mut self, h: impl Into<Res>) -> &mut Self {
+        self.accesses.push((h.into(), Access::StorageReadWrite));
+        self
+    }
+    pub fn uniform(&mut self, h: BufferHandle) -> &mut Self {
+        self.accesses.push((Res::Buffer(h), Access::Uniform));
+        self
+    }
+    pub fn transfer_src(&mut self, h: impl Into<Res>) -> &mut Self {
+        self.accesses.push((h.into(), Access::TransferSrc));
+        self
+    }
+    pub fn transfer_dst(&mut self, h: impl Into<Res>) -> &mut Self {
+        self.accesses.push((h.into(), Access::TransferDst));
+        self
+    }
+    pub fn host_read(&mut self, h: BufferHandle) -> &mut Self {
+        self.accesses.push((Res::Buffer(h), Access::HostRead));
+        self
+    }
+}
+
+/// The passes of one frame, in submission order.
+#[derive(Default)]
+pub struct Frame<'f> {
+    passes: Vec<Pass<'f>>,
+}
+
+impl<'f> Frame<'f> {
+    pub fn new() -> Self {
+        Self { passes: Vec::new() }
+    }
+
+    /// Adds a pass: `declare` lists its accesses, `record` records its commands.
+    pub fn add_pass(
+        &mut self,
+        name: impl Into<String>,
+        declare: impl FnOnce(&mut PassBuilder),
+        record: impl FnOnce(&mut PassContext) -> Result<()> + 'f,
+    ) {
+        let mut b = PassBuilder {
+            accesses: Vec::new(),
+        };
+        declare(&mut b);
+        self.passes.push(Pass {
+            name: name.into(),
+            accesses: b.accesses,
+            record: Some(Box::new(record)),
+        });
+    }
+
+    /// A pass with accesses but no commands: makes a readback visible to the host.
+    pub fn add_host_read(&mut self, name: impl Into<String>, buffer: BufferHandle) {
+        self.passes.push(Pass {
+            name: name.into(),
+            accesses: vec![(Res::Buffer(buffer), Access::HostRead)],
+            record: None,
+        });
+    }
+
+    pub fn pass_names(&self) -> Vec<&str> {
+        self.passes.iter().map(|p| p.name.as_str()).collect()
+    }
+}
+
+/// Persistent graph resources and their synchronisation state.
+pub struct RenderGraph {
+    images: Vec<ImageSlot>,
+    image_names: HashMap<String, ImageHandle>,
+    buffers: Vec<BufferSlot>,
+    buffer_names: HashMap<String, BufferHandle>,
+    histories: HashMap<String, HistorySlot>,
+    linear_sampler: vk::Sampler,
+    nearest_sampler: vk::Sampler,
+}
+
+impl RenderGraph {
+    pub fn new(ctx: &GpuContext) -> Result<Self> {
+        let make = |filter: vk::Filter| {
+            let info = vk::SamplerCreateInfo::default()
+                .mag_filter(filter)
+                .min_filter(filter)
+                .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+                .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                .max_lod(0.0);
+            unsafe { ctx.device.create_sampler(&info, None) }.map_err(|result| EngineError::Vk {
+                call: "vkCreateSampler",
+                result,
+            })
+        };
+        Ok(Self {
+            images: Vec::new(),
+            image_names: HashMap::new(),
+            buffers: Vec::new(),
+            buffer_names: HashMap::new(),
+            histories: HashMap::new(),
+            linear_sampler: make(vk::Filter::LINEAR)?,
+            nearest_sampler: make(vk::Filter::NEAREST)?,
+        })
+    }
+
+    /// The image named `name` with shape `desc`: created on first use (and cleared to
+    /// zero before its first access), reused on later frames, recreated if `desc`
+    /// changes (a resize).
+    pub fn image(&mut self, ctx: &GpuContext, name: &str, desc: ImageDesc) -> Result<ImageHandle> {
+        if let Some(&h) = self.image_names.get(name) {
+            let slot = &mut self.images[h.0 as usize];
+            if slot.image.desc == desc {
+                return Ok(h);
+            }
+            slot.image.destroy(ctx);
+            slot.image = GpuImage::new(ctx, name, desc)?;
+            slot.state = ResourceState::default();
+            slot.needs_clear = true;
+            return Ok(h);
+        }
+        let h = ImageHandle(self.images.len() as u32);
+        self.images.push(ImageSlot {
+            name: name.to_string(),
+            image: GpuImage::new(ctx, name, desc)?,
+            state: ResourceState::default(),
+            needs_clear: true,
+        });
+        self.image_names.insert(name.to_string(), h);
+        Ok(h)
+    }
+
+    /// A ping-pong pair: `prev` holds what the pass wrote last frame, `cur` is written
+    /// this frame. `valid` is false on the first frame, after a resize and after
+    /// [`RenderGraph::reset_history`]; shaders must be told and not read `prev` then.
+    pub fn history(&mut self, ctx: &GpuContext, name: &str, desc: ImageDesc) -> Result<History> {
+        let a = self.image(ctx, &format!("{name}#0"), desc)?;
+        let b = self.image(ctx, &format!("{name}#1"), desc)?;
+        let resized = self.images[a.0 as usize].needs_clear || self.images[b.0 as usize].needs_clear;
+        let slot = self.histories.entry(name.to_string()).or_insert(HistorySlot {
+            flip: false,
+            valid: false,
+            used: false,
+        });
+        if resized {
+            slot.valid = false;
+        }
+        slot.used = true;
+        let (prev, cur) = if slot.flip { (b, a) } else { (a, b) };
+        Ok(History {
+            prev,
+            cur,
+            valid: slot.valid,
+        })
+    }
+
+    /// Marks every history whose name starts with `prefix` invalid (a camera cut, a
+    /// scene change, a denoiser reset). `""` resets all.
+    pub fn reset_history(&mut self, prefix: &str) {
+        for (name, slot) in self.histories.iter_mut() {
+            if name.starts_with(prefix) {
+                slot.valid = false;
+            }
+        }
+    }
+
+    /// A buffer named `name`; recreated when the size changes.
+    pub fn buffer(
+        &mut self,
+        ctx: &GpuContext,
+        name: &str,
+        size: u64,
+        location: MemoryLocation,
+    ) -> Result<BufferHandle> {
+        let usage = vk::BufferUsageFlags::UNIFORM_BUFFER
+            | vk::BufferUsageFlags::STORAGE_BUFFER
+            | vk::BufferUsageFlags::TRANSFER_SRC
+            | vk::BufferUsageFlags::TRANSFER_DST;
+        if let Some(&h) = self.buffer_names.get(name) {
+            let slot = &mut self.buffers[h.0 as usize];
+            if slot.buffer.size == size && slot.location == location {
+                return Ok(h);
+            }
+            slot.buffer.destroy(ctx);
+            slot.buffer = GpuBuffer::new(ctx, name, size, usage, location)?;
+            slot.state = ResourceState::default();
+            return Ok(h);
+        }
+        let h = BufferHandle(self.buffers.len() as u32);
+        self.buffers.push(BufferSlot {
+            name: name.to_string(),
+            buffer: GpuBuffer::new(ctx, name, size, usage, location)?,
+            state: ResourceState::default(),
+            location,
+        });
+        self.buffer_names.insert(name.to_string(), h);
+        Ok(h)
+    }
+
+    pub fn image_desc(&self, h: ImageHandle) -> ImageDesc {
+        self.images[h.0 as usize].image.desc
+    }
+
+    pub fn buffer_ref(&self, h: BufferHandle) -> &GpuBuffer {
+        &self.buffers[h.0 as usize].buffer
+    }
+
+    pub fn buffer_mut(&mut self, h: BufferHandle) -> &mut GpuBuffer {
+        &mut self.buffers[h.0 as usize].buffer
+    }
+
+    pub fn image_name(&self, h: ImageHandle) -> &str {
+        &self.images[h.0 as usize].name
+    }
+
+    fn res_name(&self, r: Res) -> &str {
+        match r {
+            Res::Image(h) => &self.images[h.0 as usize].name,
+            Res::Buffer(h) => &self.buffers[h.0 as usize].name,
+        }
+    }
+
+    /// Checks a frame before recording: handles exist, no resource is declared twice with
+    /// conflicting accesses in one pass, storage images have storage-capable formats.
+    pub fn validate(&self, frame: &Frame) -> Result<()> {
+        for pass in &frame.passes {
+            let mut seen: HashMap<Res, Access> = HashMap::new();
+            for &(r, a) in &pass.accesses {
+                let exists = match r {
+                    Res::Image(h) => (h.0 as usize) < self.images.len(),
+                    Res::Buffer(h) => (h.0 as usize) < self.buffers.len(),
+                };
+                if !exists {
+                    return Err(EngineError::Pass {
+                        pass: pass.name.clone(),
+                        problem: format!("declares unknown resource {r:?}"),
+                    });
+                }
+                if let Some(prev) = seen.insert(r, a) {
+                    if prev != a {
+                        return Err(EngineError::Pass {
+                            pass: pass.name.clone(),
+                            problem: format!(
+                                "declares {:?} twice ({prev:?} and {a:?}); use one access",
+                                self.res_name(r)
+                            ),
+                        });
+                    }
+                }
+                if matches!(r, Res::Buffer(_)) && a == Access::Sampled {
+                    return Err(EngineError::Pass {
+                        pass: pass.name.clone(),
+                        problem: format!("buffer {:?} cannot be sampled", self.res_name(r)),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Records `frame` into `cmd`: barriers, clears of new resources, labels, timestamps.
+    pub fn execute(
+        &mut self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        timestamps: Option<&mut TimestampPool>,
+        frame: Frame,
+    ) -> Result<()> {
+        self.validate(&frame)?;
+        let mut timestamps = timestamps;
+        for mut pass in frame.passes {
+            self.clear_new_resources(ctx, cmd, &pass.accesses);
+            let mut image_barriers = Vec::new();
+            let mut buffer_barriers = Vec::new();
+            for &(r, a) in &pass.accesses {
+                match r {
+                    Res::Image(h) => {
+                        let slot = &mut self.images[h.0 as usize];
+                        if let Some(b) = access::transition(&mut slot.state, a, true) {
+                            image_barriers.push(image_barrier(slot.image.image, &b));
+                        }
+                    }
+                    Res::Buffer(h) => {
+                        let slot = &mut self.buffers[h.0 as usize];
+                        if let Some(b) = access::transition(&mut slot.state, a, false) {
+                            buffer_barriers.push(buffer_barrier(slot.buffer.buffer, &b));
+                        }
+                    }
+                }
+            }
+            if !image_barriers.is_empty() || !buffer_barriers.is_empty() {
+                let dep = vk::DependencyInfo::default()
+                    .image_memory_barriers(&image_barriers)
+                    .buffer_memory_barriers(&buffer_barriers);
+                unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+            }
+            let Some(record) = pass.record.take() else {
+                continue;
+            };
+            begin_label(ctx, cmd, &pass.name);
+            let timed = timestamps
+                .as_deref_mut()
+                .is_some_and(|t| t.begin(ctx, cmd, &pass.name));
+            let mut pc = PassContext::new(
+                ctx,
+                cmd,
+                self,
+                &pass.name,
+                &pass.accesses,
+                [self.linear_sampler, self.nearest_sampler],
+            );
+            record(&mut pc)?;
+            if timed {
+                if let Some(t) = timestamps.as_deref_mut() {
+                    t.end(ctx, cmd);
+                }
+            }
+            end_label(ctx, cmd);
+        }
+        Ok(())
+    }
+
+    /// Clears images created since the last frame to zero before their first access, so
+    /// a fresh history or accumulation buffer never holds garbage.
+    fn clear_new_resources(&mut self, ctx: &GpuContext, cmd: vk::CommandBuffer, accesses: &[(Res, Access)]) {
+        for &(r, _) in accesses {
+            let Res::Image(h) = r else { continue };
+            let slot = &mut self.images[h.0 as usize];
+            if !slot.needs_clear {
+                continue;
+            }
+            slot.needs_clear = false;
+            if let Some(b) = access::transition(&mut slot.state, Access::TransferDst, true) {
+                let barriers = [image_barrier(slot.image.image, &b)];
+                let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+                unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+            }
+            let zero = vk::ClearColorValue { float32: [0.0; 4] };
+            unsafe {
+                ctx.device.cmd_clear_color_image(
+                    cmd,
+                    slot.image.image,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &zero,
+                    &[crate::gpu::resources::color_range()],
+                )
+            };
+        }
+    }
+
+    /// Ends the frame: histories used this frame swap and become valid.
+    pub fn end_frame(&mut self) {
+        for slot in self.histories.values_mut() {
+            if slot.used {
+                slot.flip = !slot.flip;
+                slot.valid = true;
+                slot.used = false;
+            }
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &GpuContext) {
+        for s in &mut self.images {
+            s.image.destroy(ctx);
+        }
+        for s in &mut self.buffers {
+            s.buffer.destroy(ctx);
+        }
+        self.images.clear();
+        self.buffers.clear();
+        self.image_names.clear();
+        self.buffer_names.clear();
+        self.histories.clear();
+        unsafe {
+            ctx.device.destroy_sampler(self.linear_sampler, None);
+            ctx.device.destroy_sampler(self.nearest_sampler, None);
+        }
+    }
+}
+
+fn image_barrier(image: vk::Image, b: &Barrier) -> vk::ImageMemoryBarrier2<'static> {
+    vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(b.src_stage)
+        .src_access_mask(b.src_access)
+        .dst_stage_mask(b.dst_stage)
+        .dst_access_mask(b.dst_access)
+        .old_layout(b.old_layout)
+        .new_layout(b.new_layout)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .image(image)
+        .subresource_range(crate::gpu::resources::color_range())
+}
+
+fn buffer_barrier(buffer: vk::Buffer, b: &Barrier) -> vk::BufferMemoryBarrier2<'static> {
+    vk::BufferMemoryBarrier2::default()
+        .src_stage_mask(b.src_stage)
+        .src_access_mask(b.src_access)
+        .dst_stage_mask(b.dst_stage)
+        .dst_access_mask(b.dst_access)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .buffer(buffer)
+        .offset(0)
+        .size(vk::WHOLE_SIZE)
+}
+
+fn begin_label(ctx: &GpuContext, cmd: vk::CommandBuffer, name: &str) {
+    if let (Some(du), Ok(c)) = (&ctx.debug_utils, std::ffi::CString::new(name)) {
+        let label = vk::DebugUtilsLabelEXT::default().label_name(&c);
+        unsafe { du.cmd_begin_debug_utils_label(cmd, &label) };
+    }
+}
+
+fn end_label(ctx: &GpuContext, cmd: vk::CommandBuffer) {
+    if let Some(du) = &ctx.debug_utils {
+        unsafe { du.cmd_end_debug_utils_label(cmd) };
+    }
+}

@@ -1,0 +1,60 @@
+//! Handles and slots of graph resources.
+
+use super::access::ResourceState;
+use crate::gpu::{GpuBuffer, GpuImage};
+use gpu_allocator::MemoryLocation;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ImageHandle(pub(crate) u32);
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct BufferHandle(pub(crate) u32);
+
+/// Either kind of graph resource.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Res {
+    Image(ImageHandle),
+    Buffer(BufferHandle),
+}
+
+impl From<ImageHandle> for Res {
+    fn from(h: ImageHandle) -> Self {
+        Res::Image(h)
+    }
+}
+
+impl From<BufferHandle> for Res {
+    fn from(h: BufferHandle) -> Self {
+        Res::Buffer(h)
+    }
+}
+
+/// The two sides of a history resource for this frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct History {
+    /// Written last frame; read this frame only when `valid`.
+    pub prev: ImageHandle,
+    /// Written this frame; becomes `prev` next frame.
+    pub cur: ImageHandle,
+    pub valid: bool,
+}
+
+pub(crate) struct ImageSlot {
+    pub name: String,
+    pub image: GpuImage,
+    pub state: ResourceState,
+    pub needs_clear: bool,
+}
+
+pub(crate) struct BufferSlot {
+    pub name: String,
+    pub buffer: GpuBuffer,
+    pub state: ResourceState,
+    pub location: MemoryLocation,
+}
+
+pub(crate) struct HistorySlot {
+    pub flip: bool,
+    pub valid: bool,
+    pub used: bool,
+}

@@ -1,0 +1,131 @@
+//! The path-tracing pass (shaders/glsl/path_trace.comp): this frame's noisy radiance, its
+//! luminance moments and the closest first real collision per pixel.
+
+use super::{Extent, SceneBindings};
+use crate::error::Result;
+use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
+use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
+use crate::renderer::uniforms::PathTracePush;
+use ash::vk;
+
+/// Free-path estimator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Estimator {
+    /// Delta tracking with ratio-tracked shadow rays over the majorant grid (unbiased).
+    #[default]
+    Delta,
+    /// Jittered Riemann-sum ray marching (Exposure Render's choice; biased by the step).
+    RayMarch,
+}
+
+/// Scattering model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Phase {
+    #[default]
+    Isotropic,
+    /// Henyey–Greenstein with the scene's g.
+    Hg,
+    /// Exposure Render's gradient-based BRDF/phase hybrid.
+    Hybrid,
+}
+
+/// What the pipeline is specialised for (what the scene uses).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct PathTraceFeatures {
+    pub estimator: Estimator,
+    pub phase: Phase,
+    pub emission: bool,
+    pub environment_map: bool,
+}
+
+pub struct PathTrace {
+    pipeline: ComputePipeline,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct PathTraceOutputs {
+    pub radiance: ImageHandle,
+    pub moments: ImageHandle,
+    pub first_hit: ImageHandle,
+}
+
+impl PathTrace {
+    pub fn new(ctx: &GpuContext, features: PathTraceFeatures) -> Result<Self> {
+        let estimator = match features.estimator {
+            Estimator::Delta => 0,
+            Estimator::RayMarch => 1,
+        };
+        let phase = match features.phase {
+            Phase::Isotropic => 0,
+            Phase::Hg => 1,
+            Phase::Hybrid => 2,
+        };
+        let pipeline = ComputePipeline::new(
+            ctx,
+            "path_trace",
+            &[
+                ("ESTIMATOR", SpecValue::I32(estimator)),
+                ("PHASE", SpecValue::I32(phase)),
+                ("USE_EMISSION", SpecValue::Bool(features.emission)),
+                ("HAS_ENV_MAP", SpecValue::Bool(features.environment_map)),
+            ],
+        )?;
+        Ok(Self { pipeline })
+    }
+
+    /// Adds the pass as `name`, writing images `<name>.radiance` etc.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add<'f>(
+        &'f self,
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        frame: &mut Frame<'f>,
+        name: &str,
+        scene: &SceneBindings,
+        size: Extent,
+        sample_offset: u32,
+        spp: u32,
+    ) -> Result<PathTraceOutputs> {
+        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let out = PathTraceOutputs {
+            radiance: graph.image(ctx, &format!("{name}.radiance"), desc)?,
+            moments: graph.image(ctx, &format!("{name}.moments"), desc)?,
+            first_hit: graph.image(ctx, &format!("{name}.first_hit"), desc)?,
+        };
+        let scene = *scene;
+        let push = PathTracePush {
+            sample_offset,
+            spp,
+            width: size.width,
+            height: size.height,
+        };
+        frame.add_pass(
+            name,
+            |b| {
+                scene.declare_volume(b);
+                b.sampled(scene.environment)
+                    .write(out.radiance)
+                    .write(out.moments)
+                    .write(out.first_hit);
+            },
+            move |pc| {
+                let mut binds = scene.volume_binds();
+                binds.extend([
+                    ("environment_map", Bind::Image(scene.environment)),
+                    ("radiance", Bind::Image(out.radiance)),
+                    ("moments", Bind::Image(out.moments)),
+                    ("first_hit", Bind::Image(out.first_hit)),
+                ]);
+                let groups = self.pipeline.groups_2d(size.width, size.height);
+                pc.dispatch(&self.pipeline, &binds, &push, groups)
+            },
+        );
+        Ok(out)
+    }
+
+    pub fn destroy(&mut self, ctx: &GpuContext) {
+        self.pipeline.destroy(ctx);
+    }
+}

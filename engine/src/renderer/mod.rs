@@ -1,0 +1,551 @@
+//! The frame. [`Renderer::frame`] reads like the pipeline: uniforms → surface features →
+//! path trace → motion → each denoiser → readbacks, all in one render graph, submitted
+//! once. Frames alternate between two slots so recording frame N overlaps the GPU's work
+//! on frame N−1; timestamps and readbacks of a slot are collected when it comes round.
+
+pub mod scene_gpu;
+pub mod uniforms;
+
+use crate::denoise::{self, Changes, DenoiseInputs, Denoiser};
+use crate::error::{EngineError, Result, VkContext};
+use crate::gpu::timestamps::{PassTiming, TimestampPool};
+use crate::gpu::GpuContext;
+use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
+use crate::passes::accumulate::Accumulate;
+use crate::passes::motion::Motion;
+use crate::passes::path_trace::{PathTrace, PathTraceFeatures};
+use crate::passes::surface_features::SurfaceFeatures;
+use crate::passes::{Extent, SceneBindings};
+use ash::vk;
+use glam::{Mat4, Vec3, Vec4};
+use gpu_allocator::MemoryLocation;
+use scene_gpu::{EnvironmentUpload, LutUpload, SceneImages, VolumeUpload};
+use uniforms::{FrameUniforms, GpuLight, MAX_LIGHTS};
+
+const SLOTS: usize = 2;
+
+/// Fixed settings of a renderer (changing them means a new renderer).
+#[derive(Clone, Debug)]
+pub struct RenderSettings {
+    pub size: Extent,
+    pub spp: u32,
+    pub max_bounces: u32,
+    /// Bounce from which Russian roulette may end a path.
+    pub rr_depth: u32,
+    pub features: PathTraceFeatures,
+    pub hg_g: f32,
+    /// Ray-marching step in voxels (ray-march estimator only).
+    pub step_voxels: f32,
+    /// Accumulated opacity at which the surface-features pass stops.
+    pub feature_threshold: f32,
+    /// Standard deviation of the Gaussian pixel filter, in pixels.
+    pub filter_sigma: f32,
+    /// Extinction per unit opacity (1/world unit).
+    pub density_scale: f32,
+    pub seed: u32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            size: Extent {
+                width: 256,
+                height: 256,
+                },
+            spp: 2,
+            max_bounces: 8,
+            rr_depth: 3,
+            features: PathTraceFeatures::default(),
+            hg_g: 0.0,
+            step_voxels: 1.0,
+            feature_threshold: 0.5,
+            filter_sigma: 0.5,
+            density_scale: 100.0,
+            seed: 1,
+        }
+    }
+}
+
+/// A camera as the renderer needs it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraMatrices {
+    pub view: Mat4,
+    pub proj: Mat4,
+    pub position: Vec3,
+}
+
+/// The per-frame state of an animation.
+#[derive(Clone, Debug)]
+pub struct FrameInputs {
+    pub camera: CameraMatrices,
+    pub lights: Vec<GpuLight>,
+    /// The transfer function this frame (uploaded only when it differs from the last).
+    pub lut: LutUpload,
+}
+
+/// What one frame should produce.
+#[derive(Clone, Debug, Default)]
+pub struct FrameRequest {
+    /// Read the outputs of these methods back to the host ("noisy" is the raw radiance).
+    pub readback: bool,
+    /// Restart every history (a cut).
+    pub reset: bool,
+}
+
+/// Results of a completed frame.
+#[derive(Clone, Debug, Default)]
+pub struct FrameResult {
+    pub index: u64,
+    pub timings: Vec<PassTiming>,
+    /// (method, rgba pixels) for each method when readback was requested.
+    pub images: Vec<(String, Vec<[f32; 4]>)>,
+}
+
+struct Slot {
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    timestamps: TimestampPool,
+    uniforms: BufferHandle,
+    pending: Option<(u64, Vec<(String, BufferHandle)>)>,
+}
+
+struct Passes {
+    features: SurfaceFeatures,
+    path_trace: PathTrace,
+    motion: Motion,
+    accumulate: Accumulate,
+}
+
+pub struct Renderer {
+    pub settings: RenderSettings,
+    graph: RenderGraph,
+    passes: Passes,
+    denoisers: Vec<Box<dyn Denoiser>>,
+    scene: SceneImages,
+    bricks: scene_gpu::BrickRanges,
+    volume_dims: [u32; 3],
+    world_size: [f32; 3],
+    lut_size: u32,
+    current_lut: Option<LutUpload>,
+    last_inputs: Option<FrameInputs>,
+    slots: Vec<Slot>,
+    pool: vk::CommandPool,
+    frame_index: u64,
+    // Declared last: dropped after the Drop impl has released everything above.
+    ctx: GpuContext,
+}
+
+impl Renderer {
+    pub fn new(
+        ctx: GpuContext,
+        settings: RenderSettings,
+        volume: &VolumeUpload,
+        environment: Option<&EnvironmentUpload>,
+        denoisers: &[&str],
+        lut_size: u32,
+    ) -> Result<Self> {
+        let mut graph = RenderGraph::new(&ctx)?;
+        let passes = Passes {
+            features: SurfaceFeatures::new(&ctx)?,
+            path_trace: PathTrace::new(&ctx, settings.features)?,
+            motion: Motion::new(&ctx)?,
+            accumulate: Accumulate::new(&ctx)?,
+        };
+        let denoisers = denoisers
+            .iter()
+            .map(|n| denoise::create(&ctx, n))
+            .collect::<Result<Vec<_>>>()?;
+        let pool_info = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(ctx.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }
+            .vk("vkCreateCommandPool")?;
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(SLOTS as u32);
+        let cmds = unsafe { ctx.device.allocate_command_buffers(&alloc) }
+            .vk("vkAllocateCommandBuffers")?;
+        let mut slots = Vec::new();
+        for (i, &cmd) in cmds.iter().enumerate() {
+            let fence = unsafe {
+                ctx.device.create_fence(
+                    &vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED),
+                    None,
+                )
+            }
+            .vk("vkCreateFence")?;
+            let uniforms = graph.buffer(
+                &ctx,
+                &format!("frame_uniforms.{i}"),
+                std::mem::size_of::<FrameUniforms>() as u64,
+                MemoryLocation::CpuToGpu,
+            )?;
+            slots.push(Slot {
+                cmd,
+                fence,
+                timestamps: TimestampPool::new(&ctx)?,
+                uniforms,
+                pending: None,
+            });
+        }
+
+        // Upload the volume and environment once, through the graph.
+        let mut setup = Frame::new();
+        let scene = scene_gpu::create(&ctx, &mut graph, &mut setup, volume, environment, lut_size)?;
+        ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, setup))?;
+
+        Ok(Self {
+            settings,
+            graph,
+            passes,
+            denoisers,
+            scene,
+            bricks: volume.bricks.clone(),
+            volume_dims: volume.dims,
+            world_size: volume.world_size,
+            lut_size,
+            current_lut: None,
+            last_inputs: None,
+            slots,
+            pool,
+            frame_index: 0,
+            ctx,
+        })
+    }
+
+    pub fn ctx(&self) -> &GpuContext {
+        &self.ctx
+    }
+
+    pub fn denoiser_names(&self) -> Vec<String> {
+        self.denoisers.iter().map(|d| d.name().to_string()).collect()
+    }
+
+    fn uniforms(&self, inputs: &FrameInputs, majorant_max: f32) -> FrameUniforms {
+        let s = &self.settings;
+        let aspect_view_proj = inputs.camera.proj * inputs.camera.view;
+        let prev = self
+            .last_inputs
+            .as_ref()
+            .map(|p| p.camera.proj * p.camera.view)
+            .unwrap_or(aspect_view_proj);
+        let half = Vec3::from(self.world_size) * 0.5;
+        let mut lights = [GpuLight::default(); MAX_LIGHTS];
+        for (dst, src) in lights.iter_mut().zip(&inputs.lights) {
+            *dst = *src;
+        }
+        let voxel = (Vec3::from(self.world_size) / Vec3::from(self.volume_dims.map(|d| d as f32)))
+            .min_element();
+        FrameUniforms {
+            view_proj: aspect_view_proj,
+            inv_view_proj: aspect_view_proj.inverse(),
+            prev_view_proj: prev,
+            camera_pos: inputs.camera.position.extend(1.0),
+            box_min: (-half).extend(s.density_scale),
+            box_max: half.extend(majorant_max),
+            dims: glam::IVec4::new(
+                self.volume_dims[0] as i32,
+                self.volume_dims[1] as i32,
+                self.volume_dims[2] as i32,
+                0,
+            ),
+            counts: glam::IVec4::new(
+                inputs.lights.len().min(MAX_LIGHTS) as i32,
+                self.frame_index as i32,
+                s.spp as i32,
+                s.max_bounces as i32,
+            ),
+            params: Vec4::new(voxel * s.step_voxels, s.hg_g, s.feature_threshold, s.filter_sigma),
+            seeds: glam::UVec4::new(s.seed, 0, s.rr_depth, s.size.width),
+            lights,
+        }
+    }
+
+    /// Renders one frame of the animation: the noisy path-traced frame once, then every
+    /// denoiser on that same input.
+    pub fn frame(&mut self, inputs: &FrameInputs, request: &FrameRequest) -> Result<Option<FrameResult>> {
+        let slot_index = (self.frame_index % SLOTS as u64) as usize;
+        let completed = self.wait_slot(slot_index)?;
+
+        let changes = self.changes(inputs, request.reset);
+        if request.reset {
+            self.graph.reset_history("");
+        }
+        let tf_changed = self.current_lut.as_ref() != Some(&inputs.lut);
+        let ctx = &self.ctx;
+        let graph = &mut self.graph;
+        let size = self.settings.size;
+        let mut frame = Frame::new();
+
+        // Transfer function and majorant grid, re-uploaded only when the TF changes.
+        let majorants = scene_gpu::majorants(
+            &self.bricks,
+            &inputs.lut.diffuse_opacity.iter().map(|c| c[3]).collect::<Vec<_>>(),
+            self.settings.density_scale,
+        );
+        let majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
+        if tf_changed {
+            let [a, b, c] = self.scene.tf;
+            if inputs.lut.diffuse_opacity.len() != self.lut_size as usize {
+                return Err(EngineError::Resource {
+                    resource: "transfer function".into(),
+                    problem: format!(
+                        "LUT has {} entries, renderer expects {}",
+                        inputs.lut.diffuse_opacity.len(),
+                        self.lut_size
+                    ),
+                });
+            }
+            scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_diffuse", a, bytemuck::cast_slice(&inputs.lut.diffuse_opacity))?;
+            scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_specular", b, bytemuck::cast_slice(&inputs.lut.specular_roughness))?;
+            scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_emissive", c, bytemuck::cast_slice(&inputs.lut.emissive))?;
+            scene_gpu::add_upload(ctx, graph, &mut frame, "upload_majorant", self.scene.majorant, bytemuck::cast_slice(&majorants))?;
+        }
+
+        // Frame uniforms for this slot.
+        let uniforms = self.uniforms(inputs, majorant_max);
+        let slot = &self.slots[slot_index];
+        let ubo = slot.uniforms;
+        self.graph.buffer_mut(ubo).write(bytemuck::bytes_of(&uniforms))?;
+        let graph = &mut self.graph;
+        let scene = SceneBindings {
+            uniforms: ubo,
+            volume: self.scene.volume,
+            tf_diffuse_opacity: self.scene.tf[0],
+            tf_specular_roughness: self.scene.tf[1],
+            tf_emissive: self.scene.tf[2],
+            majorant: self.scene.majorant,
+            environment: self.scene.environment,
+        };
+
+        // The frame: features → path trace → motion → denoisers.
+        let features = self.passes.features.add(ctx, graph, &mut frame, &scene, size)?;
+        let noisy = self.passes.path_trace.add(
+            ctx, graph, &mut frame, "path_trace", &scene, size, 0, self.settings.spp,
+        )?;
+        let motion = self.passes.motion.add(
+            ctx, graph, &mut frame, ubo, noisy.first_hit, features.position, size,
+        )?;
+        let input = DenoiseInputs {
+            uniforms: ubo,
+            noisy: noisy.radiance,
+            moments: noisy.moments,
+            features,
+            motion,
+            size,
+            spp: self.settings.spp,
+            changes,
+        };
+        let mut outputs: Vec<(String, ImageHandle)> = Vec::new();
+        for d in &self.denoisers {
+            let out = d.add(ctx, graph, &mut frame, &input)?;
+            outputs.push((d.name().to_string(), out));
+        }
+
+        let readbacks = if request.readback {
+            add_readbacks(ctx, graph, &mut frame, slot_index, &outputs, size)?
+        } else {
+            Vec::new()
+        };
+        let slot = &mut self.slots[slot_index];
+        submit(ctx, graph, slot, frame)?;
+        slot.pending = Some((self.frame_index, readbacks));
+        self.graph.end_frame();
+        self.current_lut = Some(inputs.lut.clone());
+        self.last_inputs = Some(inputs.clone());
+        self.frame_index += 1;
+        Ok(completed)
+    }
+
+    fn changes(&self, inputs: &FrameInputs, reset: bool) -> Changes {
+        match &self.last_inputs {
+            None => Changes {
+                camera: true,
+                lights: true,
+                transfer_function: true,
+            },
+            Some(last) => Changes {
+                camera: reset || last.camera != inputs.camera,
+                lights: reset || last.lights != inputs.lights,
+                transfer_function: reset || last.lut != inputs.lut,
+            },
+        }
+    }
+
+    /// Waits for a slot's previous frame and collects its timings and readbacks.
+    fn wait_slot(&mut self, i: usize) -> Result<Option<FrameResult>> {
+        let slot = &mut self.slots[i];
+        let d = &self.ctx.device;
+        unsafe { d.wait_for_fences(&[slot.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        let Some((index, readbacks)) = slot.pending.take() else {
+            return Ok(None);
+        };
+        let timings = slot.timestamps.read(&self.ctx)?;
+        let mut images = Vec::new();
+        for (name, buffer) in readbacks {
+            let bytes = self.graph.buffer_ref(buffer).mapped().ok_or_else(|| {
+                EngineError::Resource {
+                    resource: name.clone(),
+                    problem: "readback buffer is not host visible".into(),
+                }
+            })?;
+            images.push((name, bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec()));
+        }
+        Ok(Some(FrameResult {
+            index,
+            timings,
+            images,
+        }))
+    }
+
+    /// Waits for every frame in flight; returns their results in order.
+    pub fn flush(&mut self) -> Result<Vec<FrameResult>> {
+        let mut out = Vec::new();
+        for k in 0..SLOTS as u64 {
+            let i = ((self.frame_index + k) % SLOTS as u64) as usize;
+            if let Some(r) = self.wait_slot(i)? {
+                out.push(r);
+            }
+        }
+        out.sort_by_key(|r| r.index);
+        Ok(out)
+    }
+
+    /// Renders a high-sample reference of one animation frame: `spp` samples accumulated
+    /// in batches of `batch`, independent of the per-frame noise stream.
+    pub fn reference(&mut self, inputs: &FrameInputs, spp: u32, batch: u32) -> Result<Vec<[f32; 4]>> {
+        self.flush()?;
+        let batch = batch.clamp(1, spp.max(1));
+        self.graph.reset_history("reference.");
+        let mut done = 0;
+        let mut image = Vec::new();
+        // Upload the TF/majorant through a normal frame first, so the scene state matches.
+        let majorants = scene_gpu::majorants(
+            &self.bricks,
+            &inputs.lut.diffuse_opacity.iter().map(|c| c[3]).collect::<Vec<_>>(),
+            self.settings.density_scale,
+        );
+        let majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
+        let mut uniforms = self.uniforms(inputs, majorant_max);
+        // References draw from their own sample stream: frame index far from any capture.
+        uniforms.counts.y = i32::MAX - self.frame_index as i32;
+        while done < spp {
+            let n = batch.min(spp - done);
+            let ctx = &self.ctx;
+            let graph = &mut self.graph;
+            let ubo = self.slots[0].uniforms;
+            graph.buffer_mut(ubo).write(bytemuck::bytes_of(&uniforms))?;
+            let mut frame = Frame::new();
+            if self.current_lut.as_ref() != Some(&inputs.lut) {
+                let [a, b, c] = self.scene.tf;
+                scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_diffuse", a, bytemuck::cast_slice(&inputs.lut.diffuse_opacity))?;
+                scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_specular", b, bytemuck::cast_slice(&inputs.lut.specular_roughness))?;
+                scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_emissive", c, bytemuck::cast_slice(&inputs.lut.emissive))?;
+                scene_gpu::add_upload(ctx, graph, &mut frame, "upload_majorant", self.scene.majorant, bytemuck::cast_slice(&majorants))?;
+                self.current_lut = Some(inputs.lut.clone());
+            }
+            let scene = SceneBindings {
+                uniforms: ubo,
+                volume: self.scene.volume,
+                tf_diffuse_opacity: self.scene.tf[0],
+                tf_specular_roughness: self.scene.tf[1],
+                tf_emissive: self.scene.tf[2],
+                majorant: self.scene.majorant,
+                environment: self.scene.environment,
+            };
+            let size = self.settings.size;
+            let batch_out = self.passes.path_trace.add(
+                ctx, graph, &mut frame, "reference.path_trace", &scene, size, done, n,
+            )?;
+            let mean = self.passes.accumulate.add(
+                ctx, graph, &mut frame, "reference.accumulate", batch_out.radiance, n as f32, size,
+            )?;
+            done += n;
+            let readbacks = if done >= spp {
+                add_readbacks(ctx, graph, &mut frame, 0, &[("reference".to_string(), mean)], size)?
+            } else {
+                Vec::new()
+            };
+            ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, frame))?;
+            graph.end_frame();
+            if let Some((_, buffer)) = readbacks.first() {
+                let bytes = graph.buffer_ref(*buffer).mapped().ok_or_else(|| EngineError::Resource {
+                    resource: "reference readback".into(),
+                    problem: "not host visible".into(),
+                })?;
+                image = bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec();
+            }
+        }
+        Ok(image)
+    }
+}
+
+fn add_readbacks<'f>(
+    ctx: &GpuContext,
+    graph: &mut RenderGraph,
+    frame: &mut Frame<'f>,
+    slot: usize,
+    outputs: &[(String, ImageHandle)],
+    size: Extent,
+) -> Result<Vec<(String, BufferHandle)>> {
+    let bytes = size.width as u64 * size.height as u64 * 16;
+    let mut out = Vec::new();
+    for (name, image) in outputs {
+        let buffer = graph.buffer(ctx, &format!("readback.{name}.{slot}"), bytes, MemoryLocation::GpuToCpu)?;
+        let image = *image;
+        frame.add_pass(
+            format!("readback_{name}"),
+            |b| {
+                b.transfer_src(image).transfer_dst(buffer);
+            },
+            move |pc| pc.copy_image_to_buffer(image, buffer),
+        );
+        frame.add_host_read(format!("host_read_{name}"), buffer);
+        out.push((name.clone(), buffer));
+    }
+    Ok(out)
+}
+
+fn submit(ctx: &GpuContext, graph: &mut RenderGraph, slot: &mut Slot, frame: Frame) -> Result<()> {
+    let d = &ctx.device;
+    unsafe {
+        d.reset_fences(&[slot.fence]).vk("vkResetFences")?;
+        d.reset_command_buffer(slot.cmd, vk::CommandBufferResetFlags::empty())
+            .vk("vkResetCommandBuffer")?;
+        d.begin_command_buffer(
+            slot.cmd,
+            &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+        )
+        .vk("vkBeginCommandBuffer")?;
+    }
+    slot.timestamps.reset(ctx, slot.cmd);
+    graph.execute(ctx, slot.cmd, Some(&mut slot.timestamps), frame)?;
+    unsafe {
+        d.end_command_buffer(slot.cmd).vk("vkEndCommandBuffer")?;
+        let cmds = [slot.cmd];
+        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+        d.queue_submit(ctx.queue, &submit, slot.fence).vk("vkQueueSubmit")?;
+    }
+    Ok(())
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        let ctx = &self.ctx;
+        let _ = ctx.wait_idle();
+        for s in &mut self.slots {
+            s.timestamps.destroy(ctx);
+            unsafe { ctx.device.destroy_fence(s.fence, None) };
+        }
+        unsafe { ctx.device.destroy_command_pool(self.pool, None) };
+        for d in &mut self.denoisers {
+            d.destroy(ctx);
+        }
+        self.passes.features.destroy(ctx);
+        self.passes.path_trace.destroy(ctx);
+        self.passes.motion.destroy(ctx);
+        self.passes.accumulate.destroy(ctx);
+        self.graph.destroy(ctx);
+    }
+}

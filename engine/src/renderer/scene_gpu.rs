@@ -1,0 +1,250 @@
+//! The scene's GPU-side data: the density volume as a 3D texture, the transfer function
+//! as 1D LUTs, the majorant grid and the environment map. Uploads go through the render
+//! graph as transfer passes, like everything else.
+
+use crate::error::{EngineError, Result};
+use crate::gpu::{GpuContext, ImageDesc};
+use crate::graph::{Frame, ImageHandle, RenderGraph};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+/// Texel format of an uploaded volume.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VolumeFormat {
+    R8,
+    R16,
+    R32F,
+}
+
+impl VolumeFormat {
+    pub fn vk(self) -> vk::Format {
+        match self {
+            VolumeFormat::R8 => vk::Format::R8_UNORM,
+            VolumeFormat::R16 => vk::Format::R16_UNORM,
+            VolumeFormat::R32F => vk::Format::R32_SFLOAT,
+        }
+    }
+    pub fn bytes(self) -> usize {
+        match self {
+            VolumeFormat::R8 => 1,
+            VolumeFormat::R16 => 2,
+            VolumeFormat::R32F => 4,
+        }
+    }
+}
+
+/// Min/max normalised density per brick (a coarse grid over the volume).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BrickRanges {
+    pub grid: [u32; 3],
+    pub min: Vec<f32>,
+    pub max: Vec<f32>,
+}
+
+/// A volume ready for upload.
+#[derive(Clone, Debug)]
+pub struct VolumeUpload {
+    pub name: String,
+    pub dims: [u32; 3],
+    pub format: VolumeFormat,
+    /// Texel bytes, x fastest.
+    pub bytes: Vec<u8>,
+    /// World-space size of the box (the volume is centred at the origin).
+    pub world_size: [f32; 3],
+    pub bricks: BrickRanges,
+}
+
+/// One transfer function sampled into LUTs (rgba each, same length).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LutUpload {
+    pub diffuse_opacity: Vec<[f32; 4]>,
+    pub specular_roughness: Vec<[f32; 4]>,
+    pub emissive: Vec<[f32; 4]>,
+}
+
+/// An equirectangular RGB environment map.
+#[derive(Clone, Debug)]
+pub struct EnvironmentUpload {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<[f32; 4]>,
+}
+
+pub struct SceneImages {
+    pub volume: ImageHandle,
+    pub tf: [ImageHandle; 3],
+    pub majorant: ImageHandle,
+    pub environment: ImageHandle,
+}
+
+/// Adds a pass that copies `bytes` into `image` through a staging buffer.
+pub fn add_upload<'f>(
+    ctx: &GpuContext,
+    graph: &mut RenderGraph,
+    frame: &mut Frame<'f>,
+    name: &str,
+    image: ImageHandle,
+    bytes: &[u8],
+) -> Result<()> {
+    let staging = graph.buffer(
+        ctx,
+        &format!("{name}.staging"),
+        bytes.len() as u64,
+        MemoryLocation::CpuToGpu,
+    )?;
+    graph.buffer_mut(staging).write(bytes)?;
+    frame.add_pass(
+        name.to_string(),
+        |b| {
+            b.transfer_src(staging).transfer_dst(image);
+        },
+        move |pc| pc.copy_buffer_to_image(staging, image),
+    );
+    Ok(())
+}
+
+/// Checks a volume against the device's limits before anything is allocated.
+pub fn check_volume_fits(ctx: &GpuContext, v: &VolumeUpload) -> Result<()> {
+    let texels: u64 = v.dims.iter().map(|&d| d as u64).product();
+    let needed = texels * v.format.bytes() as u64;
+    if needed != v.bytes.len() as u64 {
+        return Err(EngineError::Resource {
+            resource: v.name.clone(),
+            problem: format!("{} bytes for {:?} voxels of {:?}", v.bytes.len(), v.dims, v.format),
+        });
+    }
+    if let Some(&d) = v.dims.iter().find(|&&d| d > ctx.info.max_image_dimension_3d) {
+        return Err(EngineError::TooLarge {
+            what: format!("volume {:?}: dimension {d}", v.name),
+            needed: d as u64,
+            limit: ctx.info.max_image_dimension_3d as u64,
+            device: ctx.info.name.clone(),
+        });
+    }
+    // The texture and its staging copy live at once; each must fit one allocation.
+    if needed > ctx.info.max_memory_allocation_size {
+        return Err(EngineError::TooLarge {
+            what: format!("volume {:?} ({:?} voxels, {:?})", v.name, v.dims, v.format),
+            needed,
+            limit: ctx.info.max_memory_allocation_size,
+            device: ctx.info.name.clone(),
+        });
+    }
+    Ok(())
+}
+
+/// Creates the scene images and adds their uploads to `frame`.
+pub fn create<'f>(
+    ctx: &GpuContext,
+    graph: &mut RenderGraph,
+    frame: &mut Frame<'f>,
+    volume: &VolumeUpload,
+    environment: Option<&EnvironmentUpload>,
+    lut_size: u32,
+) -> Result<SceneImages> {
+    check_volume_fits(ctx, volume)?;
+    let vol = graph.image(ctx, "scene.volume", ImageDesc::d3(volume.dims, volume.format.vk()))?;
+    add_upload(ctx, graph, frame, "upload_volume", vol, &volume.bytes)?;
+    let lut_desc = ImageDesc::d1(lut_size, vk::Format::R32G32B32A32_SFLOAT);
+    let tf = [
+        graph.image(ctx, "scene.tf_diffuse_opacity", lut_desc)?,
+        graph.image(ctx, "scene.tf_specular_roughness", lut_desc)?,
+        graph.image(ctx, "scene.tf_emissive", lut_desc)?,
+    ];
+    let majorant = graph.image(
+        ctx,
+        "scene.majorant",
+        ImageDesc::d3(volume.bricks.grid, vk::Format::R32_SFLOAT),
+    )?;
+    let env = match environment {
+        Some(e) => {
+            let h = graph.image(
+                ctx,
+                "scene.environment",
+                ImageDesc::d2(e.width, e.height, vk::Format::R32G32B32A32_SFLOAT),
+            )?;
+            add_upload(ctx, graph, frame, "upload_environment", h, bytemuck::cast_slice(&e.rgba))?;
+            h
+        }
+        None => {
+            let h = graph.image(
+                ctx,
+                "scene.environment",
+                ImageDesc::d2(1, 1, vk::Format::R32G32B32A32_SFLOAT),
+            )?;
+            add_upload(ctx, graph, frame, "upload_environment", h, bytemuck::cast_slice(&[[0f32; 4]]))?;
+            h
+        }
+    };
+    Ok(SceneImages {
+        volume: vol,
+        tf,
+        majorant,
+        environment: env,
+    })
+}
+
+/// Max extinction per brick for the current TF: the largest LUT opacity over the
+/// brick's density range (LUT entries bracketing the range, since linear interpolation
+/// never exceeds its neighbours), times the density scale.
+pub fn majorants(bricks: &BrickRanges, opacity: &[f32], density_scale: f32) -> Vec<f32> {
+    let n = opacity.len();
+    if n == 0 {
+        return vec![0.0; bricks.min.len()];
+    }
+    // Sparse table for O(1) range maxima over the LUT.
+    let mut table = vec![opacity.to_vec()];
+    let mut span = 1;
+    while span * 2 <= n {
+        let prev = &table[table.len() - 1];
+        let next: Vec<f32> = (0..=n - span * 2).map(|i| prev[i].max(prev[i + span])).collect();
+        table.push(next);
+        span *= 2;
+    }
+    let range_max = |lo: usize, hi: usize| {
+        let len = hi - lo + 1;
+        let k = usize::BITS as usize - 1 - len.leading_zeros() as usize;
+        table[k][lo].max(table[k][hi + 1 - (1 << k)])
+    };
+    let scale = (n - 1) as f32;
+    bricks
+        .min
+        .iter()
+        .zip(&bricks.max)
+        .map(|(&lo, &hi)| {
+            let a = ((lo.clamp(0.0, 1.0) * scale).floor() as usize).min(n - 1);
+            let b = ((hi.clamp(0.0, 1.0) * scale).ceil() as usize).min(n - 1);
+            range_max(a.min(b), b.max(a)) * density_scale
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn majorant_bounds_every_interpolated_opacity_in_range() {
+        let opacity: Vec<f32> = (0..256).map(|i| ((i as f32) * 0.37).sin().abs()).collect();
+        let bricks = BrickRanges {
+            grid: [3, 1, 1],
+            min: vec![0.0, 0.2, 0.9],
+            max: vec![0.1, 0.55, 1.0],
+        };
+        let m = majorants(&bricks, &opacity, 2.0);
+        for (k, (&lo, &hi)) in bricks.min.iter().zip(&bricks.max).enumerate() {
+            for s in 0..=1000 {
+                let d = lo + (hi - lo) * s as f32 / 1000.0;
+                let x = d * 255.0;
+                let i = x.floor() as usize;
+                let f = x - i as f32;
+                let v = opacity[i] * (1.0 - f) + opacity[(i + 1).min(255)] * f;
+                assert!(v * 2.0 <= m[k] + 1e-6, "brick {k} density {d}: {v} > {}", m[k]);
+            }
+        }
+        // Tight for a constant range.
+        let flat = BrickRanges { grid: [1, 1, 1], min: vec![0.5], max: vec![0.5] };
+        let c = majorants(&flat, &vec![0.25; 256], 4.0);
+        assert!((c[0] - 1.0).abs() < 1e-6);
+    }
+}

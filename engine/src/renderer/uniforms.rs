@@ -1,0 +1,159 @@
+//! `#[repr(C)]` mirrors of the GLSL uniform and push-constant blocks. The GLSL in
+//! shaders/glsl is the source of truth; `tests::layouts_match_reflection` compares every
+//! field offset here with the offsets SPIR-V reflection reads from the compiled shaders.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, UVec4, IVec4, Vec4};
+
+/// Mirrors `frame.glsl`'s MAX_LIGHTS.
+pub const MAX_LIGHTS: usize = 4;
+pub const LIGHT_POINT: f32 = 0.0;
+pub const LIGHT_AREA: f32 = 1.0;
+pub const LIGHT_ENV: f32 = 2.0;
+pub const ENV_CONSTANT: f32 = 0.0;
+pub const ENV_GRADIENT: f32 = 1.0;
+pub const ENV_MAP: f32 = 2.0;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable, PartialEq)]
+pub struct GpuLight {
+    pub position_kind: Vec4,
+    pub radiance: Vec4,
+    pub u_axis: Vec4,
+    pub v_axis: Vec4,
+}
+
+/// `FrameBlock` in frame.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameUniforms {
+    pub view_proj: Mat4,
+    pub inv_view_proj: Mat4,
+    pub prev_view_proj: Mat4,
+    pub camera_pos: Vec4,
+    pub box_min: Vec4,
+    pub box_max: Vec4,
+    pub dims: IVec4,
+    pub counts: IVec4,
+    pub params: Vec4,
+    pub seeds: UVec4,
+    pub lights: [GpuLight; MAX_LIGHTS],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct PathTracePush {
+    pub sample_offset: u32,
+    pub spp: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct FeaturesPush {
+    pub width: u32,
+    pub height: u32,
+    pub step_voxels: f32,
+    pub pad: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct MotionPush {
+    pub width: u32,
+    pub height: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct AccumulatePush {
+    pub width: u32,
+    pub height: u32,
+    pub history_valid: u32,
+    pub weight: f32,
+}
+
+/// Field names and offsets of a mirror struct, for the layout test.
+#[macro_export]
+macro_rules! field_offsets {
+    ($t:ty { $($f:ident),* $(,)? }) => {
+        vec![$((stringify!($f), std::mem::offset_of!($t, $f))),*]
+    };
+}
+
+/// (shader, block name or "push", size, field offsets) for every mirrored block.
+pub fn mirrored_layouts() -> Vec<(&'static str, &'static str, usize, Vec<(&'static str, usize)>)> {
+    vec![
+        (
+            "path_trace",
+            "FrameBlock",
+            std::mem::size_of::<FrameUniforms>(),
+            field_offsets!(FrameUniforms {
+                view_proj, inv_view_proj, prev_view_proj, camera_pos, box_min, box_max, dims,
+                counts, params, seeds, lights
+            }),
+        ),
+        (
+            "path_trace",
+            "push",
+            std::mem::size_of::<PathTracePush>(),
+            field_offsets!(PathTracePush { sample_offset, spp, width, height }),
+        ),
+        (
+            "surface_features",
+            "push",
+            std::mem::size_of::<FeaturesPush>(),
+            field_offsets!(FeaturesPush { width, height, step_voxels, pad }),
+        ),
+        (
+            "motion",
+            "push",
+            std::mem::size_of::<MotionPush>(),
+            field_offsets!(MotionPush { width, height, pad0, pad1 }),
+        ),
+        (
+            "accumulate",
+            "push",
+            std::mem::size_of::<AccumulatePush>(),
+            field_offsets!(AccumulatePush { width, height, history_valid, weight }),
+        ),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::pipeline::shader_reflection;
+
+    #[test]
+    fn layouts_match_reflection() {
+        for (shader, block, size, fields) in mirrored_layouts() {
+            let r = shader_reflection(shader).expect("embedded shader reflects");
+            let members = if block == "push" {
+                assert_eq!(
+                    r.push_constant_size as usize, size,
+                    "{shader}: push-constant size differs from the Rust mirror"
+                );
+                r.push_constants.clone().expect("shader has push constants")
+            } else {
+                let m = r.blocks.get(block).unwrap_or_else(|| panic!("{shader} has no block {block}"));
+                let end = m.iter().map(|m| (m.offset + m.size) as usize).max().unwrap_or(0);
+                assert_eq!(end, size, "{shader}: {block} size differs from the Rust mirror");
+                m.clone()
+            };
+            assert_eq!(members.len(), fields.len(), "{shader}: {block} member count");
+            for (m, (name, offset)) in members.iter().zip(&fields) {
+                assert_eq!(&m.name, name, "{shader}: {block} member order");
+                assert_eq!(m.offset as usize, *offset, "{shader}: {block}.{name} offset");
+            }
+        }
+    }
+
+    #[test]
+    fn light_struct_is_four_vec4() {
+        assert_eq!(std::mem::size_of::<GpuLight>(), 64);
+    }
+}

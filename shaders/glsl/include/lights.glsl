@@ -1,0 +1,79 @@
+// Light sampling for next-event estimation: one light chosen uniformly per vertex.
+#ifndef DVR_LIGHTS_GLSL
+#define DVR_LIGHTS_GLSL
+
+#include "common.glsl"
+#include "frame.glsl"
+#include "specialization.glsl"
+
+layout(binding = 6) uniform sampler2D environment_map;  // equirectangular, rgb radiance
+
+struct LightSample {
+    vec3 dir;        // towards the light
+    float dist;      // FLT_BIG for the environment
+    vec3 radiance;   // incident radiance / pdf (already divided by the pdf)
+};
+
+vec3 uniform_sphere(float u1, float u2) {
+    float z = 1.0 - 2.0 * u1;
+    float r = sqrt(max(0.0, 1.0 - z * z));
+    float phi = 2.0 * PI * u2;
+    return vec3(r * cos(phi), r * sin(phi), z);
+}
+
+vec3 environment_radiance(Light l, vec3 dir) {
+    int mode = int(l.radiance.w);
+    if (mode == ENV_GRADIENT) {
+        return mix(l.u_axis.rgb, l.radiance.rgb, 0.5 * (dir.y + 1.0));
+    }
+    if (HAS_ENV_MAP && mode == ENV_MAP) {
+        vec2 uv = vec2(atan(dir.z, dir.x) / (2.0 * PI) + 0.5, acos(clamp(dir.y, -1.0, 1.0)) / PI);
+        return texture(environment_map, uv).rgb * l.u_axis.w;
+    }
+    return l.radiance.rgb;
+}
+
+// Radiance seen along an escaping ray (camera rays that miss everything).
+vec3 escaped_radiance(vec3 dir) {
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < frame.counts.x; ++i) {
+        if (int(frame.lights[i].position_kind.w) == LIGHT_ENV) {
+            sum += environment_radiance(frame.lights[i], dir);
+        }
+    }
+    return sum;
+}
+
+LightSample sample_light(vec3 p, inout Rng rng) {
+    int count = frame.counts.x;
+    int index = min(int(rng_next(rng) * float(count)), count - 1);
+    Light l = frame.lights[index];
+    int kind = int(l.position_kind.w);
+    LightSample s;
+    float choice = float(count);
+    if (kind == LIGHT_ENV) {
+        s.dir = uniform_sphere(rng_next(rng), rng_next(rng));
+        s.dist = FLT_BIG;
+        s.radiance = environment_radiance(l, s.dir) * (4.0 * PI) * choice;
+    } else if (kind == LIGHT_AREA) {
+        vec3 q = l.position_kind.xyz + (2.0 * rng_next(rng) - 1.0) * l.u_axis.xyz
+                 + (2.0 * rng_next(rng) - 1.0) * l.v_axis.xyz;
+        vec3 to = q - p;
+        float d2 = max(dot(to, to), 1e-8);
+        s.dist = sqrt(d2);
+        s.dir = to / s.dist;
+        vec3 n = cross(l.u_axis.xyz, l.v_axis.xyz);
+        float area = 4.0 * length(n);
+        float cos_l = abs(dot(normalize(n), s.dir));  // two-sided emitter
+        s.radiance = l.radiance.rgb * cos_l * area / d2 * choice;
+    } else {
+        vec3 to = l.position_kind.xyz - p;
+        float d2 = max(dot(to, to), 1e-8);
+        s.dist = sqrt(d2);
+        s.dir = to / s.dist;
+        s.radiance = l.radiance.rgb / d2 * choice;
+    }
+    return s;
+}
+
+#endif

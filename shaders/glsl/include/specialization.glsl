@@ -1,0 +1,17 @@
+// Specialisation constants: what a scene uses. The pipeline is built per scene with only
+// those features compiled in ("model no more than a scene needs"). Rust sets them by name.
+#ifndef DVR_SPECIALIZATION_GLSL
+#define DVR_SPECIALIZATION_GLSL
+
+#define ESTIMATOR_DELTA 0
+#define ESTIMATOR_RAY_MARCH 1
+#define PHASE_ISOTROPIC 0
+#define PHASE_HG 1
+#define PHASE_HYBRID 2
+
+layout(constant_id = 0) const int ESTIMATOR = ESTIMATOR_DELTA;
+layout(constant_id = 1) const int PHASE = PHASE_ISOTROPIC;
+layout(constant_id = 2) const bool USE_EMISSION = false;
+layout(constant_id = 3) const bool HAS_ENV_MAP = false;
+
+#endif

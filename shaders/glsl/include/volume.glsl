@@ -1,0 +1,95 @@
+// The density volume, its transfer-function LUTs and the majorant grid: bindings shared by
+// every pass that looks into the volume, and the functions that sample them.
+#ifndef DVR_VOLUME_GLSL
+#define DVR_VOLUME_GLSL
+
+#include "frame.glsl"
+
+layout(binding = 1) uniform sampler3D volume_density;      // normalised density [0,1]
+layout(binding = 2) uniform sampler1D tf_diffuse_opacity;  // rgb albedo, a opacity
+layout(binding = 3) uniform sampler1D tf_specular_roughness;
+layout(binding = 4) uniform sampler1D tf_emissive;
+layout(binding = 5) uniform sampler3D majorant_grid;       // max μt per brick (texelFetch)
+
+vec3 box_size() { return frame.box_max.xyz - frame.box_min.xyz; }
+
+vec3 to_uvw(vec3 p) { return (p - frame.box_min.xyz) / box_size(); }
+
+float density_at(vec3 p) { return texture(volume_density, to_uvw(p)).r; }
+
+// LUT coordinate hitting texel centres: entry i is density i/(N-1).
+float lut_coord(float d) {
+    float n = float(textureSize(tf_diffuse_opacity, 0));
+    return (clamp(d, 0.0, 1.0) * (n - 1.0) + 0.5) / n;
+}
+
+vec4 tf_albedo_opacity(float d) { return texture(tf_diffuse_opacity, lut_coord(d)); }
+vec4 tf_specular(float d) { return texture(tf_specular_roughness, lut_coord(d)); }
+vec3 tf_emission(float d) { return texture(tf_emissive, lut_coord(d)).rgb; }
+
+// Extinction coefficient at p (per world unit).
+float extinction_at(vec3 p) {
+    return tf_albedo_opacity(density_at(p)).a * frame.box_min.w;
+}
+
+// Central-difference gradient of density, in density per voxel.
+vec3 density_gradient(vec3 p) {
+    vec3 h = box_size() / vec3(frame.dims.xyz);
+    return 0.5 * vec3(
+        density_at(p + vec3(h.x, 0, 0)) - density_at(p - vec3(h.x, 0, 0)),
+        density_at(p + vec3(0, h.y, 0)) - density_at(p - vec3(0, h.y, 0)),
+        density_at(p + vec3(0, 0, h.z)) - density_at(p - vec3(0, 0, h.z)));
+}
+
+// Ray/box intersection; returns (t_enter, t_exit), empty when t_enter >= t_exit.
+vec2 intersect_box(vec3 o, vec3 d) {
+    vec3 inv = 1.0 / d;
+    vec3 t0 = (frame.box_min.xyz - o) * inv;
+    vec3 t1 = (frame.box_max.xyz - o) * inv;
+    vec3 tmin = min(t0, t1);
+    vec3 tmax = max(t0, t1);
+    return vec2(max(max(tmin.x, tmin.y), max(tmin.z, 0.0)), min(min(tmax.x, tmax.y), tmax.z));
+}
+
+// Majorant grid traversal (Amanatides–Woo). The grid covers the box; cell c spans
+// brick c of the volume.
+struct GridWalk {
+    ivec3 cell;
+    ivec3 step_dir;
+    vec3 t_next;
+    vec3 t_delta;
+    ivec3 grid;
+};
+
+GridWalk grid_walk_begin(vec3 o, vec3 d, float t) {
+    GridWalk w;
+    w.grid = textureSize(majorant_grid, 0);
+    vec3 cell_size = box_size() / vec3(w.grid);
+    vec3 p = o + d * t;
+    vec3 g = (p - frame.box_min.xyz) / cell_size;
+    w.cell = clamp(ivec3(floor(g)), ivec3(0), w.grid - 1);
+    w.step_dir = ivec3(sign(d));
+    vec3 inv = 1.0 / max(abs(d), vec3(1e-12));
+    w.t_delta = cell_size * inv;
+    vec3 next_boundary = frame.box_min.xyz + (vec3(w.cell) + step(vec3(0.0), d)) * cell_size;
+    w.t_next = t + (next_boundary - p) * sign(d) * inv;
+    w.t_next = mix(vec3(FLT_BIG), w.t_next, notEqual(w.step_dir, ivec3(0)));
+    return w;
+}
+
+float grid_walk_exit(GridWalk w) { return min(w.t_next.x, min(w.t_next.y, w.t_next.z)); }
+
+bool grid_walk_advance(inout GridWalk w) {
+    if (w.t_next.x <= w.t_next.y && w.t_next.x <= w.t_next.z) {
+        w.cell.x += w.step_dir.x; w.t_next.x += w.t_delta.x;
+    } else if (w.t_next.y <= w.t_next.z) {
+        w.cell.y += w.step_dir.y; w.t_next.y += w.t_delta.y;
+    } else {
+        w.cell.z += w.step_dir.z; w.t_next.z += w.t_delta.z;
+    }
+    return all(greaterThanEqual(w.cell, ivec3(0))) && all(lessThan(w.cell, w.grid));
+}
+
+float grid_majorant(GridWalk w) { return texelFetch(majorant_grid, w.cell, 0).r; }
+
+#endif

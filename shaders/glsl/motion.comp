@@ -1,0 +1,46 @@
+#version 460
+// Motion vectors to the previous frame, in pixels: where this pixel's surface was last
+// frame, from the closest first real collision (xy, the paper's choice) and from the
+// deterministic opacity-threshold position (zw). Pixels whose ray hit nothing use a point
+// far along the view ray, so camera rotation still moves the background correctly.
+#include "common.glsl"
+#include "frame.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = 7, rgba32f) uniform readonly image2D first_hit;
+layout(binding = 8, rgba32f) uniform readonly image2D feature_position;
+layout(binding = 9, rgba32f) uniform writeonly image2D motion;
+
+layout(push_constant) uniform MotionPush {
+    uint width;
+    uint height;
+    uint pad0;
+    uint pad1;
+} pc;
+
+vec2 previous_pixel(vec3 world) {
+    vec4 clip = frame.prev_view_proj * vec4(world, 1.0);
+    vec2 ndc = clip.xy / max(clip.w, 1e-6);
+    return (ndc * 0.5 + 0.5) * vec2(pc.width, pc.height);
+}
+
+vec3 far_point(vec2 pixel) {
+    vec2 ndc = pixel / vec2(pc.width, pc.height) * 2.0 - 1.0;
+    vec4 far_h = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+    vec3 d = normalize(far_h.xyz / far_h.w - frame.camera_pos.xyz);
+    return frame.camera_pos.xyz + d * 1000.0;
+}
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (pixel.x >= pc.width || pixel.y >= pc.height) return;
+    vec2 centre = vec2(pixel) + 0.5;
+    vec4 hit = imageLoad(first_hit, ivec2(pixel));
+    vec4 feat = imageLoad(feature_position, ivec2(pixel));
+    vec3 p_hit = hit.w > 0.0 ? hit.xyz : far_point(centre);
+    vec3 p_feat = feat.w > 0.0 ? feat.xyz : far_point(centre);
+    vec2 m_hit = previous_pixel(p_hit) - centre;
+    vec2 m_feat = previous_pixel(p_feat) - centre;
+    imageStore(motion, ivec2(pixel), vec4(m_hit, m_feat));
+}

@@ -1,0 +1,59 @@
+#version 460
+// Deterministic surface features for reprojection and edge-stopping: march the pixel
+// centre's ray front to back, compositing opacity, and stop where accumulated opacity
+// crosses a threshold. There: world position, linear depth, gradient normal and TF albedo,
+// with a validity flag (0 where the threshold is never reached).
+#include "common.glsl"
+#include "frame.glsl"
+#include "volume.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = 7, rgba32f) uniform writeonly image2D feature_position;  // xyz, w valid
+layout(binding = 8, rgba32f) uniform writeonly image2D feature_normal;    // xyz, w depth
+layout(binding = 9, rgba32f) uniform writeonly image2D feature_albedo;    // rgb, w valid
+
+layout(push_constant) uniform FeaturesPush {
+    uint width;
+    uint height;
+    float step_voxels;  // march step in voxels
+    float pad;
+} pc;
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (pixel.x >= pc.width || pixel.y >= pc.height) return;
+    vec2 ndc = (vec2(pixel) + 0.5) / vec2(pc.width, pc.height) * 2.0 - 1.0;
+    vec4 far_h = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
+    vec3 o = frame.camera_pos.xyz;
+    vec3 d = normalize(far_h.xyz / far_h.w - o);
+    vec2 span = intersect_box(o, d);
+    float voxel = min(box_size().x / float(frame.dims.x),
+                      min(box_size().y / float(frame.dims.y), box_size().z / float(frame.dims.z)));
+    float step_len = voxel * pc.step_voxels;
+    float alpha = 0.0;
+    float threshold = frame.params.z;
+    vec4 pos = vec4(0.0);
+    vec4 nrm = vec4(0.0, 0.0, 0.0, 0.0);
+    vec4 alb = vec4(0.0);
+    if (span.x < span.y) {
+        for (float t = span.x; t < span.y; t += step_len) {
+            vec3 p = o + d * t;
+            float a = 1.0 - exp(-extinction_at(p) * step_len);
+            alpha += (1.0 - alpha) * a;
+            if (alpha >= threshold) {
+                float density = density_at(p);
+                vec3 g = density_gradient(p);
+                vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
+                if (dot(n, d) > 0.0) n = -n;
+                pos = vec4(p, 1.0);
+                nrm = vec4(n, t);
+                alb = vec4(tf_albedo_opacity(density).rgb, 1.0);
+                break;
+            }
+        }
+    }
+    imageStore(feature_position, ivec2(pixel), pos);
+    imageStore(feature_normal, ivec2(pixel), nrm);
+    imageStore(feature_albedo, ivec2(pixel), alb);
+}
