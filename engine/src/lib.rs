@@ -4,12 +4,13 @@
 //! `renderer` (the frame). CPU-side data (`volume`, `transfer`, `scene`, `metrics`) feeds
 //! them.
 
+pub mod denoise;
 pub mod error;
 pub mod gpu;
 pub mod graph;
+pub mod metrics;
+pub mod passes;
+pub mod renderer;
 pub mod shaders;
 
 pub use error::{EngineError, Result};
-pub mod denoise;
-pub mod passes;
-pub mod renderer;
