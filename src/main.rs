@@ -1,1 +1,1 @@
-fn main() { println!("{}", dvr_engine::SHADERS.len()); }
+fn main() {}

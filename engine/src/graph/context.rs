@@ -100,15 +100,9 @@ impl<'a> PassContext<'a> {
         push: &P,
         groups: [u32; 3],
     ) -> Result<()> {
-        for (name, _) in bindings {
-            if !pipeline.reflection.bindings.iter().any(|b| b.name == *name) {
-                return Err(self.err(format!(
-                    "shader {} has no binding named {name:?} (has: {:?})",
-                    pipeline.name,
-                    pipeline.reflection.bindings.iter().map(|b| &b.name).collect::<Vec<_>>()
-                )));
-            }
-        }
+        // Names the shader does not reflect are skipped: the optimiser drops bindings a
+        // specialised variant never reads (e.g. the emissive LUT without emission). Every
+        // binding the shader does use must be bound, which catches misspelt names.
         let mut image_infos = Vec::with_capacity(bindings.len());
         let mut buffer_infos = Vec::with_capacity(bindings.len());
         let mut plan = Vec::with_capacity(pipeline.reflection.bindings.len());

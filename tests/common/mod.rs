@@ -1,0 +1,106 @@
+//! Shared set-up for the integration tests: a headless context on whatever device the
+//! environment selects (lavapipe in CI), synthetic volumes and transfer functions with
+//! known optics, and the validation check every GPU test ends with.
+#![allow(dead_code)]
+
+use dvr_engine::gpu::{validation, GpuContext};
+use dvr_engine::passes::Extent;
+use dvr_engine::renderer::scene_gpu::{BrickRanges, LutUpload, VolumeFormat, VolumeUpload};
+use dvr_engine::renderer::uniforms::{GpuLight, LIGHT_ENV, LIGHT_POINT, ENV_CONSTANT};
+use dvr_engine::renderer::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
+use glam::{Vec3, Vec4};
+
+pub const LUT: usize = 256;
+
+pub fn context() -> GpuContext {
+    GpuContext::headless().expect("a Vulkan device (install mesa-vulkan-drivers for lavapipe)")
+}
+
+/// A cube of constant density `d` filling the whole box.
+pub fn constant_volume(n: u32, d: f32) -> VolumeUpload {
+    let v = (d.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let dn = v as f32 / 255.0;
+    VolumeUpload {
+        name: "constant".into(),
+        dims: [n, n, n],
+        format: VolumeFormat::R8,
+        bytes: vec![v; (n * n * n) as usize],
+        world_size: [1.0, 1.0, 1.0],
+        bricks: BrickRanges {
+            grid: [1, 1, 1],
+            min: vec![dn],
+            max: vec![dn],
+        },
+    }
+}
+
+/// A LUT with constant opacity and albedo, no specular, no emission.
+pub fn constant_lut(opacity: f32, albedo: f32) -> LutUpload {
+    LutUpload {
+        diffuse_opacity: vec![[albedo, albedo, albedo, opacity]; LUT],
+        specular_roughness: vec![[0.0, 0.0, 0.0, 0.5]; LUT],
+        emissive: vec![[0.0; 4]; LUT],
+    }
+}
+
+pub fn environment(radiance: f32) -> GpuLight {
+    GpuLight {
+        position_kind: Vec4::new(0.0, 0.0, 0.0, LIGHT_ENV),
+        radiance: Vec4::new(radiance, radiance, radiance, ENV_CONSTANT),
+        ..Default::default()
+    }
+}
+
+pub fn point_light(pos: Vec3, intensity: f32) -> GpuLight {
+    GpuLight {
+        position_kind: pos.extend(LIGHT_POINT),
+        radiance: Vec4::new(intensity, intensity, intensity, 0.0),
+        ..Default::default()
+    }
+}
+
+/// Looking down −z at the box from z = `dist`, with a narrow field of view.
+pub fn front_camera(dist: f32, fov_deg: f32) -> CameraMatrices {
+    CameraMatrices::look_at(
+        Vec3::new(0.0, 0.0, dist),
+        Vec3::ZERO,
+        Vec3::Y,
+        fov_deg.to_radians(),
+        1.0,
+    )
+}
+
+pub fn settings(size: u32, spp: u32) -> RenderSettings {
+    RenderSettings {
+        size: Extent {
+            width: size,
+            height: size,
+        },
+        spp,
+        ..Default::default()
+    }
+}
+
+pub fn renderer(ctx: GpuContext, s: RenderSettings, v: &VolumeUpload, denoisers: &[&str]) -> Renderer {
+    Renderer::new(ctx, s, v, None, denoisers, LUT as u32).expect("renderer")
+}
+
+pub fn inputs(camera: CameraMatrices, lights: Vec<GpuLight>, lut: LutUpload) -> FrameInputs {
+    FrameInputs { camera, lights, lut }
+}
+
+pub fn mean_rgb(pixels: &[[f32; 4]]) -> [f64; 3] {
+    let mut s = [0.0f64; 3];
+    for p in pixels {
+        for c in 0..3 {
+            s[c] += p[c] as f64;
+        }
+    }
+    s.map(|v| v / pixels.len() as f64)
+}
+
+/// Fails the test if the validation layer reported anything in this process.
+pub fn assert_validation_clean() {
+    let msgs = validation::messages();
+    assert!(msgs.is_empty(), "validation reported {} messages:\n{}", msgs.len(), msgs.join("\n"));
+}
