@@ -1,1 +1,116 @@
-fn main() {}
+//! `dvr`: real-time Monte Carlo direct volume rendering with temporal denoising.
+//! Subcommands: capture (offscreen sequences), reference (high-sample references),
+//! profile (per-pass GPU timing), scenes (the built-in scenes).
+
+mod capture;
+mod output;
+mod profile;
+mod setup;
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(name = "dvr", version, about = "Monte Carlo direct volume rendering with temporal denoising")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Options shared by every rendering command.
+#[derive(clap::Args, Clone, Debug)]
+pub struct SceneArgs {
+    /// Built-in scene (`dvr scenes` lists them) or a scene TOML file.
+    #[arg(long, default_value = setup::DEFAULT_SCENE)]
+    pub scene: String,
+    /// Frames of the animation to render (default: the scene's own length).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "256x256", value_parser = setup::parse_size)]
+    pub size: (u32, u32),
+    /// Samples per pixel per frame (default: the scene's, 2 for built-ins).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Edge length of procedural volumes (phantom, cloud).
+    #[arg(long, default_value_t = 128)]
+    pub volume_size: u32,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render an animation offscreen with one or more denoisers: EXR + PNG per frame,
+    /// per-pass GPU timings and an HTML page.
+    Capture {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// Comma-separated denoisers (the noisy frames are rendered once and fed to all).
+        #[arg(long, default_value = "none,accum", value_delimiter = ',')]
+        denoiser: Vec<String>,
+        /// Output folder.
+        #[arg(long, default_value = "out/capture")]
+        out: PathBuf,
+    },
+    /// Render high-sample references of every frame: DIR/reference/NNNN.exr.
+    Reference {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// Samples per pixel of the reference.
+        #[arg(long = "ref-spp", alias = "samples", default_value_t = 1024)]
+        ref_spp: u32,
+        #[arg(long, default_value = "out/reference")]
+        out: PathBuf,
+    },
+    /// Per-pass GPU timings over many frames: table, JSON and Chrome trace.
+    Profile {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[arg(long, default_value = "none", value_delimiter = ',')]
+        denoiser: Vec<String>,
+        /// Write the statistics and raw per-frame timings as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Write a Chrome trace-event file (Perfetto, chrome://tracing).
+        #[arg(long)]
+        trace: Option<PathBuf>,
+    },
+    /// List the built-in scenes, or print one as a TOML scene file.
+    Scenes {
+        /// Print this scene as TOML (a starting point for your own).
+        #[arg(long)]
+        dump: Option<String>,
+    },
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = run(cli);
+    let validation_messages = dvr_engine::gpu::validation::message_count();
+    if let Err(e) = result {
+        eprintln!("dvr: error: {e:#}");
+        std::process::exit(1);
+    }
+    if validation_messages > 0 {
+        eprintln!("dvr: the Vulkan validation layer reported {validation_messages} message(s)");
+        std::process::exit(2);
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Capture { scene, denoiser, out } => capture::capture(&scene, &denoiser, &out),
+        Command::Reference {
+            scene,
+            ref_spp,
+            out,
+        } => capture::reference(&scene, ref_spp, &out),
+        Command::Profile {
+            scene,
+            denoiser,
+            json,
+            trace,
+        } => capture::profile(&scene, &denoiser, json.as_deref(), trace.as_deref()),
+        Command::Scenes { dump } => setup::list_scenes(dump.as_deref()),
+    }
+}

@@ -76,7 +76,7 @@ vec3 trace_path(vec3 o, vec3 d, inout Rng rng, out float first_t) {
             vec3 f;
             if (surface) {
                 f = surface_eval(n, d, ls.dir, albedo, spec.rgb, spec.a);
-            } else if (PHASE == PHASE_HG) {
+            } else if (PHASE != PHASE_ISOTROPIC) {
                 f = albedo * hg_eval(dot(d, ls.dir), frame.params.y);
             } else {
                 f = albedo * INV_4PI;
@@ -98,7 +98,7 @@ vec3 trace_path(vec3 o, vec3 d, inout Rng rng, out float first_t) {
             wo = orthonormal_dir(n, vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u1))));
             throughput *= albedo;
         } else {
-            float g = PHASE == PHASE_HG ? frame.params.y : 0.0;
+            float g = PHASE == PHASE_ISOTROPIC ? 0.0 : frame.params.y;
             wo = hg_sample(d, g, rng_next(rng), rng_next(rng));
             throughput *= albedo;
         }
