@@ -1,1 +1,2 @@
 include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+pub mod volume;
