@@ -12,5 +12,6 @@ pub mod metrics;
 pub mod passes;
 pub mod renderer;
 pub mod shaders;
+pub mod volume;
 
 pub use error::{EngineError, Result};

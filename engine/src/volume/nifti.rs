@@ -1,0 +1,405 @@
+//! NIfTI-1 volumes (`.nii`, `.nii.gz`), the format of most MRI tools.
+//!
+//! The 348-byte header is parsed by hand instead of using the `nifti` crate: we need
+//! about a dozen fixed-offset fields, while the crate pulls `ndarray`, `nalgebra` and
+//! friends into every build of the engine. Read: single-file NIfTI-1 (`n+1`) in either
+//! byte order, datatypes uint8, int16, uint16 and float32, `pixdim` for spacing (with the
+//! `xyzt_units` spatial unit converted to mm), `scl_slope/scl_inter` applied before
+//! normalisation. 4D files are read only when the extra dimensions have size 1. The
+//! orientation (qform/sform) is ignored: voxels keep the file's index order.
+
+use std::io::Read;
+use std::path::Path;
+
+use flate2::read::MultiGzDecoder;
+
+use super::error::VolumeError;
+use super::samples::{Affine, Rescale, SampleKind, Samples, Stored};
+use super::{io, name_of, validate_dims, validate_spacing, Volume};
+
+/// Size of a NIfTI-1 header.
+pub(crate) const HEADER_LEN: usize = 348;
+const SUPPORTED_TYPES: &str = "uint8 (2), int16 (4), uint16 (512), float32 (16)";
+
+/// The header fields the loader uses.
+#[derive(Debug)]
+struct Header {
+    big_endian: bool,
+    dims: [u32; 3],
+    kind: SampleKind,
+    spacing: [f32; 3],
+    vox_offset: u64,
+    rescale: Affine,
+}
+
+/// Loads a `.nii` or `.nii.gz` file.
+pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
+    let file = io::read_all(path)?;
+    let gz = file.starts_with(&[0x1f, 0x8b]);
+    let (header, data) = if gz {
+        let mut dec = MultiGzDecoder::new(file.as_slice());
+        let mut head = vec![0u8; HEADER_LEN];
+        dec.read_exact(&mut head).map_err(|e| match e.kind() {
+            std::io::ErrorKind::UnexpectedEof => short_header(path),
+            _ => VolumeError::Decompress {
+                path: path.to_path_buf(),
+                source: e,
+            },
+        })?;
+        let header = parse_header(path, &head)?;
+        let expected = io::expected_bytes(header.dims, header.kind);
+        let skip = header.vox_offset - HEADER_LEN as u64;
+        let data = io::read_bounded(path, dec, skip, expected)?;
+        (header, data)
+    } else {
+        let head = file.get(..HEADER_LEN).ok_or_else(|| short_header(path))?;
+        let header = parse_header(path, head)?;
+        let start = usize::try_from(header.vox_offset)
+            .unwrap_or(usize::MAX)
+            .min(file.len());
+        (header, file[start..].to_vec())
+    };
+    io::check_len(path, header.dims, header.kind, data.len() as u64)?;
+    let stored = Stored {
+        samples: Samples::decode(header.kind, data, header.big_endian),
+        type_range: header.kind.full_range(),
+        rescale: Rescale::Uniform(header.rescale),
+    };
+    Volume::from_stored(path, name_of(path), header.dims, header.spacing, stored)
+}
+
+fn short_header(path: &Path) -> VolumeError {
+    VolumeError::MalformedHeader {
+        path: path.to_path_buf(),
+        field: "sizeof_hdr".into(),
+        problem: format!("file is shorter than the {HEADER_LEN}-byte NIfTI-1 header"),
+    }
+}
+
+/// Little helper reading fixed-offset fields in the header's byte order.
+struct Fields<'a> {
+    h: &'a [u8],
+    big: bool,
+}
+
+impl Fields<'_> {
+    fn bytes<const N: usize>(&self, at: usize) -> [u8; N] {
+        let mut b = [0u8; N];
+        b.copy_from_slice(&self.h[at..at + N]);
+        if self.big {
+            b.reverse();
+        }
+        b
+    }
+    fn i16(&self, at: usize) -> i16 {
+        i16::from_le_bytes(self.bytes(at))
+    }
+    fn f32(&self, at: usize) -> f32 {
+        f32::from_le_bytes(self.bytes(at))
+    }
+}
+
+fn parse_header(path: &Path, h: &[u8]) -> Result<Header, VolumeError> {
+    let malformed = |field: &str, problem: String| VolumeError::MalformedHeader {
+        path: path.to_path_buf(),
+        field: field.to_string(),
+        problem,
+    };
+    if h.len() < HEADER_LEN {
+        return Err(short_header(path));
+    }
+    let le = i32::from_le_bytes([h[0], h[1], h[2], h[3]]);
+    let be = i32::from_be_bytes([h[0], h[1], h[2], h[3]]);
+    let big = match (le, be) {
+        (348, _) => false,
+        (_, 348) => true,
+        (540, _) | (_, 540) => {
+            return Err(VolumeError::Unsupported {
+                path: path.to_path_buf(),
+                reason: "NIfTI-2 files; save as NIfTI-1".into(),
+            })
+        }
+        _ => return Err(malformed("sizeof_hdr", format!("{le} (expected 348)"))),
+    };
+    let f = Fields { h, big };
+    match &h[344..348] {
+        b"n+1\0" => {}
+        b"ni1\0" => {
+            return Err(VolumeError::Unsupported {
+                path: path.to_path_buf(),
+                reason: "NIfTI-1 header/image pairs (.hdr/.img); save as a single .nii".into(),
+            })
+        }
+        m => return Err(malformed("magic", format!("{m:?} (expected \"n+1\\0\")"))),
+    }
+
+    // dim[0] is the number of dimensions, dim[1..=3] the spatial ones.
+    let dim: Vec<i64> = (0..8).map(|i| i64::from(f.i16(40 + 2 * i))).collect();
+    let ndim = dim[0];
+    if !(1..=7).contains(&ndim) {
+        return Err(malformed(
+            "dim[0]",
+            format!("{ndim} dimensions (expected 1..7)"),
+        ));
+    }
+    let ndim = ndim as usize;
+    if let Some(extra) = (4..=ndim).find(|&i| dim[i] != 1) {
+        return Err(VolumeError::Unsupported {
+            path: path.to_path_buf(),
+            reason: format!(
+                "{ndim}D NIfTI with dim[{extra}] = {}; only one 3D volume is read",
+                dim[extra]
+            ),
+        });
+    }
+    let dims = validate_dims(path, [1, 2, 3].map(|i| if i <= ndim { dim[i] } else { 1 }))?;
+
+    let datatype = f.i16(70);
+    let bitpix = f.i16(72);
+    let kind = match datatype {
+        2 => SampleKind::U8,
+        4 => SampleKind::I16,
+        512 => SampleKind::U16,
+        16 => SampleKind::F32,
+        other => {
+            return Err(VolumeError::UnsupportedType {
+                path: path.to_path_buf(),
+                datatype: format!("{} ({other})", datatype_name(other)),
+                supported: SUPPORTED_TYPES,
+            })
+        }
+    };
+    if bitpix as usize != 8 * kind.bytes() {
+        return Err(malformed(
+            "bitpix",
+            format!("{bitpix} does not match datatype {}", kind.name()),
+        ));
+    }
+
+    // Spatial units (xyzt_units & 7): 1 = m, 2 = mm, 3 = µm, 0 = unknown (taken as mm).
+    let to_mm = match h[123] & 0x07 {
+        1 => 1000.0,
+        3 => 0.001,
+        _ => 1.0,
+    };
+    let pixdim = [1, 2, 3].map(|i| {
+        if i <= ndim {
+            f64::from(f.f32(76 + 4 * i)).abs() * to_mm
+        } else {
+            1.0
+        }
+    });
+    let spacing = validate_spacing(path, "pixdim", pixdim)?;
+
+    let vox_offset = f.f32(108);
+    if !vox_offset.is_finite() || vox_offset < HEADER_LEN as f32 {
+        return Err(malformed(
+            "vox_offset",
+            format!("{vox_offset} (must be at least {HEADER_LEN})"),
+        ));
+    }
+    // NIfTI-1: a zero or non-finite slope means "no scaling".
+    let slope = f.f32(112);
+    let inter = f.f32(116);
+    let rescale = if slope.is_finite() && slope != 0.0 {
+        Affine {
+            slope: f64::from(slope),
+            intercept: if inter.is_finite() {
+                f64::from(inter)
+            } else {
+                0.0
+            },
+        }
+    } else {
+        Affine::IDENTITY
+    };
+    Ok(Header {
+        big_endian: big,
+        dims,
+        kind,
+        spacing,
+        vox_offset: vox_offset as u64,
+        rescale,
+    })
+}
+
+fn datatype_name(code: i16) -> &'static str {
+    match code {
+        1 => "binary",
+        8 => "int32",
+        32 => "complex64",
+        64 => "float64",
+        128 => "rgb24",
+        256 => "int8",
+        768 => "uint32",
+        1024 => "int64",
+        1280 => "uint64",
+        1536 => "float128",
+        1792 => "complex128",
+        2304 => "rgba32",
+        _ => "unknown datatype",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::volume::write::{self, NiftiData};
+    use crate::volume::VolumeData;
+
+    #[test]
+    fn nii_and_nii_gz_round_trip() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let u8s: Vec<u8> = (0..60).map(|i| (i * 4) as u8).collect();
+        for name in ["a.nii", "a.nii.gz"] {
+            let path = dir.path().join(name);
+            write::nifti(
+                &path,
+                [5, 4, 3],
+                [0.8, 0.9, 1.5],
+                &NiftiData::U8(u8s.clone()),
+                None,
+            );
+            let v = Volume::load(&path, None).expect(name);
+            assert_eq!(v.name, "a");
+            assert_eq!(v.dims, [5, 4, 3]);
+            assert_eq!(v.spacing, [0.8, 0.9, 1.5]);
+            assert_eq!(v.data, VolumeData::U8(u8s.clone()), "{name}");
+        }
+    }
+
+    #[test]
+    fn scaling_int16_uint16_and_float() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        // int16 with scl_slope 2, scl_inter -1000: physical -1000..-1000+2*59*10.
+        let path = dir.path().join("s.nii.gz");
+        let i: Vec<i16> = (0..60).map(|x| x * 10).collect();
+        write::nifti(
+            &path,
+            [5, 4, 3],
+            [1.0; 3],
+            &NiftiData::I16(i),
+            Some((2.0, -1000.0)),
+        );
+        let v = Volume::load(&path, None).expect("int16");
+        assert_eq!(v.window, [-1000.0, 180.0]);
+        let VolumeData::U16(d) = &v.data else {
+            panic!("int16 must load as U16")
+        };
+        assert_eq!((d[0], d[59]), (0, 65535));
+
+        let path = dir.path().join("u.nii");
+        let u: Vec<u16> = (0..60).map(|x| x * 1000).collect();
+        write::nifti(&path, [5, 4, 3], [1.0; 3], &NiftiData::U16(u.clone()), None);
+        assert_eq!(
+            Volume::load(&path, None).expect("u16").data,
+            VolumeData::U16(u)
+        );
+
+        let path = dir.path().join("f.nii");
+        let fl: Vec<f32> = (0..60).map(|x| x as f32 / 59.0).collect();
+        write::nifti(
+            &path,
+            [5, 4, 3],
+            [1.0; 3],
+            &NiftiData::F32(fl.clone()),
+            None,
+        );
+        assert_eq!(
+            Volume::load(&path, None).expect("f32").data,
+            VolumeData::F32(fl)
+        );
+    }
+
+    #[test]
+    fn bad_files_are_rejected_by_name() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let good = dir.path().join("good.nii");
+        write::nifti(
+            &good,
+            [5, 4, 3],
+            [1.0; 3],
+            &NiftiData::U8(vec![7; 60]),
+            None,
+        );
+        let bytes = std::fs::read(&good).expect("read");
+        let variant = |name: &str, edit: &dyn Fn(&mut Vec<u8>)| {
+            let mut b = bytes.clone();
+            edit(&mut b);
+            let p = dir.path().join(name);
+            write::bytes(&p, &b);
+            let err = Volume::load(&p, None).unwrap_err();
+            assert!(err.to_string().contains(name), "{err}");
+            err
+        };
+        let err = variant("cut.nii", &|b| b.truncate(b.len() - 5));
+        assert!(
+            matches!(
+                err,
+                VolumeError::Truncated {
+                    expected: 60,
+                    found: 55,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        let err = variant("long.nii", &|b| b.extend_from_slice(&[0; 3]));
+        assert!(matches!(err, VolumeError::SizeMismatch { .. }), "{err}");
+        let err = variant("zero.nii", &|b| {
+            b[42..44].copy_from_slice(&0i16.to_le_bytes())
+        });
+        assert!(matches!(err, VolumeError::BadDims { .. }), "{err}");
+        let err = variant("big.nii", &|b| {
+            b[42..44].copy_from_slice(&5000i16.to_le_bytes())
+        });
+        assert!(matches!(err, VolumeError::BadDims { .. }), "{err}");
+        let err = variant("dt.nii", &|b| {
+            b[70..72].copy_from_slice(&64i16.to_le_bytes())
+        });
+        assert!(matches!(err, VolumeError::UnsupportedType { .. }), "{err}");
+        assert!(err.to_string().contains("float64"));
+        let err = variant("magic.nii", &|b| b[344..348].copy_from_slice(b"xyz\0"));
+        assert!(
+            matches!(&err, VolumeError::MalformedHeader { field, .. } if field == "magic"),
+            "{err}"
+        );
+        let err = variant("hdr.nii", &|b| {
+            b[0..4].copy_from_slice(&100i32.to_le_bytes())
+        });
+        assert!(
+            matches!(&err, VolumeError::MalformedHeader { field, .. } if field == "sizeof_hdr"),
+            "{err}"
+        );
+        let err = variant("tiny.nii", &|b| b.truncate(100));
+        assert!(matches!(err, VolumeError::MalformedHeader { .. }), "{err}");
+        let err = variant("t4.nii", &|b| {
+            b[40..42].copy_from_slice(&4i16.to_le_bytes());
+            b[48..50].copy_from_slice(&2i16.to_le_bytes());
+        });
+        assert!(matches!(err, VolumeError::Unsupported { .. }), "{err}");
+    }
+
+    #[test]
+    fn nan_in_float_nifti_is_rejected() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("nan.nii.gz");
+        let mut f = vec![0.5f32; 60];
+        f[17] = f32::NAN;
+        write::nifti(&path, [5, 4, 3], [1.0; 3], &NiftiData::F32(f), None);
+        let err = Volume::load(&path, None).unwrap_err();
+        // voxel 17 = (2, 3, 0) in a 5x4 slice.
+        assert!(
+            matches!(
+                err,
+                VolumeError::NonFinite {
+                    count: 1,
+                    first: [2, 3, 0],
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().contains("nan.nii.gz"));
+    }
+}

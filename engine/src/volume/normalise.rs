@@ -1,0 +1,392 @@
+//! Normalisation of stored samples to the `[0, 1]` density the renderer samples.
+//!
+//! The GPU reads the volume as an R8/R16 unorm or R32F texture and indexes transfer
+//! functions by that value, so every loader must agree on what 0 and 1 mean. The rule
+//! (also in the module docs of [`super`]):
+//!
+//! 1. Stored values are first rescaled to physical units, `p = slope * v + intercept`
+//!    (per slice for DICOM series whose rescale varies).
+//! 2. The **window** `[lo, hi]` (physical units) maps to `[0, 1]`:
+//!    - integer data: let `T` be the type's range in physical units (for DICOM the
+//!      `BitsStored` range) and `D = [min, max]` the data's actual range. If
+//!      `max > min` and `max - min < (T.hi - T.lo) / 4` (a 12-bit CT stored in 16 bits
+//!      uses 1/16 of it), the window is `D`; otherwise it is `T`, so files of the same
+//!      type keep comparable values.
+//!    - float data: NaN/Inf is an error. If all values lie in `[0, 1]` the window is
+//!      `[0, 1]` (the values already are densities); otherwise it is `[min, max]`; a
+//!      constant outside `[0, 1]` uses `[min(0, c), max(1, c)]`.
+//! 3. Output type follows the stored width: 8-bit stays `U8`, 16-bit (signed or not)
+//!    becomes `U16` (rounded into `0..=65535`), float becomes `F32` clamped to `[0, 1]`.
+
+use std::path::Path;
+
+use super::error::VolumeError;
+use super::samples::{Affine, Rescale, Samples, Stored};
+use super::VolumeData;
+
+/// Normalised data and the physical window that maps to `[0, 1]`.
+#[derive(Debug)]
+pub(crate) struct Normalised {
+    pub data: VolumeData,
+    pub window: [f32; 2],
+}
+
+/// Applies the windowing rule of this module to `stored` (x fastest, `dims` already
+/// validated).
+pub(crate) fn normalise(
+    path: &Path,
+    dims: [u32; 3],
+    stored: Stored,
+) -> Result<Normalised, VolumeError> {
+    let slice_len = dims[0] as usize * dims[1] as usize;
+    let voxels = slice_len * dims[2] as usize;
+    let kind = stored.samples.kind();
+    if stored.samples.len() != voxels {
+        let b = kind.bytes() as u64;
+        return Err(VolumeError::SizeMismatch {
+            path: path.to_path_buf(),
+            dims,
+            format: kind.name(),
+            expected: voxels as u64 * b,
+            found: stored.samples.len() as u64 * b,
+        });
+    }
+    if let Samples::F32(v) = &stored.samples {
+        check_finite(path, dims, v)?;
+    }
+    let data_range = physical_range(&stored.samples, slice_len, &stored.rescale);
+    let window = match stored.type_range {
+        Some(type_range) => integer_window(type_range, data_range, &stored.rescale, dims[2]),
+        None => float_window(data_range),
+    };
+    let data = apply_window(stored, slice_len, window);
+    Ok(Normalised {
+        data,
+        window: [window.0 as f32, window.1 as f32],
+    })
+}
+
+fn check_finite(path: &Path, dims: [u32; 3], v: &[f32]) -> Result<(), VolumeError> {
+    let count = v.iter().filter(|x| !x.is_finite()).count();
+    if count == 0 {
+        return Ok(());
+    }
+    let i = v.iter().position(|x| !x.is_finite()).unwrap_or(0);
+    let (nx, ny) = (dims[0] as usize, dims[1] as usize);
+    let first = [
+        (i % nx) as u32,
+        ((i / nx) % ny) as u32,
+        (i / (nx * ny)) as u32,
+    ];
+    Err(VolumeError::NonFinite {
+        path: path.to_path_buf(),
+        count: count as u64,
+        first,
+    })
+}
+
+/// Min and max of a slice of stored values, as f64.
+fn stored_minmax(s: &Samples, range: std::ops::Range<usize>) -> Option<(f64, f64)> {
+    fn ord<T: Ord + Copy + Into<f64>>(v: &[T]) -> Option<(f64, f64)> {
+        let lo = v.iter().copied().min()?;
+        let hi = v.iter().copied().max()?;
+        Some((lo.into(), hi.into()))
+    }
+    match s {
+        Samples::U8(v) => ord(&v[range]),
+        Samples::U16(v) => ord(&v[range]),
+        Samples::I16(v) => ord(&v[range]),
+        Samples::F32(v) => {
+            let v = &v[range];
+            let first = *v.first()?;
+            let (lo, hi) = v
+                .iter()
+                .fold((first, first), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+            Some((lo as f64, hi as f64))
+        }
+    }
+}
+
+/// The data's range in physical units (after the per-slice rescale).
+fn physical_range(s: &Samples, slice_len: usize, rescale: &Rescale) -> (f64, f64) {
+    let mut acc: Option<(f64, f64)> = None;
+    match rescale {
+        Rescale::Uniform(a) => {
+            if let Some(r) = stored_minmax(s, 0..s.len()) {
+                acc = Some(a.apply_range(r));
+            }
+        }
+        Rescale::PerSlice(_) => {
+            for z in 0..s.len() / slice_len.max(1) {
+                let range = z * slice_len..(z + 1) * slice_len;
+                if let Some(r) = stored_minmax(s, range) {
+                    let (lo, hi) = rescale.for_slice(z).apply_range(r);
+                    acc = Some(acc.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
+                }
+            }
+        }
+    }
+    acc.unwrap_or((0.0, 0.0))
+}
+
+/// The window for integer data (rule 2, first case).
+pub(crate) fn integer_window(
+    type_range: (f64, f64),
+    data: (f64, f64),
+    rescale: &Rescale,
+    slices: u32,
+) -> (f64, f64) {
+    let t = match rescale {
+        Rescale::Uniform(a) => a.apply_range(type_range),
+        Rescale::PerSlice(_) => (0..slices as usize)
+            .map(|z| rescale.for_slice(z).apply_range(type_range))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (lo, hi)| {
+                (a.min(lo), b.max(hi))
+            }),
+    };
+    let (lo, hi) = data;
+    if hi > lo && (hi - lo) < (t.1 - t.0) / 4.0 {
+        data
+    } else {
+        t
+    }
+}
+
+/// The window for float data (rule 2, second case).
+pub(crate) fn float_window((lo, hi): (f64, f64)) -> (f64, f64) {
+    if lo >= 0.0 && hi <= 1.0 {
+        (0.0, 1.0)
+    } else if hi > lo {
+        (lo, hi)
+    } else {
+        (lo.min(0.0), hi.max(1.0))
+    }
+}
+
+/// Maps a physical value through the window to `[0, 1]`.
+fn unit(p: f64, (lo, hi): (f64, f64)) -> f64 {
+    if hi > lo {
+        ((p - lo) / (hi - lo)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+fn apply_window(stored: Stored, slice_len: usize, window: (f64, f64)) -> VolumeData {
+    let Stored {
+        samples,
+        type_range,
+        rescale,
+    } = stored;
+    let identity = rescale == Rescale::Uniform(Affine::IDENTITY);
+    let untouched = identity && type_range == samples.kind().full_range();
+    match samples {
+        Samples::U8(v) if untouched && window == (0.0, 255.0) => VolumeData::U8(v),
+        Samples::U16(v) if untouched && window == (0.0, 65535.0) => VolumeData::U16(v),
+        Samples::U8(v) => VolumeData::U8(map_slices(&v, slice_len, &rescale, |a| {
+            lut(a, window, 255.0, (0..=255u8).map(f64::from))
+        })),
+        Samples::U16(v) => VolumeData::U16(map_slices(&v, slice_len, &rescale, |a| {
+            lut(a, window, 65535.0, (0..=65535u16).map(f64::from))
+        })),
+        Samples::I16(v) => {
+            // Index the table by the raw bits so one 64 Ki table serves i16 too.
+            let bits: Vec<u16> = v.iter().map(|&x| x as u16).collect();
+            VolumeData::U16(map_slices(&bits, slice_len, &rescale, |a| {
+                lut(
+                    a,
+                    window,
+                    65535.0,
+                    (0..=65535u16).map(|b| f64::from(b as i16)),
+                )
+            }))
+        }
+        Samples::F32(mut v) => {
+            for (z, slice) in v.chunks_mut(slice_len.max(1)).enumerate() {
+                let a = rescale.for_slice(z);
+                for x in slice {
+                    *x = unit(a.apply(f64::from(*x)), window) as f32;
+                }
+            }
+            VolumeData::F32(v)
+        }
+    }
+}
+
+/// A lookup table from every stored value (in index order) to the output unorm value.
+fn lut<O: TryFrom<u32> + Default>(
+    a: Affine,
+    window: (f64, f64),
+    scale: f64,
+    values: impl Iterator<Item = f64>,
+) -> Vec<O> {
+    values
+        .map(|v| {
+            let q = (unit(a.apply(v), window) * scale).round() as u32;
+            O::try_from(q).unwrap_or_default()
+        })
+        .collect()
+}
+
+/// Maps each slice through a table built for its rescale (rebuilt only when it changes).
+fn map_slices<I, O>(
+    v: &[I],
+    slice_len: usize,
+    rescale: &Rescale,
+    make_lut: impl Fn(Affine) -> Vec<O>,
+) -> Vec<O>
+where
+    I: Copy + Into<usize>,
+    O: Copy + Default,
+{
+    let mut out = Vec::with_capacity(v.len());
+    let mut current: Option<(Affine, Vec<O>)> = None;
+    for (z, slice) in v.chunks(slice_len.max(1)).enumerate() {
+        let a = rescale.for_slice(z);
+        if current.as_ref().is_none_or(|(ca, _)| *ca != a) {
+            current = Some((a, make_lut(a)));
+        }
+        let Some((_, table)) = &current else {
+            continue;
+        };
+        out.extend(
+            slice
+                .iter()
+                .map(|&x| table.get(x.into()).copied().unwrap_or_default()),
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::volume::samples::SampleKind;
+
+    fn run(samples: Samples, rescale: Rescale, dims: [u32; 3]) -> Normalised {
+        let stored = Stored {
+            type_range: samples.kind().full_range(),
+            samples,
+            rescale,
+        };
+        normalise(Path::new("t.raw"), dims, stored).expect("normalise")
+    }
+
+    #[test]
+    fn full_range_u8_is_untouched() {
+        let n = run(
+            Samples::U8(vec![0, 10, 255, 7]),
+            Rescale::Uniform(Affine::IDENTITY),
+            [4, 1, 1],
+        );
+        assert_eq!(n.data, VolumeData::U8(vec![0, 10, 255, 7]));
+        assert_eq!(n.window, [0.0, 255.0]);
+    }
+
+    #[test]
+    fn twelve_bit_ct_is_windowed_to_its_data() {
+        // i16 CT in Hounsfield units: -1024..3071 uses 1/16 of the type's range.
+        let n = run(
+            Samples::I16(vec![-1024, 0, 3071, 1000]),
+            Rescale::Uniform(Affine::IDENTITY),
+            [2, 2, 1],
+        );
+        assert_eq!(n.window, [-1024.0, 3071.0]);
+        let VolumeData::U16(v) = n.data else {
+            panic!("16-bit must stay 16-bit")
+        };
+        assert_eq!(v[0], 0);
+        assert_eq!(v[2], 65535);
+        assert_eq!(v[1], ((1024.0 / 4095.0) * 65535.0f64).round() as u16);
+    }
+
+    #[test]
+    fn wide_integer_data_keeps_the_type_window() {
+        let n = run(
+            Samples::U16(vec![0, 40000]),
+            Rescale::Uniform(Affine::IDENTITY),
+            [2, 1, 1],
+        );
+        assert_eq!(n.window, [0.0, 65535.0]);
+        assert_eq!(n.data, VolumeData::U16(vec![0, 40000]));
+    }
+
+    #[test]
+    fn per_slice_rescale_lands_on_one_scale() {
+        // Two slices storing the same physical values with different rescales.
+        let slope2 = Affine {
+            slope: 2.0,
+            intercept: -100.0,
+        };
+        let n = run(
+            Samples::U16(vec![100, 300, 100, 200]),
+            Rescale::PerSlice(vec![Affine::IDENTITY, slope2]),
+            [2, 1, 2],
+        );
+        // physical: slice 0 = 100, 300; slice 1 = 100, 300.
+        assert_eq!(n.window, [100.0, 300.0]);
+        assert_eq!(n.data, VolumeData::U16(vec![0, 65535, 0, 65535]));
+    }
+
+    #[test]
+    fn float_in_unit_range_is_kept_and_others_windowed() {
+        let n = run(
+            Samples::F32(vec![0.25, 0.5]),
+            Rescale::Uniform(Affine::IDENTITY),
+            [2, 1, 1],
+        );
+        assert_eq!(n.data, VolumeData::F32(vec![0.25, 0.5]));
+        let n = run(
+            Samples::F32(vec![-2.0, 2.0, 0.0]),
+            Rescale::Uniform(Affine::IDENTITY),
+            [3, 1, 1],
+        );
+        assert_eq!(n.window, [-2.0, 2.0]);
+        assert_eq!(n.data, VolumeData::F32(vec![0.0, 1.0, 0.5]));
+        let n = run(
+            Samples::F32(vec![5.0, 5.0]),
+            Rescale::Uniform(Affine::IDENTITY),
+            [2, 1, 1],
+        );
+        assert_eq!(n.data, VolumeData::F32(vec![1.0, 1.0]));
+    }
+
+    #[test]
+    fn nan_is_an_error_naming_the_first_voxel() {
+        let stored = Stored::plain(Samples::F32(vec![
+            0.0,
+            0.0,
+            0.0,
+            f32::NAN,
+            f32::INFINITY,
+            0.0,
+        ]));
+        let err = normalise(Path::new("bad.raw"), [3, 1, 2], stored).unwrap_err();
+        assert!(matches!(
+            err,
+            VolumeError::NonFinite {
+                count: 2,
+                first: [0, 0, 1],
+                ..
+            }
+        ));
+        let msg = err.to_string();
+        assert!(
+            msg.contains("bad.raw") && msg.contains("(0, 0, 1)"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn dicom_bits_stored_range_is_the_type_range() {
+        let stored = Stored {
+            samples: Samples::U16(vec![0, 4095]),
+            type_range: Some((0.0, 4095.0)),
+            rescale: Rescale::Uniform(Affine::IDENTITY),
+        };
+        let n = normalise(Path::new("x.dcm"), [2, 1, 1], stored).expect("normalise");
+        assert_eq!(n.window, [0.0, 4095.0]);
+        assert_eq!(n.data, VolumeData::U16(vec![0, 65535]));
+        assert_eq!(SampleKind::I16.full_range(), Some((-32768.0, 32767.0)));
+    }
+}

@@ -1,0 +1,251 @@
+//! Raw voxel files: no header, the layout comes from [`RawParams`] or a sidecar.
+//!
+//! Raw dumps are what many tools and public datasets (e.g. the Stanford and Klacansky
+//! volume collections) ship. Their dims are easy to get wrong, so the file size must
+//! match the dims exactly: short is "truncated", long is "dims do not match".
+//!
+//! A sidecar sits next to the data as `<file>.json` or `<file>.toml`, e.g.
+//! `head.raw.toml`:
+//!
+//! ```toml
+//! dims = [256, 256, 113]
+//! format = "u16"        # u8 | u16 | i16 | f32 (also uint8, uint16, int16, float32)
+//! spacing = [1.0, 1.0, 2.0]   # mm, optional, default 1
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::error::VolumeError;
+use super::samples::{SampleKind, Samples, Stored};
+use super::{io, name_of, validate_dims, validate_spacing, Volume};
+
+/// Sample type of a raw file (always little endian).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum RawFormat {
+    #[serde(rename = "u8", alias = "uint8")]
+    U8,
+    #[serde(rename = "u16", alias = "uint16")]
+    U16,
+    /// Signed 16-bit, e.g. CT in Hounsfield units.
+    #[serde(rename = "i16", alias = "int16")]
+    I16,
+    #[serde(rename = "f32", alias = "float32", alias = "float")]
+    F32,
+}
+
+impl RawFormat {
+    pub(crate) fn kind(self) -> SampleKind {
+        match self {
+            RawFormat::U8 => SampleKind::U8,
+            RawFormat::U16 => SampleKind::U16,
+            RawFormat::I16 => SampleKind::I16,
+            RawFormat::F32 => SampleKind::F32,
+        }
+    }
+}
+
+/// Layout of a raw volume file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawParams {
+    /// Voxels along x, y, z (x fastest in the file).
+    pub dims: [u32; 3],
+    pub format: RawFormat,
+    /// Voxel size in mm.
+    #[serde(default = "unit_spacing")]
+    pub spacing: [f32; 3],
+}
+
+fn unit_spacing() -> [f32; 3] {
+    [1.0; 3]
+}
+
+/// The sidecar paths tried for `path`, in order.
+fn sidecar_paths(path: &Path) -> [PathBuf; 2] {
+    ["json", "toml"].map(|ext| {
+        let mut s = path.as_os_str().to_os_string();
+        s.push(".");
+        s.push(ext);
+        PathBuf::from(s)
+    })
+}
+
+/// Reads `<path>.json` or `<path>.toml` if one exists.
+pub(crate) fn read_sidecar(path: &Path) -> Result<Option<RawParams>, VolumeError> {
+    for side in sidecar_paths(path) {
+        if !side.is_file() {
+            continue;
+        }
+        let bytes = io::read_all(&side)?;
+        let text = String::from_utf8_lossy(&bytes);
+        let parsed = if side.extension().is_some_and(|e| e == "json") {
+            serde_json::from_str::<RawParams>(&text).map_err(|e| e.to_string())
+        } else {
+            toml::from_str::<RawParams>(&text).map_err(|e| e.to_string())
+        };
+        return parsed
+            .map(Some)
+            .map_err(|problem| VolumeError::MalformedHeader {
+                path: side.clone(),
+                field: "dims/format/spacing".into(),
+                problem,
+            });
+    }
+    Ok(None)
+}
+
+/// Loads `path` as raw little-endian voxels laid out as `params` says.
+pub(crate) fn load(path: &Path, params: &RawParams) -> Result<Volume, VolumeError> {
+    let dims = validate_dims(path, params.dims.map(i64::from))?;
+    let spacing = validate_spacing(path, "spacing", params.spacing.map(f64::from))?;
+    let kind = params.format.kind();
+    // Check the size before reading, so wrong dims on a huge file fail fast.
+    let len = std::fs::metadata(path)
+        .map_err(|source| VolumeError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?
+        .len();
+    io::check_len(path, dims, kind, len)?;
+    let bytes = io::read_all(path)?;
+    io::check_len(path, dims, kind, bytes.len() as u64)?;
+    let stored = Stored::plain(Samples::decode(kind, bytes, false));
+    Volume::from_stored(path, name_of(path), dims, spacing, stored)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::volume::write;
+    use crate::volume::VolumeData;
+
+    #[test]
+    fn round_trips_with_params_and_sidecars() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let values: Vec<u16> = (0..24).map(|i| i * 2000).collect();
+        let path = dir.path().join("ramp.raw");
+        write::raw_u16(&path, &values);
+        let params = RawParams {
+            dims: [2, 3, 4],
+            format: RawFormat::U16,
+            spacing: [0.5, 0.5, 2.0],
+        };
+        let v = Volume::load(&path, Some(&params)).expect("load with params");
+        assert_eq!(v.name, "ramp");
+        assert_eq!(v.dims, [2, 3, 4]);
+        assert_eq!(v.spacing, [0.5, 0.5, 2.0]);
+        // 0..46000 spans most of u16: the type window is kept.
+        assert_eq!(v.data, VolumeData::U16(values.clone()));
+
+        // The same file found through a TOML sidecar, then a JSON one (JSON is tried first).
+        write::text(
+            &dir.path().join("ramp.raw.toml"),
+            "dims = [2, 3, 4]\nformat = \"uint16\"\nspacing = [0.5, 0.5, 2.0]\n",
+        );
+        assert_eq!(Volume::load(&path, None).expect("toml sidecar"), v);
+        write::text(
+            &dir.path().join("ramp.raw.json"),
+            r#"{"dims": [4, 3, 2], "format": "u16"}"#,
+        );
+        let j = Volume::load(&path, None).expect("json sidecar");
+        assert_eq!((j.dims, j.spacing), ([4, 3, 2], [1.0; 3]));
+    }
+
+    #[test]
+    fn f32_raw_round_trips() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("f.raw");
+        write::raw_f32(&path, &[0.0, 0.25, 0.5, 1.0]);
+        let p = RawParams {
+            dims: [4, 1, 1],
+            format: RawFormat::F32,
+            spacing: [1.0; 3],
+        };
+        let v = Volume::load(&path, Some(&p)).expect("load");
+        assert_eq!(v.data, VolumeData::F32(vec![0.0, 0.25, 0.5, 1.0]));
+    }
+
+    #[test]
+    fn wrong_sizes_are_named() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("short.raw");
+        write::raw_u16(&path, &[1, 2, 3]);
+        let mut p = RawParams {
+            dims: [2, 2, 1],
+            format: RawFormat::U16,
+            spacing: [1.0; 3],
+        };
+        let err = Volume::load(&path, Some(&p)).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                VolumeError::Truncated {
+                    expected: 8,
+                    found: 6,
+                    ..
+                }
+            ),
+            "{err}"
+        );
+        assert!(err.to_string().contains("short.raw"));
+        assert!(err.to_string().contains("expected 8 bytes"));
+
+        p.dims = [1, 1, 1];
+        let err = Volume::load(&path, Some(&p)).unwrap_err();
+        assert!(matches!(err, VolumeError::SizeMismatch { .. }), "{err}");
+        assert!(err.to_string().contains("short.raw"));
+        assert!(err.to_string().contains("do not match"));
+
+        p.dims = [0, 1, 3];
+        let err = Volume::load(&path, Some(&p)).unwrap_err();
+        assert!(matches!(err, VolumeError::BadDims { .. }), "{err}");
+        assert!(err.to_string().contains("short.raw"));
+
+        p.dims = [8192, 1, 1];
+        let err = Volume::load(&path, Some(&p)).unwrap_err();
+        assert!(matches!(err, VolumeError::BadDims { .. }), "{err}");
+        assert!(err.to_string().contains("8192"));
+    }
+
+    #[test]
+    fn nan_in_float_raw_is_rejected_with_location() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("nan.raw");
+        write::raw_f32(&path, &[0.0, 0.1, 0.2, f32::NAN, 0.3, f32::NEG_INFINITY]);
+        let p = RawParams {
+            dims: [2, 3, 1],
+            format: RawFormat::F32,
+            spacing: [1.0; 3],
+        };
+        let err = Volume::load(&path, Some(&p)).unwrap_err();
+        assert!(matches!(
+            err,
+            VolumeError::NonFinite {
+                count: 2,
+                first: [1, 1, 0],
+                ..
+            }
+        ));
+        let msg = err.to_string();
+        assert!(
+            msg.contains("nan.raw") && msg.contains("2 non-finite"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn malformed_sidecar_names_the_sidecar() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("v.raw");
+        write::raw_u16(&path, &[0; 8]);
+        write::text(
+            &dir.path().join("v.raw.toml"),
+            "dims = [2, 2]\nformat = \"u16\"\n",
+        );
+        let err = Volume::load(&path, None).unwrap_err();
+        assert!(matches!(err, VolumeError::MalformedHeader { .. }), "{err}");
+        assert!(err.to_string().contains("v.raw.toml"), "{err}");
+    }
+}
