@@ -4,13 +4,15 @@
 
 mod accum;
 mod passthrough;
+pub mod wrls;
 
 pub use accum::Accum;
 pub use passthrough::Passthrough;
+pub use wrls::{Wrls, WrlsVariant};
 
 use crate::error::{EngineError, Result};
 use crate::gpu::GpuContext;
-use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
+use crate::graph::{BufferHandle, Frame, History, ImageHandle, RenderGraph};
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::Extent;
 
@@ -37,9 +39,13 @@ pub struct DenoiseInputs {
     /// Luminance moments (x mean, y second moment).
     pub moments: ImageHandle,
     pub features: FeatureImages,
+    /// Closest first real collision per pixel, this frame's and last frame's.
+    pub first_hit: History,
     /// Motion to the previous frame in pixels: xy from the first collision, zw from features.
     pub motion: ImageHandle,
     pub size: Extent,
+    /// Camera position this frame (disocclusion tolerances scale with distance).
+    pub camera: glam::Vec3,
     pub spp: u32,
     pub changes: Changes,
 }
@@ -59,13 +65,20 @@ pub trait Denoiser {
 }
 
 /// Names accepted by `--denoiser`.
-pub const NAMES: &[&str] = &["none", "accum"];
+pub const NAMES: &[&str] = &["none", "accum", "ours", "rls", "wrls-nf", "rls-nf"];
 
 /// Builds a denoiser by name.
 pub fn create(ctx: &GpuContext, name: &str) -> Result<Box<dyn Denoiser>> {
     Ok(match name {
         "none" => Box::new(Passthrough),
         "accum" => Box::new(Accum::new(ctx)?),
+        n if WrlsVariant::from_name(n).is_some() => {
+            let variant = WrlsVariant::from_name(n).unwrap_or(WrlsVariant {
+                weighted: true,
+                feature: true,
+            });
+            Box::new(Wrls::new(ctx, n, variant, 0)?)
+        }
         other => {
             return Err(EngineError::Pass {
                 pass: "denoise".into(),

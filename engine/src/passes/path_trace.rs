@@ -4,7 +4,7 @@
 use super::{Extent, SceneBindings};
 use crate::error::Result;
 use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
-use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
+use crate::graph::{Bind, Frame, History, ImageHandle, RenderGraph};
 use crate::renderer::uniforms::PathTracePush;
 use ash::vk;
 
@@ -48,7 +48,9 @@ pub struct PathTrace {
 pub struct PathTraceOutputs {
     pub radiance: ImageHandle,
     pub moments: ImageHandle,
-    pub first_hit: ImageHandle,
+    /// World position of the closest first real collision (w = 1 where hit); `prev`
+    /// holds last frame's, for disocclusion tests.
+    pub first_hit: History,
 }
 
 impl PathTrace {
@@ -92,7 +94,7 @@ impl PathTrace {
         let out = PathTraceOutputs {
             radiance: graph.image(ctx, &format!("{name}.radiance"), desc)?,
             moments: graph.image(ctx, &format!("{name}.moments"), desc)?,
-            first_hit: graph.image(ctx, &format!("{name}.first_hit"), desc)?,
+            first_hit: graph.history(ctx, &format!("{name}.first_hit"), desc)?,
         };
         let scene = *scene;
         let push = PathTracePush {
@@ -108,7 +110,7 @@ impl PathTrace {
                 b.sampled(scene.environment)
                     .write(out.radiance)
                     .write(out.moments)
-                    .write(out.first_hit);
+                    .write(out.first_hit.cur);
             },
             move |pc| {
                 let mut binds = scene.volume_binds();
@@ -116,7 +118,7 @@ impl PathTrace {
                     ("environment_map", Bind::Image(scene.environment)),
                     ("radiance", Bind::Image(out.radiance)),
                     ("moments", Bind::Image(out.moments)),
-                    ("first_hit", Bind::Image(out.first_hit)),
+                    ("first_hit", Bind::Image(out.first_hit.cur)),
                 ]);
                 let groups = self.pipeline.groups_2d(size.width, size.height);
                 pc.dispatch(&self.pipeline, &binds, &push, groups)

@@ -4,7 +4,7 @@
 use super::{Extent, SceneBindings};
 use crate::error::Result;
 use crate::gpu::{ComputePipeline, GpuContext, ImageDesc};
-use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
+use crate::graph::{Bind, Frame, History, ImageHandle, RenderGraph};
 use crate::renderer::uniforms::FeaturesPush;
 use ash::vk;
 
@@ -17,8 +17,8 @@ pub struct SurfaceFeatures {
 
 #[derive(Clone, Copy, Debug)]
 pub struct FeatureImages {
-    /// xyz world position, w = 1 where valid.
-    pub position: ImageHandle,
+    /// xyz world position, w = 1 where valid; `prev` is last frame's.
+    pub position: History,
     /// xyz normal (towards the viewer), w = distance along the ray.
     pub normal: ImageHandle,
     /// rgb TF albedo, w = 1 where valid.
@@ -42,7 +42,7 @@ impl SurfaceFeatures {
     ) -> Result<FeatureImages> {
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
         let out = FeatureImages {
-            position: graph.image(ctx, "features.position", desc)?,
+            position: graph.history(ctx, "features.position", desc)?,
             normal: graph.image(ctx, "features.normal", desc)?,
             albedo: graph.image(ctx, "features.albedo", desc)?,
         };
@@ -57,12 +57,12 @@ impl SurfaceFeatures {
             "surface_features",
             |b| {
                 scene.declare_volume(b);
-                b.write(out.position).write(out.normal).write(out.albedo);
+                b.write(out.position.cur).write(out.normal).write(out.albedo);
             },
             move |pc| {
                 let mut binds = scene.volume_binds();
                 binds.extend([
-                    ("feature_position", Bind::Image(out.position)),
+                    ("feature_position", Bind::Image(out.position.cur)),
                     ("feature_normal", Bind::Image(out.normal)),
                     ("feature_albedo", Bind::Image(out.albedo)),
                 ]);

@@ -354,15 +354,17 @@ impl Renderer {
             ctx, graph, &mut frame, "path_trace", &scene, size, 0, self.settings.spp,
         )?;
         let motion = self.passes.motion.add(
-            ctx, graph, &mut frame, ubo, noisy.first_hit, features.position, size,
+            ctx, graph, &mut frame, ubo, noisy.first_hit.cur, features.position.cur, size,
         )?;
         let input = DenoiseInputs {
             uniforms: ubo,
             noisy: noisy.radiance,
             moments: noisy.moments,
             features,
+            first_hit: noisy.first_hit,
             motion,
             size,
+            camera: inputs.camera.position,
             spp: self.settings.spp,
             changes,
         };

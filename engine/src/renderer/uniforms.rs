@@ -76,6 +76,29 @@ pub struct AccumulatePush {
     pub weight: f32,
 }
 
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct WrlsUpdatePush {
+    pub camera: Vec4,
+    pub width: u32,
+    pub height: u32,
+    pub history_valid: u32,
+    pub lambda: f32,
+    pub alpha: f32,
+    pub h: f32,
+    pub delta: f32,
+    pub tolerance: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct WrlsSpatialPush {
+    pub width: u32,
+    pub height: u32,
+    pub sigma_spatial: f32,
+    pub sigma_range: f32,
+}
+
 /// Field names and offsets of a mirror struct, for the layout test.
 #[macro_export]
 macro_rules! field_offsets {
@@ -119,6 +142,20 @@ pub fn mirrored_layouts() -> Vec<(&'static str, &'static str, usize, Vec<(&'stat
             "push",
             std::mem::size_of::<AccumulatePush>(),
             field_offsets!(AccumulatePush { width, height, history_valid, weight }),
+        ),
+        (
+            "wrls_update",
+            "push",
+            std::mem::size_of::<WrlsUpdatePush>(),
+            field_offsets!(WrlsUpdatePush {
+                camera, width, height, history_valid, lambda, alpha, h, delta, tolerance
+            }),
+        ),
+        (
+            "wrls_spatial",
+            "push",
+            std::mem::size_of::<WrlsSpatialPush>(),
+            field_offsets!(WrlsSpatialPush { width, height, sigma_spatial, sigma_range }),
         ),
     ]
 }

@@ -1,0 +1,204 @@
+//! `ours`: the paper's weighted-RLS denoiser (TVCG §5–6), and its ablations from the same
+//! code through specialisation constants: `rls` (w = 1, the paper's RLS-F), `wrls-nf` and
+//! `rls-nf` (no temporal feature, p = [1]). Two passes: `<name>.update` (temporal feature,
+//! reprojected models, weighted RLS update) and `<name>.spatial` (5×5 model blending).
+
+use super::{DenoiseInputs, Denoiser};
+use crate::error::Result;
+use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
+use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
+use crate::renderer::uniforms::{WrlsSpatialPush, WrlsUpdatePush};
+use ash::vk;
+
+/// The paper's parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WrlsParams {
+    pub lambda: f32,
+    pub alpha: f32,
+    pub h: f32,
+    /// Initial P = delta · I for a new model.
+    pub delta: f32,
+    /// Disocclusion tolerance, relative to the distance from the camera.
+    pub tolerance: f32,
+    pub sigma_spatial: f32,
+    pub sigma_range: f32,
+}
+
+impl Default for WrlsParams {
+    fn default() -> Self {
+        Self {
+            lambda: 0.998,
+            alpha: 0.75,
+            h: 0.75,
+            delta: 100.0,
+            tolerance: 0.05,
+            sigma_spatial: 2.0,
+            sigma_range: 0.5,
+        }
+    }
+}
+
+/// Which of the paper's variants.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WrlsVariant {
+    pub weighted: bool,
+    pub feature: bool,
+}
+
+impl WrlsVariant {
+    pub fn from_name(name: &str) -> Option<Self> {
+        Some(match name {
+            "ours" => Self { weighted: true, feature: true },
+            "rls" => Self { weighted: false, feature: true },
+            "wrls-nf" => Self { weighted: true, feature: false },
+            "rls-nf" => Self { weighted: false, feature: false },
+            _ => return None,
+        })
+    }
+}
+
+pub struct Wrls {
+    name: String,
+    update: ComputePipeline,
+    spatial: ComputePipeline,
+    pub params: WrlsParams,
+    /// 0: motion from the first real collision (the paper's), 1: from surface features.
+    pub motion_source: i32,
+}
+
+impl Wrls {
+    pub fn new(ctx: &GpuContext, name: &str, variant: WrlsVariant, motion_source: i32) -> Result<Self> {
+        let spec = [
+            ("WEIGHTED", SpecValue::Bool(variant.weighted)),
+            ("USE_FEATURE", SpecValue::Bool(variant.feature)),
+            ("MOTION_SOURCE", SpecValue::I32(motion_source)),
+        ];
+        Ok(Self {
+            name: name.to_string(),
+            update: ComputePipeline::new(ctx, "wrls_update", &spec)?,
+            spatial: ComputePipeline::new(ctx, "wrls_spatial", &spec[1..2])?,
+            params: WrlsParams::default(),
+            motion_source,
+        })
+    }
+}
+
+impl Denoiser for Wrls {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn add<'f>(
+        &'f self,
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        frame: &mut Frame<'f>,
+        input: &DenoiseInputs,
+    ) -> Result<ImageHandle> {
+        let size = input.size;
+        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let n = &self.name;
+        let z = graph.history(ctx, &format!("{n}.z"), desc)?;
+        let beta = [
+            graph.history(ctx, &format!("{n}.beta_r"), desc)?,
+            graph.history(ctx, &format!("{n}.beta_g"), desc)?,
+            graph.history(ctx, &format!("{n}.beta_b"), desc)?,
+        ];
+        let pm = [
+            graph.history(ctx, &format!("{n}.p0"), desc)?,
+            graph.history(ctx, &format!("{n}.p1"), desc)?,
+            graph.history(ctx, &format!("{n}.p2"), desc)?,
+        ];
+        let out = graph.image(ctx, &format!("{n}.out"), desc)?;
+        let (pos_cur, pos_prev) = if self.motion_source == 0 {
+            (input.first_hit.cur, input.first_hit.prev)
+        } else {
+            (input.features.position.cur, input.features.position.prev)
+        };
+        let valid = z.valid && input.first_hit.valid && input.features.position.valid;
+        let p = self.params;
+        let push = WrlsUpdatePush {
+            camera: input.camera.extend(1.0),
+            width: size.width,
+            height: size.height,
+            history_valid: valid as u32,
+            lambda: p.lambda,
+            alpha: p.alpha,
+            h: p.h,
+            delta: p.delta,
+            tolerance: p.tolerance,
+        };
+        let noisy = input.noisy;
+        let motion = input.motion;
+        frame.add_pass(
+            format!("{n}.update"),
+            |b| {
+                b.read(noisy).read(motion).read(pos_cur).sampled(pos_prev).sampled(z.prev);
+                for h in beta.iter().chain(&pm) {
+                    b.sampled(h.prev);
+                }
+                b.write(z.cur);
+                for h in beta.iter().chain(&pm) {
+                    b.write(h.cur);
+                }
+            },
+            move |pc| {
+                let binds = [
+                    ("noisy", Bind::Image(noisy)),
+                    ("motion", Bind::Image(motion)),
+                    ("position_cur", Bind::Image(pos_cur)),
+                    ("position_prev", Bind::ImageNearest(pos_prev)),
+                    ("z_prev", Bind::Image(z.prev)),
+                    ("beta_r_prev", Bind::Image(beta[0].prev)),
+                    ("beta_g_prev", Bind::Image(beta[1].prev)),
+                    ("beta_b_prev", Bind::Image(beta[2].prev)),
+                    ("p0_prev", Bind::Image(pm[0].prev)),
+                    ("p1_prev", Bind::Image(pm[1].prev)),
+                    ("p2_prev", Bind::Image(pm[2].prev)),
+                    ("z_cur", Bind::Image(z.cur)),
+                    ("beta_r_cur", Bind::Image(beta[0].cur)),
+                    ("beta_g_cur", Bind::Image(beta[1].cur)),
+                    ("beta_b_cur", Bind::Image(beta[2].cur)),
+                    ("p0_cur", Bind::Image(pm[0].cur)),
+                    ("p1_cur", Bind::Image(pm[1].cur)),
+                    ("p2_cur", Bind::Image(pm[2].cur)),
+                ];
+                let groups = self.update.groups_2d(size.width, size.height);
+                pc.dispatch(&self.update, &binds, &push, groups)
+            },
+        );
+        let spush = WrlsSpatialPush {
+            width: size.width,
+            height: size.height,
+            sigma_spatial: p.sigma_spatial,
+            sigma_range: p.sigma_range,
+        };
+        frame.add_pass(
+            format!("{n}.spatial"),
+            |b| {
+                b.read(z.cur).read(noisy).write(out);
+                for h in &beta {
+                    b.read(h.cur);
+                }
+            },
+            move |pc| {
+                let binds = [
+                    ("z", Bind::Image(z.cur)),
+                    ("beta_r", Bind::Image(beta[0].cur)),
+                    ("beta_g", Bind::Image(beta[1].cur)),
+                    ("beta_b", Bind::Image(beta[2].cur)),
+                    ("noisy", Bind::Image(noisy)),
+                    ("denoised", Bind::Image(out)),
+                ];
+                let groups = self.spatial.groups_2d(size.width, size.height);
+                pc.dispatch(&self.spatial, &binds, &spush, groups)
+            },
+        );
+        Ok(out)
+    }
+
+    fn destroy(&mut self, ctx: &GpuContext) {
+        self.update.destroy(ctx);
+        self.spatial.destroy(ctx);
+    }
+}

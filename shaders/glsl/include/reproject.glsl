@@ -1,0 +1,47 @@
+// The one reprojection step every temporal denoiser uses: where this pixel's surface was
+// last frame (motion vectors from a per-pixel world position and last frame's camera),
+// whether that place was on screen, and whether it is the same surface (disocclusion test
+// on world positions). History data is then fetched bilinearly at that place.
+#ifndef DVR_REPROJECT_GLSL
+#define DVR_REPROJECT_GLSL
+
+#include "common.glsl"
+
+// Motion in pixels: xy from the closest first real collision, zw from the surface features.
+layout(binding = 20, rgba32f) uniform readonly image2D motion;
+// This frame's and last frame's world positions (w > 0 where something was hit), from
+// the same source as the motion vectors in use.
+layout(binding = 21, rgba32f) uniform readonly image2D position_cur;
+layout(binding = 22) uniform sampler2D position_prev;
+
+// Which motion source to use: 0 = first real collision (the paper's), 1 = features.
+layout(constant_id = 8) const int MOTION_SOURCE = 0;
+
+struct Reprojection {
+    vec2 uv;     // last frame's texture coordinate of this pixel's surface
+    bool valid;  // on screen, same surface, history exists
+};
+
+// `tolerance` is the allowed world-space distance, relative to the distance from the
+// camera, between this surface and what was at the reprojected place last frame.
+Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, float tolerance) {
+    Reprojection r;
+    vec4 m = imageLoad(motion, p);
+    vec2 delta = MOTION_SOURCE == 0 ? m.xy : m.zw;
+    vec2 q = vec2(p) + 0.5 + delta;
+    r.uv = q / vec2(size);
+    r.valid = history_valid && all(greaterThanEqual(q, vec2(0.0))) && all(lessThan(q, vec2(size)));
+    if (r.valid) {
+        vec4 cur = imageLoad(position_cur, p);
+        vec4 prev = texelFetch(position_prev, ivec2(q), 0);
+        if ((cur.w > 0.0) != (prev.w > 0.0)) {
+            r.valid = false;
+        } else if (cur.w > 0.0) {
+            float dist = length(cur.xyz - camera);
+            r.valid = length(cur.xyz - prev.xyz) <= tolerance * max(dist, 1e-3);
+        }
+    }
+    return r;
+}
+
+#endif

@@ -1,0 +1,30 @@
+// State of the per-pixel linear models (TVCG §5): predictor p = [1, z] (d = 4), one β
+// per colour channel, and one symmetric 4×4 P shared by the channels, stored as its upper
+// triangle in three rgba32f texels: (P00 P01 P02 P03) (P11 P12 P13 P22) (P23 P33 − −).
+#ifndef DVR_WRLS_GLSL
+#define DVR_WRLS_GLSL
+
+// Ablation switches (the paper's Fig. 8): weighted (wRLS) or plain RLS (w = 1), and the
+// temporal feature in the predictor or not (p = [1]).
+layout(constant_id = 9) const bool WEIGHTED = true;
+layout(constant_id = 10) const bool USE_FEATURE = true;
+
+mat4 unpack_p(vec4 a, vec4 b, vec4 c) {
+    return mat4(
+        a.x, a.y, a.z, a.w,
+        a.y, b.x, b.y, b.z,
+        a.z, b.y, b.w, c.x,
+        a.w, b.z, c.x, c.y);
+}
+
+void pack_p(mat4 m, out vec4 a, out vec4 b, out vec4 c) {
+    a = vec4(m[0][0], m[0][1], m[0][2], m[0][3]);
+    b = vec4(m[1][1], m[1][2], m[1][3], m[2][2]);
+    c = vec4(m[2][3], m[3][3], 0.0, 0.0);
+}
+
+vec4 predictor(vec3 z) {
+    return USE_FEATURE ? vec4(1.0, z) : vec4(1.0, 0.0, 0.0, 0.0);
+}
+
+#endif

@@ -1,0 +1,50 @@
+#version 460
+// The paper's denoiser, spatial part: pixel i's colour blends the predictions of the 25
+// linear models in its 5×5 window, each applied to i's own predictor p_i, with bilateral
+// weights (pixel distance and temporal-feature difference).
+#include "common.glsl"
+#include "wrls.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = 0, rgba32f) uniform readonly image2D z;
+layout(binding = 1, rgba32f) uniform readonly image2D beta_r;
+layout(binding = 2, rgba32f) uniform readonly image2D beta_g;
+layout(binding = 3, rgba32f) uniform readonly image2D beta_b;
+layout(binding = 4, rgba32f) uniform readonly image2D noisy;
+layout(binding = 5, rgba32f) uniform writeonly image2D denoised;
+
+layout(push_constant) uniform WrlsSpatialPush {
+    uint width;
+    uint height;
+    float sigma_spatial;  // pixels
+    float sigma_range;    // relative feature difference
+} pc;
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = ivec2(pc.width, pc.height);
+    if (p.x >= size.x || p.y >= size.y) return;
+    vec3 zi = imageLoad(z, p).rgb;
+    vec4 xi = predictor(zi);
+    float norm_i = dot(zi, zi) + 1e-4;
+    vec3 sum = vec3(0.0);
+    float wsum = 0.0;
+    for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+            ivec2 j = p + ivec2(dx, dy);
+            if (any(lessThan(j, ivec2(0))) || any(greaterThanEqual(j, size))) continue;
+            vec3 zj = imageLoad(z, j).rgb;
+            vec3 dz = zi - zj;
+            float w = exp(-float(dx * dx + dy * dy) / (2.0 * pc.sigma_spatial * pc.sigma_spatial)
+                          - dot(dz, dz) / (pc.sigma_range * pc.sigma_range * norm_i));
+            vec3 pred = vec3(dot(xi, imageLoad(beta_r, j)), dot(xi, imageLoad(beta_g, j)),
+                             dot(xi, imageLoad(beta_b, j)));
+            sum += w * pred;
+            wsum += w;
+        }
+    }
+    vec3 result = sum / max(wsum, 1e-8);
+    if (!all_finite(result)) result = imageLoad(noisy, p).rgb;
+    imageStore(denoised, p, vec4(max(result, vec3(0.0)), 1.0));
+}
