@@ -1,1 +1,3 @@
 include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+pub mod scene;
+pub mod transfer;
