@@ -11,7 +11,9 @@ pub mod graph;
 pub mod metrics;
 pub mod passes;
 pub mod renderer;
+pub mod scene;
 pub mod shaders;
+pub mod transfer;
 pub mod volume;
 
 pub use error::{EngineError, Result};

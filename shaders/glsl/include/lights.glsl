@@ -24,10 +24,10 @@ vec3 uniform_sphere(float u1, float u2) {
 vec3 environment_radiance(Light l, vec3 dir) {
     int mode = int(l.radiance.w);
     if (mode == ENV_GRADIENT) {
-        return mix(l.u_axis.rgb, l.radiance.rgb, 0.5 * (dir.y + 1.0));
+        return mix(l.u_axis.rgb, l.radiance.rgb, 0.5 * (dir.z + 1.0));  // z up
     }
     if (HAS_ENV_MAP && mode == ENV_MAP) {
-        vec2 uv = vec2(atan(dir.z, dir.x) / (2.0 * PI) + 0.5, acos(clamp(dir.y, -1.0, 1.0)) / PI);
+        vec2 uv = vec2(atan(dir.y, dir.x) / (2.0 * PI) + 0.5, acos(clamp(dir.z, -1.0, 1.0)) / PI);
         return texture(environment_map, uv).rgb * l.u_axis.w;
     }
     return l.radiance.rgb;
@@ -64,7 +64,8 @@ LightSample sample_light(vec3 p, inout Rng rng) {
         s.dir = to / s.dist;
         vec3 n = cross(l.u_axis.xyz, l.v_axis.xyz);
         float area = 4.0 * length(n);
-        float cos_l = abs(dot(normalize(n), s.dir));  // two-sided emitter
+        // One-sided: emits from the side its normal (u × v) faces.
+        float cos_l = max(dot(normalize(n), -s.dir), 0.0);
         s.radiance = l.radiance.rgb * cos_l * area / d2 * choice;
     } else {
         vec3 to = l.position_kind.xyz - p;

@@ -1,0 +1,129 @@
+//! Errors from reading and checking scenes, and the small checking helpers that make
+//! every message name the file and the field.
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use crate::transfer::TransferError;
+
+/// Everything that can go wrong reading, checking or writing a scene. Messages start
+/// with the file (or label) the scene came from, then the field, e.g.
+/// `scenes/head.toml: animation.light[2].index: light 3 does not exist (...)`.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{}: cannot read scene: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// Malformed TOML, an unknown field, a missing required field or a value of the
+    /// wrong type (negative counts included). The message carries line and column.
+    #[error("{origin}: {source}")]
+    Parse {
+        origin: String,
+        source: Box<toml::de::Error>,
+    },
+    /// A value parsed but is out of range or inconsistent with the rest of the scene.
+    #[error("{origin}: {field}: {message}")]
+    Invalid {
+        origin: String,
+        field: String,
+        message: String,
+    },
+    /// A transfer function named by the scene is missing or invalid.
+    #[error("{origin}: {field}: {source}")]
+    Transfer {
+        origin: String,
+        field: String,
+        source: Box<TransferError>,
+    },
+    /// `Scene::builtin` with a name that is not in [`super::Scene::builtin_names`].
+    #[error("unknown built-in scene `{name}`; available: {available}")]
+    UnknownBuiltin { name: String, available: String },
+    /// The scene could not be written as TOML (e.g. a path that is not UTF-8).
+    #[error("{name}: cannot write scene as TOML: {source}")]
+    Serialize {
+        name: String,
+        source: Box<toml::ser::Error>,
+    },
+}
+
+/// Where a scene came from: names it in errors and anchors its relative paths.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Ctx<'a> {
+    pub origin: &'a str,
+    /// Relative paths in the scene are joined to this (the scene file's folder).
+    pub base: Option<&'a Path>,
+}
+
+impl Ctx<'_> {
+    pub fn invalid(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            origin: self.origin.to_string(),
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    pub fn resolve(&self, path: &Path) -> PathBuf {
+        match self.base {
+            Some(base) if path.is_relative() => base.join(path),
+            _ => path.to_path_buf(),
+        }
+    }
+
+    pub fn finite(&self, field: &str, x: f64) -> Result<(), SceneError> {
+        if x.is_finite() {
+            Ok(())
+        } else {
+            Err(self.invalid(field, format!("{x} is not a finite number")))
+        }
+    }
+
+    pub fn positive(&self, field: &str, x: f64) -> Result<(), SceneError> {
+        if x.is_finite() && x > 0.0 {
+            Ok(())
+        } else {
+            Err(self.invalid(field, format!("{x} must be finite and > 0")))
+        }
+    }
+
+    pub fn non_negative(&self, field: &str, x: f64) -> Result<(), SceneError> {
+        if x.is_finite() && x >= 0.0 {
+            Ok(())
+        } else {
+            Err(self.invalid(field, format!("{x} must be finite and >= 0")))
+        }
+    }
+
+    pub fn finite3(&self, field: &str, v: DVec3) -> Result<(), SceneError> {
+        if v.is_finite() {
+            Ok(())
+        } else {
+            Err(self.invalid(field, format!("{v} has a component that is not finite")))
+        }
+    }
+
+    /// A colour: finite, every channel `>= 0`.
+    pub fn colour(&self, field: &str, c: DVec3) -> Result<(), SceneError> {
+        if c.is_finite() && c.min_element() >= 0.0 {
+            Ok(())
+        } else {
+            Err(self.invalid(
+                field,
+                format!("colour {c} must be finite and >= 0 in every channel"),
+            ))
+        }
+    }
+
+    pub fn unit_vector(&self, field: &str, v: DVec3) -> Result<(), SceneError> {
+        self.finite3(field, v)?;
+        if v.length_squared() > 1e-12 {
+            Ok(())
+        } else {
+            Err(self.invalid(field, "must not be the zero vector"))
+        }
+    }
+}

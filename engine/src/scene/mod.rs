@@ -1,0 +1,233 @@
+//! Scenes: what to render (volume, transfer functions, camera, lights, render settings)
+//! and how it moves over a scripted sequence of frames.
+//!
+//! A scene is a TOML file, or one of the 24 built-in scenes (`<dataset>/<animation>`,
+//! see [`builtin`]). The renderer never reads the file itself: it asks a [`Scene`] for
+//! the [`FrameState`] of each frame (camera with its matrices, lights, TF blend),
+//! uploads the TF LUTs from [`Scene::tf_luts`], specialises its pipeline from
+//! [`Scene::features`], and uses [`changed`] between consecutive frames to decide which
+//! history to reset. Scripted animations are what makes denoisers comparable: every
+//! method sees exactly the same sequence, and `with_frames` resamples it for an 8-frame
+//! test or a 120-frame evaluation.
+//!
+//! # Conventions
+//!
+//! - **World space** is set by the volume: centred at the origin, longest side 1.0
+//!   world unit, voxel axes i, j, k along x, y, z; right-handed. Built-in scenes use
+//!   +z as up (superior, for RAS medical volumes). See [`volume`].
+//! - **Extinction** `μt = TF opacity × volume.density_scale` per world unit.
+//! - **Camera**: right-handed view space; Vulkan clip space (y down, depth 0..1). See
+//!   [`camera`].
+//! - **Light units**: see [`light`]. Radiance on lit surfaces of the built-in scenes is
+//!   of order 1.
+//! - **Animation**: keyframe tracks per property, linear or step; orbits as a rate. See
+//!   [`animation`]. Frames default to 60.
+//! - Relative paths in a scene file are relative to the file's folder.
+//!
+//! # File format
+//!
+//! Sections: `[volume]` and `[transfer]` are required, `[camera]`, `[render]` and
+//! `[animation]` are optional, and `[[light]]` is needed at least once unless
+//! `render.emission = true`. Unknown fields are errors. This is
+//! `assets/scenes/example.toml`, which uses every section (a test loads it):
+//!
+//! ```toml
+#![doc = include_str!("../../../assets/scenes/example.toml")]
+//! ```
+
+pub mod animation;
+pub mod builtin;
+pub mod camera;
+pub mod error;
+pub mod features;
+mod file;
+pub mod frame;
+pub mod light;
+pub mod render;
+pub mod transfer_ref;
+pub mod volume;
+
+#[cfg(test)]
+mod tests;
+
+use std::path::Path;
+
+pub use animation::{Animation, CameraKey, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES};
+pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR};
+pub use error::SceneError;
+pub use features::Features;
+pub use frame::{changed, Change, FrameState};
+pub use light::{
+    AreaLight, EnvMode, EnvSource, EnvironmentLight, Facing, Light, LightKind, PointLight,
+};
+pub use render::{Estimator, Phase, RenderSettings};
+pub use transfer_ref::TransferSpec;
+pub use volume::{BuiltinVolume, RawFormat, RawLayout, VolumeSource, VolumeSpec};
+
+use crate::transfer::{TfLut, TransferFunction};
+use error::Ctx;
+
+/// A checked scene: everything needed to render any of its frames.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// The file's `name`, its file stem, or `<dataset>/<animation>` for a built-in.
+    pub name: String,
+    pub volume: VolumeSpec,
+    /// Where the TFs came from (what [`Scene::to_toml`] writes).
+    pub transfer: TransferSpec,
+    /// The TF at rest (blend 0), loaded from `transfer.a`. An editor may change it in
+    /// place; `to_toml` still writes `transfer.a`, so save the TF itself too.
+    pub tf_a: TransferFunction,
+    /// The blend target (blend 1), loaded from `transfer.b`.
+    pub tf_b: Option<TransferFunction>,
+    /// The camera at rest; animation may override it per frame.
+    pub camera: CameraSpec,
+    /// The lights at rest, in file order (animation keys refer to these indices).
+    pub lights: Vec<Light>,
+    pub render: RenderSettings,
+    /// Number of frames in the scripted sequence (>= 1).
+    pub frames: u32,
+    pub animation: Animation,
+}
+
+impl Scene {
+    /// Reads and checks a scene file. Relative paths inside it are relative to its
+    /// folder.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, SceneError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        file::parse(&text, &path.display().to_string(), path.parent())
+    }
+
+    /// Parses and checks scene text. `origin` names it in error messages and gives the
+    /// default name (its file stem); relative paths stay relative to the working
+    /// directory.
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, SceneError> {
+        file::parse(text, origin, None)
+    }
+
+    /// A built-in scene (`<dataset>/<animation>`) if `name_or_path` is one, else the
+    /// scene file at that path: what `--scene` accepts.
+    pub fn open(name_or_path: &str) -> Result<Self, SceneError> {
+        if Self::builtin_names().iter().any(|n| n == name_or_path) {
+            Self::builtin(name_or_path)
+        } else {
+            Self::load(name_or_path)
+        }
+    }
+
+    /// A built-in scene, e.g. `"phantom/orbit"`, with [`DEFAULT_FRAMES`] frames.
+    pub fn builtin(name: &str) -> Result<Self, SceneError> {
+        builtin::build(name)
+    }
+
+    /// All built-in scene names: `<dataset>/<animation>` for the datasets `phantom`,
+    /// `mri`, `cloud` and the animations in [`builtin::ANIMATIONS`].
+    pub fn builtin_names() -> Vec<String> {
+        builtin::names()
+    }
+
+    /// The same scene resampled to `frames` frames (keyframes scale proportionally,
+    /// orbits keep their rate; see [`animation`]).
+    pub fn with_frames(&self, frames: u32) -> Result<Self, SceneError> {
+        if frames == 0 {
+            return Err(SceneError::Invalid {
+                origin: self.name.clone(),
+                field: "animation.frames".into(),
+                message: "must be at least 1".into(),
+            });
+        }
+        Ok(Self {
+            frames,
+            animation: self.animation.rescaled(self.frames, frames),
+            ..self.clone()
+        })
+    }
+
+    /// The scene as a TOML file that [`Scene::from_toml_str`] reads back into an equal
+    /// scene (with `tf_a`/`tf_b` reloaded from `transfer`).
+    pub fn to_toml(&self) -> Result<String, SceneError> {
+        file::write(self)
+    }
+
+    /// Checks a scene built or edited in code, as loading checks a file. Errors name
+    /// the scene by its `name`.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        self.check(&Ctx {
+            origin: &self.name,
+            base: None,
+        })
+    }
+
+    /// The TF LUTs at blend 0 and 1 (`b` = `a` when the scene has no blend target). A
+    /// renderer that blends on the GPU uploads both; see also [`Scene::tf_lut`].
+    pub fn tf_luts(&self) -> (TfLut, TfLut) {
+        let a = self.tf_a.lut();
+        let b = self
+            .tf_b
+            .as_ref()
+            .map_or_else(|| a.clone(), TransferFunction::lut);
+        (a, b)
+    }
+
+    /// The LUT in effect at a blend (a [`FrameState::tf_blend`]).
+    pub fn tf_lut(&self, blend: f32) -> TfLut {
+        let (a, b) = self.tf_luts();
+        TfLut::lerp(&a, &b, blend)
+    }
+
+    pub(crate) fn check(&self, ctx: &Ctx) -> Result<(), SceneError> {
+        self.volume.check(ctx)?;
+        let tf_err = |field: &str| {
+            let field = field.to_string();
+            move |source| SceneError::Transfer {
+                origin: ctx.origin.to_string(),
+                field,
+                source: Box::new(source),
+            }
+        };
+        self.tf_a.validate().map_err(tf_err("transfer.a"))?;
+        if let Some(b) = &self.tf_b {
+            b.validate().map_err(tf_err("transfer.b"))?;
+        }
+        self.camera.check(ctx, "camera")?;
+        if self.lights.is_empty() && !self.render.emission {
+            return Err(ctx.invalid(
+                "light",
+                "a scene needs at least one [[light]] (or render.emission = true)",
+            ));
+        }
+        let mut environments = 0;
+        for (i, light) in self.lights.iter().enumerate() {
+            light.check(ctx, i)?;
+            if matches!(light, Light::Environment(_)) {
+                environments += 1;
+                if environments > 1 {
+                    return Err(ctx.invalid(
+                        format!("light[{i}].kind"),
+                        "a scene has at most one environment light",
+                    ));
+                }
+            }
+        }
+        self.render.check(ctx)?;
+        self.animation.check(
+            ctx,
+            self.frames,
+            &self.camera,
+            &self.lights,
+            self.tf_b.is_some(),
+        )?;
+        // The camera must be well defined where keyframes put it (in between, linear
+        // motion between two valid poses could only fail by passing exactly through the
+        // target, which no sensible path does).
+        for (i, k) in self.animation.camera.iter().enumerate() {
+            self.camera_at(k.frame)
+                .check(ctx, &format!("animation.camera[{i}]"))?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,135 @@
+//! Named presets: `assets/transfer/<name>.toml`, one file per TF.
+//!
+//! Presets are files, not code, so they can be tuned without a rebuild and a user can
+//! copy one as a starting point. The assets folder is `$DVR_ASSETS` when set (an
+//! installed binary points it at its data), otherwise the source tree's `assets/`
+//! (`CARGO_MANIFEST_DIR/../assets`), which is what tests and `cargo run` use.
+
+use std::path::{Path, PathBuf};
+
+use super::{TransferError, TransferFunction};
+
+/// Environment variable that overrides the assets folder.
+pub const ASSETS_ENV: &str = "DVR_ASSETS";
+
+/// The assets folder: `$DVR_ASSETS` if set and non-empty, else the workspace's `assets/`.
+pub fn assets_dir() -> PathBuf {
+    match std::env::var_os(ASSETS_ENV) {
+        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("..")
+            .join("assets"),
+    }
+}
+
+/// The folder holding the TF presets.
+pub fn preset_dir() -> PathBuf {
+    assets_dir().join("transfer")
+}
+
+impl TransferFunction {
+    /// Loads the preset `name` (`assets/transfer/<name>.toml`). An unknown name lists
+    /// the available ones.
+    pub fn preset(name: &str) -> Result<Self, TransferError> {
+        let dir = preset_dir();
+        let plain = !name.is_empty() && !name.contains(['/', '\\']) && name != "." && name != "..";
+        let path = dir.join(format!("{name}.toml"));
+        if !plain || !path.is_file() {
+            let available = match Self::preset_names() {
+                Ok(names) if !names.is_empty() => names.join(", "),
+                Ok(_) => "none".to_string(),
+                Err(e) => format!("none ({e})"),
+            };
+            return Err(TransferError::UnknownPreset {
+                name: name.to_string(),
+                dir,
+                available,
+            });
+        }
+        Self::load(path)
+    }
+
+    /// The names of all presets (file stems in `assets/transfer/`), sorted.
+    pub fn preset_names() -> Result<Vec<String>, TransferError> {
+        let dir = preset_dir();
+        let io = |source| TransferError::Io {
+            path: dir.clone(),
+            source,
+        };
+        let mut names = Vec::new();
+        for entry in std::fs::read_dir(&dir).map_err(io)? {
+            let path = entry.map_err(io)?.path();
+            if path.extension().is_some_and(|e| e == "toml") {
+                if let Some(stem) = path.file_stem() {
+                    names.push(stem.to_string_lossy().into_owned());
+                }
+            }
+        }
+        names.sort();
+        Ok(names)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transfer::LUT_SIZE;
+
+    /// The presets the built-in scenes and the docs rely on.
+    const REQUIRED: [&str; 10] = [
+        "phantom-opaque",
+        "phantom-opaque-edit",
+        "phantom-layered",
+        "phantom-layered-edit",
+        "mri-opaque",
+        "mri-opaque-edit",
+        "mri-layered",
+        "mri-layered-edit",
+        "cloud",
+        "cloud-edit",
+    ];
+
+    #[test]
+    fn all_presets_load_and_are_valid() {
+        let names = TransferFunction::preset_names().expect("preset folder readable");
+        for r in REQUIRED {
+            assert!(
+                names.iter().any(|n| n == r),
+                "missing preset {r}; have {names:?}"
+            );
+        }
+        for name in &names {
+            let tf = TransferFunction::preset(name).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(&tf.name, name, "preset name must match its file");
+            tf.validate().unwrap_or_else(|e| panic!("{e}"));
+            let lut = tf.lut();
+            assert_eq!(lut.len(), LUT_SIZE);
+            assert!(lut.max_opacity() > 0.0, "{name} is invisible");
+            // Air (density 0) is transparent in every preset.
+            assert_eq!(lut.diffuse_opacity[0][3], 0.0, "{name}: air must be clear");
+        }
+    }
+
+    #[test]
+    fn edits_differ_from_their_originals() {
+        for r in REQUIRED.iter().filter(|r| r.ends_with("-edit")) {
+            let base = r.trim_end_matches("-edit");
+            let a = TransferFunction::preset(base).expect("base preset").lut();
+            let b = TransferFunction::preset(r).expect("edit preset").lut();
+            assert!(a.max_abs_diff(&b) > 0.1, "{r} barely changes {base}");
+        }
+    }
+
+    #[test]
+    fn unknown_preset_lists_the_available_ones() {
+        let e = TransferFunction::preset("no-such-preset")
+            .map(|_| ())
+            .map_err(|e| e.to_string());
+        assert!(
+            matches!(&e, Err(m) if m.contains("no-such-preset") && m.contains("phantom-opaque")),
+            "{e:?}"
+        );
+        assert!(TransferFunction::preset("../transfer/cloud").is_err());
+        assert!(TransferFunction::preset("").is_err());
+    }
+}
