@@ -99,7 +99,11 @@ pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
         );
     }
     eprintln!();
-    println!("wrote {} reference frames to {}", setup.frames, dir.display());
+    println!(
+        "wrote {} reference frames to {}",
+        setup.frames,
+        dir.display()
+    );
     Ok(())
 }
 
@@ -149,5 +153,8 @@ pub fn profile(
 fn progress(what: &str, done: u32, total: u32, started: Instant) {
     let secs = started.elapsed().as_secs_f64();
     let left = secs / done as f64 * (total - done) as f64;
-    eprint!("\r{what}: frame {done}/{total} | {:.1} fps | {left:.0} s left   ", done as f64 / secs);
+    eprint!(
+        "\r{what}: frame {done}/{total} | {:.1} fps | {left:.0} s left   ",
+        done as f64 / secs
+    );
 }

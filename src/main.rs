@@ -12,7 +12,11 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
 #[derive(Parser)]
-#[command(name = "dvr", version, about = "Monte Carlo direct volume rendering with temporal denoising")]
+#[command(
+    name = "dvr",
+    version,
+    about = "Monte Carlo direct volume rendering with temporal denoising"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -99,7 +103,11 @@ fn main() {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Capture { scene, denoiser, out } => capture::capture(&scene, &denoiser, &out),
+        Command::Capture {
+            scene,
+            denoiser,
+            out,
+        } => capture::capture(&scene, &denoiser, &out),
         Command::Reference {
             scene,
             ref_spp,

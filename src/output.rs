@@ -48,6 +48,12 @@ pub fn read_exr(path: &Path) -> Result<Rgb32Image> {
 
 pub fn write_png(path: &Path, img: &Rgb32Image) -> Result<()> {
     let bytes = tonemap_srgb(img, PNG_EXPOSURE).to_srgb8();
-    image::save_buffer(path, &bytes, img.width, img.height, image::ExtendedColorType::Rgb8)
-        .with_context(|| format!("writing {}", path.display()))
+    image::save_buffer(
+        path,
+        &bytes,
+        img.width,
+        img.height,
+        image::ExtendedColorType::Rgb8,
+    )
+    .with_context(|| format!("writing {}", path.display()))
 }

@@ -48,7 +48,11 @@ pub fn stats(name: &str, mut values: Vec<f64>) -> PassStats {
     PassStats {
         pass: name.to_string(),
         frames: n,
-        mean_ms: if n == 0 { 0.0 } else { values.iter().sum::<f64>() / n as f64 },
+        mean_ms: if n == 0 {
+            0.0
+        } else {
+            values.iter().sum::<f64>() / n as f64
+        },
         median_ms: percentile(&values, 0.5),
         p95_ms: percentile(&values, 0.95),
     }
@@ -56,7 +60,11 @@ pub fn stats(name: &str, mut values: Vec<f64>) -> PassStats {
 
 /// Aggregates per-pass timings over frames (after the warm-up), in first-seen pass order.
 pub fn aggregate(frames: &[Vec<PassTiming>]) -> (Vec<PassStats>, PassStats) {
-    let measured = if frames.len() > WARMUP_FRAMES { &frames[WARMUP_FRAMES..] } else { frames };
+    let measured = if frames.len() > WARMUP_FRAMES {
+        &frames[WARMUP_FRAMES..]
+    } else {
+        frames
+    };
     let mut order = Vec::new();
     let mut by_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut totals = Vec::new();

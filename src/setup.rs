@@ -28,8 +28,14 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("size {s:?} is not WIDTHxHEIGHT"))?;
-    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in {s:?}"))?;
-    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in {s:?}"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad width in {s:?}"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad height in {s:?}"))?;
     if w == 0 || h == 0 || w > 8192 || h > 8192 {
         return Err(format!("size {s:?} must be between 1x1 and 8192x8192"));
     }
@@ -101,7 +107,9 @@ fn gpu_light(l: &Light) -> GpuLight {
         Light::Environment(e) => {
             let k = e.intensity as f32;
             let (top, bottom, mode) = match &e.source {
-                EnvSource::Constant { colour } => (v3(*colour) * k, Vec3::ZERO, uniforms::ENV_CONSTANT),
+                EnvSource::Constant { colour } => {
+                    (v3(*colour) * k, Vec3::ZERO, uniforms::ENV_CONSTANT)
+                }
                 EnvSource::Gradient { top, bottom } => {
                     (v3(*top) * k, v3(*bottom) * k, uniforms::ENV_GRADIENT)
                 }
@@ -178,10 +186,9 @@ impl Setup {
                 scene::Phase::Hybrid => Phase::Hybrid,
             },
             emission: r.emission,
-            environment_map: scene
-                .lights
-                .iter()
-                .any(|l| matches!(l, Light::Environment(e) if matches!(e.source, EnvSource::Map { .. }))),
+            environment_map: scene.lights.iter().any(
+                |l| matches!(l, Light::Environment(e) if matches!(e.source, EnvSource::Map { .. })),
+            ),
         };
         let settings = RenderSettings {
             size: Extent {
@@ -292,14 +299,18 @@ pub fn write_capture_page(
             "<figure><img class=seq data-m='{m}'><figcaption>{m}</figcaption></figure>"
         ));
     }
-    html.push_str("<h2>GPU time per pass (ms)</h2><table><tr><th>pass<th>mean<th>median<th>p95</tr>");
+    html.push_str(
+        "<h2>GPU time per pass (ms)</h2><table><tr><th>pass<th>mean<th>median<th>p95</tr>",
+    );
     for p in passes.iter().chain(std::iter::once(total)) {
         html.push_str(&format!(
             "<tr><td style=text-align:left>{}<td>{:.3}<td>{:.3}<td>{:.3}</tr>",
             p.pass, p.mean_ms, p.median_ms, p.p95_ms
         ));
     }
-    html.push_str("</table><script>const f=document.getElementById('f'),n=document.getElementById('n');");
+    html.push_str(
+        "</table><script>const f=document.getElementById('f'),n=document.getElementById('n');",
+    );
     html.push_str("function show(){const i=String(f.value).padStart(4,'0');n.textContent=f.value;for(const im of document.querySelectorAll('img.seq'))im.src=im.dataset.m+'/'+i+'.png';}f.oninput=show;show();</script>");
     std::fs::write(out.join("index.html"), html)
         .with_context(|| format!("writing {}", out.join("index.html").display()))

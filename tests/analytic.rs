@@ -20,7 +20,11 @@ fn slab_transmittance(estimator: Estimator) -> f64 {
     s.filter_sigma = 0.0; // straight through the pixel centre
     let volume = constant_volume(8, 1.0);
     let mut r = renderer(context(), s, &volume, &["none"]);
-    let inputs = inputs(front_camera(3.0, 2.0), vec![environment(1.0)], constant_lut(1.0, 0.0));
+    let inputs = inputs(
+        front_camera(3.0, 2.0),
+        vec![environment(1.0)],
+        constant_lut(1.0, 0.0),
+    );
     let img = r.reference(&inputs, 4096, 512).expect("reference render");
     mean_rgb(&img)[0]
 }
@@ -55,11 +59,18 @@ fn white_furnace_returns_the_environment() {
     s.rr_depth = 4;
     let volume = constant_volume(8, 1.0);
     let mut r = renderer(context(), s, &volume, &["none"]);
-    let inputs = inputs(front_camera(3.0, 30.0), vec![environment(1.0)], constant_lut(1.0, 1.0));
+    let inputs = inputs(
+        front_camera(3.0, 30.0),
+        vec![environment(1.0)],
+        constant_lut(1.0, 1.0),
+    );
     let img = r.reference(&inputs, 2048, 256).expect("reference render");
     let m = mean_rgb(&img);
     for c in m {
-        assert!((c - 1.0).abs() < 0.01, "white furnace mean {m:?}, expected 1");
+        assert!(
+            (c - 1.0).abs() < 0.01,
+            "white furnace mean {m:?}, expected 1"
+        );
     }
     assert_validation_clean();
 }
@@ -71,11 +82,20 @@ fn identical_seeds_give_identical_images() {
         let mut r = renderer(context(), settings(16, 2), &volume, &["none"]);
         let inputs = inputs(
             front_camera(2.5, 40.0),
-            vec![point_light(glam::Vec3::new(1.0, 1.0, 2.0), 4.0), environment(0.2)],
+            vec![
+                point_light(glam::Vec3::new(1.0, 1.0, 2.0), 4.0),
+                environment(0.2),
+            ],
             constant_lut(0.5, 0.8),
         );
-        r.frame(&inputs, &dvr_engine::renderer::FrameRequest { readback: true, reset: false })
-            .expect("frame");
+        r.frame(
+            &inputs,
+            &dvr_engine::renderer::FrameRequest {
+                readback: true,
+                reset: false,
+            },
+        )
+        .expect("frame");
         let done = r.flush().expect("flush");
         done[0].images[0].1.clone()
     };

@@ -22,14 +22,24 @@ fn read_image(
     image: dvr_engine::graph::ImageHandle,
 ) -> Vec<[f32; 4]> {
     let buf = graph
-        .buffer(ctx, "test.readback", (W * H * 16) as u64, MemoryLocation::GpuToCpu)
+        .buffer(
+            ctx,
+            "test.readback",
+            (W * H * 16) as u64,
+            MemoryLocation::GpuToCpu,
+        )
         .expect("buffer");
     let mut f = Frame::new();
-    f.add_pass("readback", |b| {
-        b.transfer_src(image).transfer_dst(buf);
-    }, move |pc| pc.copy_image_to_buffer(image, buf));
+    f.add_pass(
+        "readback",
+        |b| {
+            b.transfer_src(image).transfer_dst(buf);
+        },
+        move |pc| pc.copy_image_to_buffer(image, buf),
+    );
     f.add_host_read("host_read", buf);
-    ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f)).expect("submit");
+    ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
+        .expect("submit");
     bytemuck::cast_slice::<u8, [f32; 4]>(graph.buffer_ref(buf).mapped().expect("mapped")).to_vec()
 }
 
@@ -40,7 +50,10 @@ fn history_accumulates_across_frames_and_resets() {
     let acc = Accumulate::new(&ctx).expect("pipeline");
     let desc = ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT);
     let input = graph.image(&ctx, "input", desc).expect("image");
-    let size = Extent { width: W, height: H };
+    let size = Extent {
+        width: W,
+        height: H,
+    };
     let mut means = Vec::new();
     for frame_index in 0..6u32 {
         if frame_index == 4 {
@@ -51,13 +64,28 @@ fn history_accumulates_across_frames_and_resets() {
         let value = frame_index as f32;
         let data = vec![[value, value, value, 1.0f32]; (W * H) as usize];
         let mut f = Frame::new();
-        add_upload(&ctx, &mut graph, &mut f, "upload", input, bytemuck::cast_slice(&data)).expect("upload");
-        let mean = acc.add(&ctx, &mut graph, &mut f, "acc", input, 1.0, size).expect("add");
-        ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f)).expect("submit");
+        add_upload(
+            &ctx,
+            &mut graph,
+            &mut f,
+            "upload",
+            input,
+            bytemuck::cast_slice(&data),
+        )
+        .expect("upload");
+        let mean = acc
+            .add(&ctx, &mut graph, &mut f, "acc", input, 1.0, size)
+            .expect("add");
+        ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
+            .expect("submit");
         graph.end_frame();
         means.push(read_image(&ctx, &mut graph, mean)[0][0]);
     }
-    assert_eq!(means[..4], [0.0, 0.5, 1.0, 1.5], "running mean over frames 0..3");
+    assert_eq!(
+        means[..4],
+        [0.0, 0.5, 1.0, 1.5],
+        "running mean over frames 0..3"
+    );
     assert_eq!(means[4..], [4.0, 4.5], "restarted at the reset");
     let mut acc = acc;
     acc.destroy(&ctx);
@@ -76,21 +104,33 @@ fn undeclared_resources_are_refused_naming_the_pass() {
     let mut pipeline =
         dvr_engine::gpu::ComputePipeline::new(&ctx, "accumulate", &[]).expect("pipeline");
     let mut f = Frame::new();
-    f.add_pass("sneaky", |d| {
-        d.read(a);
-    }, |pc| {
-        pc.dispatch(
-            &pipeline,
-            &[("radiance", Bind::Image(a)), ("sum_prev", Bind::Image(b)), ("sum_cur", Bind::Image(b)), ("mean", Bind::Image(b))],
-            &[0u32; 4],
-            [1, 1, 1],
-        )
-    });
+    f.add_pass(
+        "sneaky",
+        |d| {
+            d.read(a);
+        },
+        |pc| {
+            pc.dispatch(
+                &pipeline,
+                &[
+                    ("radiance", Bind::Image(a)),
+                    ("sum_prev", Bind::Image(b)),
+                    ("sum_cur", Bind::Image(b)),
+                    ("mean", Bind::Image(b)),
+                ],
+                &[0u32; 4],
+                [1, 1, 1],
+            )
+        },
+    );
     let err = ctx
         .submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
         .expect_err("b was not declared");
     let msg = err.to_string();
-    assert!(msg.contains("sneaky") && msg.contains("\"b\""), "message: {msg}");
+    assert!(
+        msg.contains("sneaky") && msg.contains("\"b\""),
+        "message: {msg}"
+    );
     pipeline.destroy(&ctx);
     acc.destroy(&ctx);
     graph.destroy(&ctx);
@@ -101,7 +141,11 @@ fn new_images_start_at_zero() {
     let ctx = context();
     let mut graph = RenderGraph::new(&ctx).expect("graph");
     let img = graph
-        .image(&ctx, "fresh", ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT))
+        .image(
+            &ctx,
+            "fresh",
+            ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT),
+        )
         .expect("image");
     let px = read_image(&ctx, &mut graph, img);
     assert!(px.iter().all(|p| *p == [0.0; 4]));

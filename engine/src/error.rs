@@ -18,7 +18,10 @@ pub enum EngineError {
     #[error("DVR_DEVICE={wanted:?} matches no Vulkan device; available: {available}")]
     DeviceNotFound { wanted: String, available: String },
     #[error("Vulkan call {call} failed: {result}")]
-    Vk { call: &'static str, result: ash::vk::Result },
+    Vk {
+        call: &'static str,
+        result: ash::vk::Result,
+    },
     #[error("GPU memory allocation for {what} failed: {source}")]
     Alloc {
         what: String,

@@ -6,7 +6,7 @@
 use dvr_engine::gpu::{validation, GpuContext};
 use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::{BrickRanges, LutUpload, VolumeFormat, VolumeUpload};
-use dvr_engine::renderer::uniforms::{GpuLight, LIGHT_ENV, LIGHT_POINT, ENV_CONSTANT};
+use dvr_engine::renderer::uniforms::{GpuLight, ENV_CONSTANT, LIGHT_ENV, LIGHT_POINT};
 use dvr_engine::renderer::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
 use glam::{Vec3, Vec4};
 
@@ -81,12 +81,21 @@ pub fn settings(size: u32, spp: u32) -> RenderSettings {
     }
 }
 
-pub fn renderer(ctx: GpuContext, s: RenderSettings, v: &VolumeUpload, denoisers: &[&str]) -> Renderer {
+pub fn renderer(
+    ctx: GpuContext,
+    s: RenderSettings,
+    v: &VolumeUpload,
+    denoisers: &[&str],
+) -> Renderer {
     Renderer::new(ctx, s, v, None, denoisers, LUT as u32).expect("renderer")
 }
 
 pub fn inputs(camera: CameraMatrices, lights: Vec<GpuLight>, lut: LutUpload) -> FrameInputs {
-    FrameInputs { camera, lights, lut }
+    FrameInputs {
+        camera,
+        lights,
+        lut,
+    }
 }
 
 pub fn mean_rgb(pixels: &[[f32; 4]]) -> [f64; 3] {
@@ -102,5 +111,10 @@ pub fn mean_rgb(pixels: &[[f32; 4]]) -> [f64; 3] {
 /// Fails the test if the validation layer reported anything in this process.
 pub fn assert_validation_clean() {
     let msgs = validation::messages();
-    assert!(msgs.is_empty(), "validation reported {} messages:\n{}", msgs.len(), msgs.join("\n"));
+    assert!(
+        msgs.is_empty(),
+        "validation reported {} messages:\n{}",
+        msgs.len(),
+        msgs.join("\n")
+    );
 }

@@ -82,7 +82,10 @@ pub fn create(ctx: &GpuContext, name: &str) -> Result<Box<dyn Denoiser>> {
         other => {
             return Err(EngineError::Pass {
                 pass: "denoise".into(),
-                problem: format!("unknown denoiser {other:?}; available: {}", NAMES.join(", ")),
+                problem: format!(
+                    "unknown denoiser {other:?}; available: {}",
+                    NAMES.join(", ")
+                ),
             })
         }
     })

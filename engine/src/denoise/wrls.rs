@@ -48,10 +48,22 @@ pub struct WrlsVariant {
 impl WrlsVariant {
     pub fn from_name(name: &str) -> Option<Self> {
         Some(match name {
-            "ours" => Self { weighted: true, feature: true },
-            "rls" => Self { weighted: false, feature: true },
-            "wrls-nf" => Self { weighted: true, feature: false },
-            "rls-nf" => Self { weighted: false, feature: false },
+            "ours" => Self {
+                weighted: true,
+                feature: true,
+            },
+            "rls" => Self {
+                weighted: false,
+                feature: true,
+            },
+            "wrls-nf" => Self {
+                weighted: true,
+                feature: false,
+            },
+            "rls-nf" => Self {
+                weighted: false,
+                feature: false,
+            },
             _ => return None,
         })
     }
@@ -67,7 +79,12 @@ pub struct Wrls {
 }
 
 impl Wrls {
-    pub fn new(ctx: &GpuContext, name: &str, variant: WrlsVariant, motion_source: i32) -> Result<Self> {
+    pub fn new(
+        ctx: &GpuContext,
+        name: &str,
+        variant: WrlsVariant,
+        motion_source: i32,
+    ) -> Result<Self> {
         let spec = [
             ("WEIGHTED", SpecValue::Bool(variant.weighted)),
             ("USE_FEATURE", SpecValue::Bool(variant.feature)),
@@ -133,7 +150,11 @@ impl Denoiser for Wrls {
         frame.add_pass(
             format!("{n}.update"),
             |b| {
-                b.read(noisy).read(motion).read(pos_cur).sampled(pos_prev).sampled(z.prev);
+                b.read(noisy)
+                    .read(motion)
+                    .read(pos_cur)
+                    .sampled(pos_prev)
+                    .sampled(z.prev);
                 for h in beta.iter().chain(&pm) {
                     b.sampled(h.prev);
                 }

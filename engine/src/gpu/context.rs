@@ -146,8 +146,10 @@ impl GpuContext {
             .enabled_extension_names(&ext_names)
             .enabled_features(&features)
             .push_next(&mut f13);
-        let device = unsafe { instance.create_device(physical, &device_info, None) }
-            .map_err(|e| EngineError::NoDevice(format!("{}: vkCreateDevice failed: {e}", info.name)))?;
+        let device =
+            unsafe { instance.create_device(physical, &device_info, None) }.map_err(|e| {
+                EngineError::NoDevice(format!("{}: vkCreateDevice failed: {e}", info.name))
+            })?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let push_descriptor = ash::khr::push_descriptor::Device::new(&instance, &device);
         let debug_utils = Some(ash::ext::debug_utils::Device::new(&instance, &device));
@@ -253,7 +255,9 @@ fn pick_device(
     let physicals = unsafe { instance.enumerate_physical_devices() }
         .map_err(|e| EngineError::NoDevice(format!("vkEnumeratePhysicalDevices failed: {e}")))?;
     if physicals.is_empty() {
-        return Err(EngineError::NoDevice("the loader reports no devices".into()));
+        return Err(EngineError::NoDevice(
+            "the loader reports no devices".into(),
+        ));
     }
     let mut candidates = Vec::new();
     let mut names = Vec::new();

@@ -66,7 +66,10 @@ impl ComputePipeline {
         if let Some(b) = reflection.bindings.iter().find(|b| b.set != 0) {
             return Err(EngineError::Reflection {
                 shader: shader.into(),
-                problem: format!("binding {:?} uses set {}; passes use set 0 only", b.name, b.set),
+                problem: format!(
+                    "binding {:?} uses set {}; passes use set 0 only",
+                    b.name, b.set
+                ),
             });
         }
         let d = &ctx.device;
@@ -110,13 +113,17 @@ impl ComputePipeline {
         let mut entries = Vec::new();
         let mut data = Vec::new();
         for (name, value) in spec {
-            let id = reflection.spec_constants.get(*name).ok_or_else(|| EngineError::Reflection {
-                shader: shader.into(),
-                problem: format!(
-                    "no specialisation constant named {name:?} (has: {:?})",
-                    reflection.spec_constants.keys().collect::<Vec<_>>()
-                ),
-            })?;
+            let id =
+                reflection
+                    .spec_constants
+                    .get(*name)
+                    .ok_or_else(|| EngineError::Reflection {
+                        shader: shader.into(),
+                        problem: format!(
+                            "no specialisation constant named {name:?} (has: {:?})",
+                            reflection.spec_constants.keys().collect::<Vec<_>>()
+                        ),
+                    })?;
             entries.push(
                 vk::SpecializationMapEntry::default()
                     .constant_id(*id)
@@ -139,7 +146,8 @@ impl ComputePipeline {
         let info = [vk::ComputePipelineCreateInfo::default()
             .stage(stage)
             .layout(layout)];
-        let pipeline = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
+        let pipeline =
+            unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) };
         unsafe { d.destroy_shader_module(module, None) };
         let pipeline = pipeline.map_err(|(_, e)| EngineError::Vk {
             call: "vkCreateComputePipelines",
@@ -165,7 +173,8 @@ impl ComputePipeline {
         unsafe {
             ctx.device.destroy_pipeline(self.pipeline, None);
             ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
+            ctx.device
+                .destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
 }

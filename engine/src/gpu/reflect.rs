@@ -41,9 +41,9 @@ pub struct Reflection {
 #[derive(Clone, Debug)]
 enum Ty {
     Scalar(u32),
-    Vector(u32, u32),        // component type, count
-    Matrix(u32, u32),        // column type, count
-    Array(u32, u32),         // element type, length id
+    Vector(u32, u32), // component type, count
+    Matrix(u32, u32), // column type, count
+    Array(u32, u32),  // element type, length id
     RuntimeArray,
     Struct(Vec<u32>),
     Image { sampled: u32, dim: u32 },
@@ -207,7 +207,8 @@ pub fn reflect(words: &[u32]) -> Result<Reflection, String> {
         }
     }
 
-    let type_size = |ty: u32| -> u32 { size_of_type(ty, &types, &constants, &decorations, &member_offsets) };
+    let type_size =
+        |ty: u32| -> u32 { size_of_type(ty, &types, &constants, &decorations, &member_offsets) };
     let struct_members = |struct_id: u32| -> Vec<MemberInfo> {
         let Some(Ty::Struct(members)) = types.get(&struct_id) else {
             return Vec::new();
@@ -220,7 +221,10 @@ pub fn reflect(words: &[u32]) -> Result<Reflection, String> {
                     .get(&(struct_id, m as u32))
                     .cloned()
                     .unwrap_or_default(),
-                offset: member_offsets.get(&(struct_id, m as u32)).copied().unwrap_or(0),
+                offset: member_offsets
+                    .get(&(struct_id, m as u32))
+                    .copied()
+                    .unwrap_or(0),
                 size: type_size(mty),
             })
             .collect()
@@ -250,7 +254,10 @@ pub fn reflect(words: &[u32]) -> Result<Reflection, String> {
         }
         let (Some(&binding), set) = (
             decorations.get(&(id, DEC_BINDING)),
-            decorations.get(&(id, DEC_DESCRIPTOR_SET)).copied().unwrap_or(0),
+            decorations
+                .get(&(id, DEC_DESCRIPTOR_SET))
+                .copied()
+                .unwrap_or(0),
         ) else {
             continue;
         };
@@ -270,13 +277,18 @@ pub fn reflect(words: &[u32]) -> Result<Reflection, String> {
                 (vk::DescriptorType::STORAGE_BUFFER, None)
             }
             (SC_UNIFORM, _) if has(pointee, DEC_BLOCK) => {
-                out.blocks.insert(type_name.clone(), struct_members(pointee));
+                out.blocks
+                    .insert(type_name.clone(), struct_members(pointee));
                 (vk::DescriptorType::UNIFORM_BUFFER, None)
             }
             (SC_STORAGE_BUFFER, _) => (vk::DescriptorType::STORAGE_BUFFER, None),
             _ => continue,
         };
-        let name = if var_name.is_empty() { type_name } else { var_name };
+        let name = if var_name.is_empty() {
+            type_name
+        } else {
+            var_name
+        };
         out.bindings.push(BindingInfo {
             name,
             set,

@@ -36,7 +36,9 @@ pub(crate) unsafe extern "system" fn callback(
     let text = if data.is_null() || (*data).p_message.is_null() {
         "(no message)".to_string()
     } else {
-        CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
+        CStr::from_ptr((*data).p_message)
+            .to_string_lossy()
+            .into_owned()
     };
     let level = if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
         "error"

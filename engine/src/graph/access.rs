@@ -39,7 +39,12 @@ impl Access {
         use vk::ImageLayout as L;
         use vk::PipelineStageFlags2 as S;
         let (stage, access, layout, writes) = match self {
-            Access::Sampled => (S::COMPUTE_SHADER, A::SHADER_SAMPLED_READ, L::SHADER_READ_ONLY_OPTIMAL, false),
+            Access::Sampled => (
+                S::COMPUTE_SHADER,
+                A::SHADER_SAMPLED_READ,
+                L::SHADER_READ_ONLY_OPTIMAL,
+                false,
+            ),
             Access::StorageRead => (S::COMPUTE_SHADER, A::SHADER_STORAGE_READ, L::GENERAL, false),
             Access::StorageWrite => (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE, L::GENERAL, true),
             Access::StorageReadWrite => (
@@ -49,8 +54,18 @@ impl Access {
                 true,
             ),
             Access::Uniform => (S::COMPUTE_SHADER, A::UNIFORM_READ, L::UNDEFINED, false),
-            Access::TransferSrc => (S::COPY | S::CLEAR, A::TRANSFER_READ, L::TRANSFER_SRC_OPTIMAL, false),
-            Access::TransferDst => (S::COPY | S::CLEAR, A::TRANSFER_WRITE, L::TRANSFER_DST_OPTIMAL, true),
+            Access::TransferSrc => (
+                S::COPY | S::CLEAR,
+                A::TRANSFER_READ,
+                L::TRANSFER_SRC_OPTIMAL,
+                false,
+            ),
+            Access::TransferDst => (
+                S::COPY | S::CLEAR,
+                A::TRANSFER_WRITE,
+                L::TRANSFER_DST_OPTIMAL,
+                true,
+            ),
             Access::HostRead => (S::HOST, A::HOST_READ, L::UNDEFINED, false),
         };
         AccessInfo {
@@ -121,9 +136,15 @@ pub fn transition(state: &mut ResourceState, access: Access, is_image: bool) -> 
     if next.writes || layout_change {
         // A write (or a layout transition, which is a write) must wait for every earlier
         // access: the last write (memory dependency) and the reads since (execution).
-        let src_stage = state.last_write.map(|(s, _)| s).unwrap_or(vk::PipelineStageFlags2::NONE)
+        let src_stage = state
+            .last_write
+            .map(|(s, _)| s)
+            .unwrap_or(vk::PipelineStageFlags2::NONE)
             | state.read_stages;
-        let src_access = state.last_write.map(|(_, a)| a).unwrap_or(vk::AccessFlags2::NONE);
+        let src_access = state
+            .last_write
+            .map(|(_, a)| a)
+            .unwrap_or(vk::AccessFlags2::NONE);
         let needed = layout_change || src_stage != vk::PipelineStageFlags2::NONE;
         let barrier = needed.then_some(Barrier {
             src_stage,
@@ -153,8 +174,8 @@ pub fn transition(state: &mut ResourceState, access: Access, is_image: bool) -> 
     // A read in the current layout.
     state.read_stages |= next.stage;
     let (w_stage, w_access) = state.last_write?;
-    let already_visible = state.visible_stages.contains(next.stage)
-        && state.visible_access.contains(next.access);
+    let already_visible =
+        state.visible_stages.contains(next.stage) && state.visible_access.contains(next.access);
     if already_visible {
         return None;
     }

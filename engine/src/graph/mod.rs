@@ -185,12 +185,16 @@ impl RenderGraph {
     pub fn history(&mut self, ctx: &GpuContext, name: &str, desc: ImageDesc) -> Result<History> {
         let a = self.image(ctx, &format!("{name}#0"), desc)?;
         let b = self.image(ctx, &format!("{name}#1"), desc)?;
-        let resized = self.images[a.0 as usize].needs_clear || self.images[b.0 as usize].needs_clear;
-        let slot = self.histories.entry(name.to_string()).or_insert(HistorySlot {
-            flip: false,
-            valid: false,
-            used: false,
-        });
+        let resized =
+            self.images[a.0 as usize].needs_clear || self.images[b.0 as usize].needs_clear;
+        let slot = self
+            .histories
+            .entry(name.to_string())
+            .or_insert(HistorySlot {
+                flip: false,
+                valid: false,
+                used: false,
+            });
         if resized {
             slot.valid = false;
         }
@@ -371,7 +375,12 @@ impl RenderGraph {
 
     /// Clears images created since the last frame to zero before their first access, so
     /// a fresh history or accumulation buffer never holds garbage.
-    fn clear_new_resources(&mut self, ctx: &GpuContext, cmd: vk::CommandBuffer, accesses: &[(Res, Access)]) {
+    fn clear_new_resources(
+        &mut self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        accesses: &[(Res, Access)],
+    ) {
         for &(r, _) in accesses {
             let Res::Image(h) = r else { continue };
             let slot = &mut self.images[h.0 as usize];

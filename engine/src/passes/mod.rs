@@ -37,7 +37,10 @@ impl SceneBindings {
             ("frame", Bind::Buffer(self.uniforms)),
             ("volume_density", Bind::Image(self.volume)),
             ("tf_diffuse_opacity", Bind::Image(self.tf_diffuse_opacity)),
-            ("tf_specular_roughness", Bind::Image(self.tf_specular_roughness)),
+            (
+                "tf_specular_roughness",
+                Bind::Image(self.tf_specular_roughness),
+            ),
             ("tf_emissive", Bind::Image(self.tf_emissive)),
             ("majorant_grid", Bind::ImageNearest(self.majorant)),
         ]

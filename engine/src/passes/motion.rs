@@ -40,7 +40,10 @@ impl Motion {
         frame.add_pass(
             "motion",
             |b| {
-                b.uniform(uniforms).read(first_hit).read(feature_position).write(motion);
+                b.uniform(uniforms)
+                    .read(first_hit)
+                    .read(feature_position)
+                    .write(motion);
             },
             move |pc| {
                 let binds = [

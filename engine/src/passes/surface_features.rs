@@ -57,7 +57,9 @@ impl SurfaceFeatures {
             "surface_features",
             |b| {
                 scene.declare_volume(b);
-                b.write(out.position.cur).write(out.normal).write(out.albedo);
+                b.write(out.position.cur)
+                    .write(out.normal)
+                    .write(out.albedo);
             },
             move |pc| {
                 let mut binds = scene.volume_binds();

@@ -51,7 +51,7 @@ impl Default for RenderSettings {
             size: Extent {
                 width: 256,
                 height: 256,
-                },
+            },
             spp: 2,
             max_bounces: 8,
             rr_depth: 3,
@@ -248,7 +248,10 @@ impl Renderer {
     }
 
     pub fn denoiser_names(&self) -> Vec<String> {
-        self.denoisers.iter().map(|d| d.name().to_string()).collect()
+        self.denoisers
+            .iter()
+            .map(|d| d.name().to_string())
+            .collect()
     }
 
     fn uniforms(&self, inputs: &FrameInputs, majorant_max: f32) -> FrameUniforms {
@@ -285,7 +288,12 @@ impl Renderer {
                 s.spp as i32,
                 s.max_bounces as i32,
             ),
-            params: Vec4::new(voxel * s.step_voxels, s.hg_g, s.feature_threshold, s.filter_sigma),
+            params: Vec4::new(
+                voxel * s.step_voxels,
+                s.hg_g,
+                s.feature_threshold,
+                s.filter_sigma,
+            ),
             seeds: glam::UVec4::new(s.seed, 0, s.rr_depth, s.size.width),
             lights,
         }
@@ -293,7 +301,11 @@ impl Renderer {
 
     /// Renders one frame of the animation: the noisy path-traced frame once, then every
     /// denoiser on that same input.
-    pub fn frame(&mut self, inputs: &FrameInputs, request: &FrameRequest) -> Result<Option<FrameResult>> {
+    pub fn frame(
+        &mut self,
+        inputs: &FrameInputs,
+        request: &FrameRequest,
+    ) -> Result<Option<FrameResult>> {
         let slot_index = (self.frame_index % SLOTS as u64) as usize;
         let completed = self.wait_slot(slot_index)?;
 
@@ -310,7 +322,12 @@ impl Renderer {
         // Transfer function and majorant grid, re-uploaded only when the TF changes.
         let majorants = scene_gpu::majorants(
             &self.bricks,
-            &inputs.lut.diffuse_opacity.iter().map(|c| c[3]).collect::<Vec<_>>(),
+            &inputs
+                .lut
+                .diffuse_opacity
+                .iter()
+                .map(|c| c[3])
+                .collect::<Vec<_>>(),
             self.settings.density_scale,
         );
         let majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
@@ -326,17 +343,47 @@ impl Renderer {
                     ),
                 });
             }
-            scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_diffuse", a, bytemuck::cast_slice(&inputs.lut.diffuse_opacity))?;
-            scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_specular", b, bytemuck::cast_slice(&inputs.lut.specular_roughness))?;
-            scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_emissive", c, bytemuck::cast_slice(&inputs.lut.emissive))?;
-            scene_gpu::add_upload(ctx, graph, &mut frame, "upload_majorant", self.scene.majorant, bytemuck::cast_slice(&majorants))?;
+            scene_gpu::add_upload(
+                ctx,
+                graph,
+                &mut frame,
+                "upload_tf_diffuse",
+                a,
+                bytemuck::cast_slice(&inputs.lut.diffuse_opacity),
+            )?;
+            scene_gpu::add_upload(
+                ctx,
+                graph,
+                &mut frame,
+                "upload_tf_specular",
+                b,
+                bytemuck::cast_slice(&inputs.lut.specular_roughness),
+            )?;
+            scene_gpu::add_upload(
+                ctx,
+                graph,
+                &mut frame,
+                "upload_tf_emissive",
+                c,
+                bytemuck::cast_slice(&inputs.lut.emissive),
+            )?;
+            scene_gpu::add_upload(
+                ctx,
+                graph,
+                &mut frame,
+                "upload_majorant",
+                self.scene.majorant,
+                bytemuck::cast_slice(&majorants),
+            )?;
         }
 
         // Frame uniforms for this slot.
         let uniforms = self.uniforms(inputs, majorant_max);
         let slot = &self.slots[slot_index];
         let ubo = slot.uniforms;
-        self.graph.buffer_mut(ubo).write(bytemuck::bytes_of(&uniforms))?;
+        self.graph
+            .buffer_mut(ubo)
+            .write(bytemuck::bytes_of(&uniforms))?;
         let graph = &mut self.graph;
         let scene = SceneBindings {
             uniforms: ubo,
@@ -349,12 +396,28 @@ impl Renderer {
         };
 
         // The frame: features → path trace → motion → denoisers.
-        let features = self.passes.features.add(ctx, graph, &mut frame, &scene, size)?;
+        let features = self
+            .passes
+            .features
+            .add(ctx, graph, &mut frame, &scene, size)?;
         let noisy = self.passes.path_trace.add(
-            ctx, graph, &mut frame, "path_trace", &scene, size, 0, self.settings.spp,
+            ctx,
+            graph,
+            &mut frame,
+            "path_trace",
+            &scene,
+            size,
+            0,
+            self.settings.spp,
         )?;
         let motion = self.passes.motion.add(
-            ctx, graph, &mut frame, ubo, noisy.first_hit.cur, features.position.cur, size,
+            ctx,
+            graph,
+            &mut frame,
+            ubo,
+            noisy.first_hit.cur,
+            features.position.cur,
+            size,
         )?;
         let input = DenoiseInputs {
             uniforms: ubo,
@@ -415,12 +478,14 @@ impl Renderer {
         let timings = slot.timestamps.read(&self.ctx)?;
         let mut images = Vec::new();
         for (name, buffer) in readbacks {
-            let bytes = self.graph.buffer_ref(buffer).mapped().ok_or_else(|| {
-                EngineError::Resource {
-                    resource: name.clone(),
-                    problem: "readback buffer is not host visible".into(),
-                }
-            })?;
+            let bytes =
+                self.graph
+                    .buffer_ref(buffer)
+                    .mapped()
+                    .ok_or_else(|| EngineError::Resource {
+                        resource: name.clone(),
+                        problem: "readback buffer is not host visible".into(),
+                    })?;
             images.push((name, bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec()));
         }
         Ok(Some(FrameResult {
@@ -445,7 +510,12 @@ impl Renderer {
 
     /// Renders a high-sample reference of one animation frame: `spp` samples accumulated
     /// in batches of `batch`, independent of the per-frame noise stream.
-    pub fn reference(&mut self, inputs: &FrameInputs, spp: u32, batch: u32) -> Result<Vec<[f32; 4]>> {
+    pub fn reference(
+        &mut self,
+        inputs: &FrameInputs,
+        spp: u32,
+        batch: u32,
+    ) -> Result<Vec<[f32; 4]>> {
         self.flush()?;
         let batch = batch.clamp(1, spp.max(1));
         self.graph.reset_history("reference.");
@@ -454,7 +524,12 @@ impl Renderer {
         // Upload the TF/majorant through a normal frame first, so the scene state matches.
         let majorants = scene_gpu::majorants(
             &self.bricks,
-            &inputs.lut.diffuse_opacity.iter().map(|c| c[3]).collect::<Vec<_>>(),
+            &inputs
+                .lut
+                .diffuse_opacity
+                .iter()
+                .map(|c| c[3])
+                .collect::<Vec<_>>(),
             self.settings.density_scale,
         );
         let majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
@@ -470,10 +545,38 @@ impl Renderer {
             let mut frame = Frame::new();
             if self.current_lut.as_ref() != Some(&inputs.lut) {
                 let [a, b, c] = self.scene.tf;
-                scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_diffuse", a, bytemuck::cast_slice(&inputs.lut.diffuse_opacity))?;
-                scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_specular", b, bytemuck::cast_slice(&inputs.lut.specular_roughness))?;
-                scene_gpu::add_upload(ctx, graph, &mut frame, "upload_tf_emissive", c, bytemuck::cast_slice(&inputs.lut.emissive))?;
-                scene_gpu::add_upload(ctx, graph, &mut frame, "upload_majorant", self.scene.majorant, bytemuck::cast_slice(&majorants))?;
+                scene_gpu::add_upload(
+                    ctx,
+                    graph,
+                    &mut frame,
+                    "upload_tf_diffuse",
+                    a,
+                    bytemuck::cast_slice(&inputs.lut.diffuse_opacity),
+                )?;
+                scene_gpu::add_upload(
+                    ctx,
+                    graph,
+                    &mut frame,
+                    "upload_tf_specular",
+                    b,
+                    bytemuck::cast_slice(&inputs.lut.specular_roughness),
+                )?;
+                scene_gpu::add_upload(
+                    ctx,
+                    graph,
+                    &mut frame,
+                    "upload_tf_emissive",
+                    c,
+                    bytemuck::cast_slice(&inputs.lut.emissive),
+                )?;
+                scene_gpu::add_upload(
+                    ctx,
+                    graph,
+                    &mut frame,
+                    "upload_majorant",
+                    self.scene.majorant,
+                    bytemuck::cast_slice(&majorants),
+                )?;
                 self.current_lut = Some(inputs.lut.clone());
             }
             let scene = SceneBindings {
@@ -487,24 +590,48 @@ impl Renderer {
             };
             let size = self.settings.size;
             let batch_out = self.passes.path_trace.add(
-                ctx, graph, &mut frame, "reference.path_trace", &scene, size, done, n,
+                ctx,
+                graph,
+                &mut frame,
+                "reference.path_trace",
+                &scene,
+                size,
+                done,
+                n,
             )?;
             let mean = self.passes.accumulate.add(
-                ctx, graph, &mut frame, "reference.accumulate", batch_out.radiance, n as f32, size,
+                ctx,
+                graph,
+                &mut frame,
+                "reference.accumulate",
+                batch_out.radiance,
+                n as f32,
+                size,
             )?;
             done += n;
             let readbacks = if done >= spp {
-                add_readbacks(ctx, graph, &mut frame, 0, &[("reference".to_string(), mean)], size)?
+                add_readbacks(
+                    ctx,
+                    graph,
+                    &mut frame,
+                    0,
+                    &[("reference".to_string(), mean)],
+                    size,
+                )?
             } else {
                 Vec::new()
             };
             ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, frame))?;
             graph.end_frame();
             if let Some((_, buffer)) = readbacks.first() {
-                let bytes = graph.buffer_ref(*buffer).mapped().ok_or_else(|| EngineError::Resource {
-                    resource: "reference readback".into(),
-                    problem: "not host visible".into(),
-                })?;
+                let bytes =
+                    graph
+                        .buffer_ref(*buffer)
+                        .mapped()
+                        .ok_or_else(|| EngineError::Resource {
+                            resource: "reference readback".into(),
+                            problem: "not host visible".into(),
+                        })?;
                 image = bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec();
             }
         }
@@ -523,7 +650,12 @@ fn add_readbacks<'f>(
     let bytes = size.width as u64 * size.height as u64 * 16;
     let mut out = Vec::new();
     for (name, image) in outputs {
-        let buffer = graph.buffer(ctx, &format!("readback.{name}.{slot}"), bytes, MemoryLocation::GpuToCpu)?;
+        let buffer = graph.buffer(
+            ctx,
+            &format!("readback.{name}.{slot}"),
+            bytes,
+            MemoryLocation::GpuToCpu,
+        )?;
         let image = *image;
         frame.add_pass(
             format!("readback_{name}"),
@@ -546,7 +678,8 @@ fn submit(ctx: &GpuContext, graph: &mut RenderGraph, slot: &mut Slot, frame: Fra
             .vk("vkResetCommandBuffer")?;
         d.begin_command_buffer(
             slot.cmd,
-            &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
+            &vk::CommandBufferBeginInfo::default()
+                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
         )
         .vk("vkBeginCommandBuffer")?;
     }
@@ -556,7 +689,8 @@ fn submit(ctx: &GpuContext, graph: &mut RenderGraph, slot: &mut Slot, frame: Fra
         d.end_command_buffer(slot.cmd).vk("vkEndCommandBuffer")?;
         let cmds = [slot.cmd];
         let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
-        d.queue_submit(ctx.queue, &submit, slot.fence).vk("vkQueueSubmit")?;
+        d.queue_submit(ctx.queue, &submit, slot.fence)
+            .vk("vkQueueSubmit")?;
     }
     Ok(())
 }

@@ -110,10 +110,19 @@ pub fn check_volume_fits(ctx: &GpuContext, v: &VolumeUpload) -> Result<()> {
     if needed != v.bytes.len() as u64 {
         return Err(EngineError::Resource {
             resource: v.name.clone(),
-            problem: format!("{} bytes for {:?} voxels of {:?}", v.bytes.len(), v.dims, v.format),
+            problem: format!(
+                "{} bytes for {:?} voxels of {:?}",
+                v.bytes.len(),
+                v.dims,
+                v.format
+            ),
         });
     }
-    if let Some(&d) = v.dims.iter().find(|&&d| d > ctx.info.max_image_dimension_3d) {
+    if let Some(&d) = v
+        .dims
+        .iter()
+        .find(|&&d| d > ctx.info.max_image_dimension_3d)
+    {
         return Err(EngineError::TooLarge {
             what: format!("volume {:?}: dimension {d}", v.name),
             needed: d as u64,
@@ -143,7 +152,11 @@ pub fn create<'f>(
     lut_size: u32,
 ) -> Result<SceneImages> {
     check_volume_fits(ctx, volume)?;
-    let vol = graph.image(ctx, "scene.volume", ImageDesc::d3(volume.dims, volume.format.vk()))?;
+    let vol = graph.image(
+        ctx,
+        "scene.volume",
+        ImageDesc::d3(volume.dims, volume.format.vk()),
+    )?;
     add_upload(ctx, graph, frame, "upload_volume", vol, &volume.bytes)?;
     let lut_desc = ImageDesc::d1(lut_size, vk::Format::R32G32B32A32_SFLOAT);
     let tf = [
@@ -163,7 +176,14 @@ pub fn create<'f>(
                 "scene.environment",
                 ImageDesc::d2(e.width, e.height, vk::Format::R32G32B32A32_SFLOAT),
             )?;
-            add_upload(ctx, graph, frame, "upload_environment", h, bytemuck::cast_slice(&e.rgba))?;
+            add_upload(
+                ctx,
+                graph,
+                frame,
+                "upload_environment",
+                h,
+                bytemuck::cast_slice(&e.rgba),
+            )?;
             h
         }
         None => {
@@ -172,7 +192,14 @@ pub fn create<'f>(
                 "scene.environment",
                 ImageDesc::d2(1, 1, vk::Format::R32G32B32A32_SFLOAT),
             )?;
-            add_upload(ctx, graph, frame, "upload_environment", h, bytemuck::cast_slice(&[[0f32; 4]]))?;
+            add_upload(
+                ctx,
+                graph,
+                frame,
+                "upload_environment",
+                h,
+                bytemuck::cast_slice(&[[0f32; 4]]),
+            )?;
             h
         }
     };
@@ -197,7 +224,9 @@ pub fn majorants(bricks: &BrickRanges, opacity: &[f32], density_scale: f32) -> V
     let mut span = 1;
     while span * 2 <= n {
         let prev = &table[table.len() - 1];
-        let next: Vec<f32> = (0..=n - span * 2).map(|i| prev[i].max(prev[i + span])).collect();
+        let next: Vec<f32> = (0..=n - span * 2)
+            .map(|i| prev[i].max(prev[i + span]))
+            .collect();
         table.push(next);
         span *= 2;
     }
@@ -239,11 +268,19 @@ mod tests {
                 let i = x.floor() as usize;
                 let f = x - i as f32;
                 let v = opacity[i] * (1.0 - f) + opacity[(i + 1).min(255)] * f;
-                assert!(v * 2.0 <= m[k] + 1e-6, "brick {k} density {d}: {v} > {}", m[k]);
+                assert!(
+                    v * 2.0 <= m[k] + 1e-6,
+                    "brick {k} density {d}: {v} > {}",
+                    m[k]
+                );
             }
         }
         // Tight for a constant range.
-        let flat = BrickRanges { grid: [1, 1, 1], min: vec![0.5], max: vec![0.5] };
+        let flat = BrickRanges {
+            grid: [1, 1, 1],
+            min: vec![0.5],
+            max: vec![0.5],
+        };
         let c = majorants(&flat, &vec![0.25; 256], 4.0);
         assert!((c[0] - 1.0).abs() < 1e-6);
     }

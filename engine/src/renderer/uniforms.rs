@@ -3,7 +3,7 @@
 //! field offset here with the offsets SPIR-V reflection reads from the compiled shaders.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, UVec4, IVec4, Vec4};
+use glam::{IVec4, Mat4, UVec4, Vec4};
 
 /// Mirrors `frame.glsl`'s MAX_LIGHTS.
 pub const MAX_LIGHTS: usize = 4;
@@ -108,54 +108,104 @@ macro_rules! field_offsets {
 }
 
 /// (shader, block name or "push", size, field offsets) for every mirrored block.
-pub fn mirrored_layouts() -> Vec<(&'static str, &'static str, usize, Vec<(&'static str, usize)>)> {
+/// A mirrored block: shader, block name (or "push"), Rust size, Rust field offsets.
+pub type MirroredLayout = (
+    &'static str,
+    &'static str,
+    usize,
+    Vec<(&'static str, usize)>,
+);
+
+pub fn mirrored_layouts() -> Vec<MirroredLayout> {
     vec![
         (
             "path_trace",
             "FrameBlock",
             std::mem::size_of::<FrameUniforms>(),
             field_offsets!(FrameUniforms {
-                view_proj, inv_view_proj, prev_view_proj, camera_pos, box_min, box_max, dims,
-                counts, params, seeds, lights
+                view_proj,
+                inv_view_proj,
+                prev_view_proj,
+                camera_pos,
+                box_min,
+                box_max,
+                dims,
+                counts,
+                params,
+                seeds,
+                lights
             }),
         ),
         (
             "path_trace",
             "push",
             std::mem::size_of::<PathTracePush>(),
-            field_offsets!(PathTracePush { sample_offset, spp, width, height }),
+            field_offsets!(PathTracePush {
+                sample_offset,
+                spp,
+                width,
+                height
+            }),
         ),
         (
             "surface_features",
             "push",
             std::mem::size_of::<FeaturesPush>(),
-            field_offsets!(FeaturesPush { width, height, step_voxels, pad }),
+            field_offsets!(FeaturesPush {
+                width,
+                height,
+                step_voxels,
+                pad
+            }),
         ),
         (
             "motion",
             "push",
             std::mem::size_of::<MotionPush>(),
-            field_offsets!(MotionPush { width, height, pad0, pad1 }),
+            field_offsets!(MotionPush {
+                width,
+                height,
+                pad0,
+                pad1
+            }),
         ),
         (
             "accumulate",
             "push",
             std::mem::size_of::<AccumulatePush>(),
-            field_offsets!(AccumulatePush { width, height, history_valid, weight }),
+            field_offsets!(AccumulatePush {
+                width,
+                height,
+                history_valid,
+                weight
+            }),
         ),
         (
             "wrls_update",
             "push",
             std::mem::size_of::<WrlsUpdatePush>(),
             field_offsets!(WrlsUpdatePush {
-                camera, width, height, history_valid, lambda, alpha, h, delta, tolerance
+                camera,
+                width,
+                height,
+                history_valid,
+                lambda,
+                alpha,
+                h,
+                delta,
+                tolerance
             }),
         ),
         (
             "wrls_spatial",
             "push",
             std::mem::size_of::<WrlsSpatialPush>(),
-            field_offsets!(WrlsSpatialPush { width, height, sigma_spatial, sigma_range }),
+            field_offsets!(WrlsSpatialPush {
+                width,
+                height,
+                sigma_spatial,
+                sigma_range
+            }),
         ),
     ]
 }
@@ -176,15 +226,32 @@ mod tests {
                 );
                 r.push_constants.clone().expect("shader has push constants")
             } else {
-                let m = r.blocks.get(block).unwrap_or_else(|| panic!("{shader} has no block {block}"));
-                let end = m.iter().map(|m| (m.offset + m.size) as usize).max().unwrap_or(0);
-                assert_eq!(end, size, "{shader}: {block} size differs from the Rust mirror");
+                let m = r
+                    .blocks
+                    .get(block)
+                    .unwrap_or_else(|| panic!("{shader} has no block {block}"));
+                let end = m
+                    .iter()
+                    .map(|m| (m.offset + m.size) as usize)
+                    .max()
+                    .unwrap_or(0);
+                assert_eq!(
+                    end, size,
+                    "{shader}: {block} size differs from the Rust mirror"
+                );
                 m.clone()
             };
-            assert_eq!(members.len(), fields.len(), "{shader}: {block} member count");
+            assert_eq!(
+                members.len(),
+                fields.len(),
+                "{shader}: {block} member count"
+            );
             for (m, (name, offset)) in members.iter().zip(&fields) {
                 assert_eq!(&m.name, name, "{shader}: {block} member order");
-                assert_eq!(m.offset as usize, *offset, "{shader}: {block}.{name} offset");
+                assert_eq!(
+                    m.offset as usize, *offset,
+                    "{shader}: {block}.{name} offset"
+                );
             }
         }
     }

@@ -33,7 +33,10 @@ pub fn compile_dir(src_dir: &Path, out_dir: &Path) -> Result<Vec<Compiled>, Stri
     options.set_include_callback(move |requested, _ty, requester, _depth| {
         let path = inc.join(requested);
         let content = fs::read_to_string(&path).map_err(|e| {
-            format!("{requester}: cannot include {requested} ({}): {e}", path.display())
+            format!(
+                "{requester}: cannot include {requested} ({}): {e}",
+                path.display()
+            )
         })?;
         Ok(shaderc::ResolvedInclude {
             resolved_name: path.display().to_string(),
@@ -74,10 +77,16 @@ pub fn compile_dir(src_dir: &Path, out_dir: &Path) -> Result<Vec<Compiled>, Stri
 
 /// Rust source embedding the compiled shaders: `pub static SHADERS: &[(&str, &[u8])]`.
 pub fn embed_rs(compiled: &[Compiled]) -> String {
-    let mut s = String::from("/// Every compute shader, compiled at build time: (name, SPIR-V bytes).\n");
+    let mut s =
+        String::from("/// Every compute shader, compiled at build time: (name, SPIR-V bytes).\n");
     s.push_str("pub static SHADERS: &[(&str, &[u8])] = &[\n");
     for c in compiled {
-        let _ = writeln!(s, "    ({:?}, include_bytes!({:?})),", c.name, c.spv.display().to_string());
+        let _ = writeln!(
+            s,
+            "    ({:?}, include_bytes!({:?})),",
+            c.name,
+            c.spv.display().to_string()
+        );
     }
     s.push_str("];\n");
     s
