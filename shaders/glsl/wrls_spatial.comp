@@ -7,7 +7,7 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 0, rgba32f) uniform readonly image2D z;
+layout(binding = 0, rgba32f) uniform readonly image2D z;  // this frame's temporal feature
 layout(binding = 1, rgba32f) uniform readonly image2D beta_r;
 layout(binding = 2, rgba32f) uniform readonly image2D beta_g;
 layout(binding = 3, rgba32f) uniform readonly image2D beta_b;

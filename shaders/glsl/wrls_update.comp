@@ -36,6 +36,10 @@ layout(push_constant) uniform WrlsUpdatePush {
     float h;              // weight bandwidth (0.75)
     float delta;          // initial P = delta · I
     float tolerance;      // disocclusion tolerance, relative to camera distance
+    float lambda_min;     // forgetting factor during a detected change
+    float change_ratio;   // residual / noise-level ratio that counts as a change
+    float pad0;
+    float pad1;
 } pc;
 
 const float P_MAX = 1e6;
@@ -57,20 +61,28 @@ void main() {
 
     Reprojection r = reproject(p, size, pc.history_valid != 0u, pc.camera.xyz, pc.tolerance);
     vec3 z;
+    vec3 z_hist;
     vec4 beta[3];
     mat4 P;
     float age;
+    float noise_level = -1.0;  // running mean of the squared a-priori residual
+    float streak = 0.0;        // consecutive frames far above the noise level
     if (r.valid) {
         vec4 zq = texture(z_prev, r.uv);
-        z = pc.alpha * clamp(zq.rgb, lo, hi) + (1.0 - pc.alpha) * I;
+        z_hist = clamp(zq.rgb, lo, hi);
+        z = pc.alpha * z_hist + (1.0 - pc.alpha) * I;
         age = zq.w + 1.0;
         beta[0] = texture(beta_r_prev, r.uv);
         beta[1] = texture(beta_g_prev, r.uv);
         beta[2] = texture(beta_b_prev, r.uv);
-        P = unpack_p(texture(p0_prev, r.uv), texture(p1_prev, r.uv), texture(p2_prev, r.uv));
+        vec4 p2 = texture(p2_prev, r.uv);
+        P = unpack_p(texture(p0_prev, r.uv), texture(p1_prev, r.uv), p2);
+        noise_level = p2.z;
+        streak = p2.w;
     } else {
         // A new surface: start the models over.
         z = I;
+        z_hist = I;
         age = 1.0;
         beta[0] = vec4(0.0);
         beta[1] = vec4(0.0);
@@ -79,19 +91,28 @@ void main() {
         if (!USE_FEATURE) P = mat4(pc.delta, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0);
     }
 
-    vec4 x = predictor(z);
+    vec3 feature = PAPER_PREDICTOR ? z : z_hist;
+    vec4 x = predictor(feature);
     float w = 1.0;
     if (WEIGHTED) {
-        float d = length(I - z) / (min(length(I), length(z)) + 1e-4);
+        float d = length(I - feature) / (min(length(I), length(feature)) + 1e-4);
         w = max(exp(-(d * d) / (pc.h * pc.h)), 1e-6);
     }
-    vec4 Px = P * x;
-    vec4 q = Px / (pc.lambda / w + dot(x, Px));
-    for (int c = 0; c < 3; ++c) {
-        float e = I[c] - dot(x, beta[c]);
-        beta[c] += q * e;
+    vec3 e = I - vec3(dot(x, beta[0]), dot(x, beta[1]), dot(x, beta[2]));
+    float r2 = dot(e, e);
+    float lambda = pc.lambda;
+    if (ADAPTIVE_LAMBDA) {
+        if (noise_level < 0.0) noise_level = r2;
+        bool far = r2 > pc.change_ratio * (noise_level + 1e-6);
+        streak = far ? streak + 1.0 : 0.0;
+        if (streak >= 2.0) lambda = pc.lambda_min;
+        // Spikes barely move the noise level; ordinary residuals track it.
+        noise_level = mix(noise_level, r2, far ? 0.02 : 0.1);
     }
-    P = (P - outerProduct(q, Px)) / pc.lambda;
+    vec4 Px = P * x;
+    vec4 q = Px / (lambda / w + dot(x, Px));
+    for (int c = 0; c < 3; ++c) beta[c] += q * e[c];
+    P = (P - outerProduct(q, Px)) / lambda;
     // fp32 hygiene: keep P symmetric with a positive, bounded diagonal (wind-up guard
     // for predictors that stop exciting some direction on long static runs).
     P = 0.5 * (P + transpose(P));
@@ -109,6 +130,8 @@ void main() {
     }
     vec4 a, b, c;
     pack_p(P, a, b, c);
+    c.z = noise_level;
+    c.w = streak;
     imageStore(z_cur, p, vec4(z, age));
     imageStore(beta_r_cur, p, beta[0]);
     imageStore(beta_g_cur, p, beta[1]);

@@ -118,3 +118,5 @@ pub fn assert_validation_clean() {
         msgs.join("\n")
     );
 }
+
+pub mod harness;

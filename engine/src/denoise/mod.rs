@@ -65,7 +65,16 @@ pub trait Denoiser {
 }
 
 /// Names accepted by `--denoiser`.
-pub const NAMES: &[&str] = &["none", "accum", "ours", "rls", "wrls-nf", "rls-nf"];
+pub const NAMES: &[&str] = &[
+    "none",
+    "accum",
+    "ours",
+    "ours-fixed-lambda",
+    "wrls-paper",
+    "rls",
+    "wrls-nf",
+    "rls-nf",
+];
 
 /// Builds a denoiser by name.
 pub fn create(ctx: &GpuContext, name: &str) -> Result<Box<dyn Denoiser>> {
@@ -73,10 +82,10 @@ pub fn create(ctx: &GpuContext, name: &str) -> Result<Box<dyn Denoiser>> {
         "none" => Box::new(Passthrough),
         "accum" => Box::new(Accum::new(ctx)?),
         n if WrlsVariant::from_name(n).is_some() => {
-            let variant = WrlsVariant::from_name(n).unwrap_or(WrlsVariant {
-                weighted: true,
-                feature: true,
-            });
+            let variant = WrlsVariant::from_name(n).ok_or_else(|| EngineError::Pass {
+                pass: "denoise".into(),
+                problem: format!("unknown wRLS variant {n:?}"),
+            })?;
             Box::new(Wrls::new(ctx, n, variant, 0)?)
         }
         other => {

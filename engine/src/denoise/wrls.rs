@@ -22,6 +22,10 @@ pub struct WrlsParams {
     pub tolerance: f32,
     pub sigma_spatial: f32,
     pub sigma_range: f32,
+    /// Forgetting factor while a change is detected (adaptive λ only).
+    pub lambda_min: f32,
+    /// Squared a-priori residual over its running noise level that counts as a change.
+    pub change_ratio: f32,
 }
 
 impl Default for WrlsParams {
@@ -34,35 +38,54 @@ impl Default for WrlsParams {
             tolerance: 0.05,
             sigma_spatial: 2.0,
             sigma_range: 0.5,
+            lambda_min: 0.5,
+            change_ratio: 9.0,
         }
     }
 }
 
-/// Which of the paper's variants.
+/// Which variant: the paper's ablation switches (weighting, temporal feature) and our
+/// two changes to it (predictor from the reprojected history, automatic forgetting).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct WrlsVariant {
     pub weighted: bool,
     pub feature: bool,
+    /// The paper's exact predictor p = [1, z(t)] (z contains this frame's noisy colour).
+    pub paper_predictor: bool,
+    pub adaptive_lambda: bool,
 }
 
 impl WrlsVariant {
     pub fn from_name(name: &str) -> Option<Self> {
+        let ours = Self {
+            weighted: true,
+            feature: true,
+            paper_predictor: false,
+            adaptive_lambda: true,
+        };
         Some(match name {
-            "ours" => Self {
-                weighted: true,
-                feature: true,
+            "ours" => ours,
+            "ours-fixed-lambda" => Self {
+                adaptive_lambda: false,
+                ..ours
+            },
+            "wrls-paper" => Self {
+                paper_predictor: true,
+                adaptive_lambda: false,
+                ..ours
             },
             "rls" => Self {
                 weighted: false,
-                feature: true,
+                ..ours
             },
             "wrls-nf" => Self {
-                weighted: true,
                 feature: false,
+                ..ours
             },
             "rls-nf" => Self {
                 weighted: false,
                 feature: false,
+                ..ours
             },
             _ => return None,
         })
@@ -89,6 +112,8 @@ impl Wrls {
             ("WEIGHTED", SpecValue::Bool(variant.weighted)),
             ("USE_FEATURE", SpecValue::Bool(variant.feature)),
             ("MOTION_SOURCE", SpecValue::I32(motion_source)),
+            ("PAPER_PREDICTOR", SpecValue::Bool(variant.paper_predictor)),
+            ("ADAPTIVE_LAMBDA", SpecValue::Bool(variant.adaptive_lambda)),
         ];
         Ok(Self {
             name: name.to_string(),
@@ -144,6 +169,10 @@ impl Denoiser for Wrls {
             h: p.h,
             delta: p.delta,
             tolerance: p.tolerance,
+            lambda_min: p.lambda_min,
+            change_ratio: p.change_ratio,
+            pad0: 0.0,
+            pad1: 0.0,
         };
         let noisy = input.noisy;
         let motion = input.motion;

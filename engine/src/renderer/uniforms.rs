@@ -88,6 +88,10 @@ pub struct WrlsUpdatePush {
     pub h: f32,
     pub delta: f32,
     pub tolerance: f32,
+    pub lambda_min: f32,
+    pub change_ratio: f32,
+    pub pad0: f32,
+    pub pad1: f32,
 }
 
 #[repr(C)]

@@ -8,6 +8,17 @@
 // temporal feature in the predictor or not (p = [1]).
 layout(constant_id = 9) const bool WEIGHTED = true;
 layout(constant_id = 10) const bool USE_FEATURE = true;
+// The paper builds the predictor from z(t), which contains this frame's noisy colour, the
+// regression target itself; the fitted coefficient on z then tends to 1 + α and the
+// output keeps (amplified) single-frame noise. `ours` fits against the reprojected,
+// clamped history Ψ[z_q(t−1), Ĩ(t)] instead (uncorrelated with this frame's noise), so
+// static regions converge like a long average. PAPER_PREDICTOR = true restores the
+// paper's exact formulation for comparison (`wrls-paper`).
+layout(constant_id = 11) const bool PAPER_PREDICTOR = false;
+// Per-pixel automatic forgetting (beyond the paper): when the a-priori residual stays far
+// above its running noise level for consecutive frames (a light/TF change, not a single
+// spike), the model forgets fast (λ_min) until it has caught up.
+layout(constant_id = 12) const bool ADAPTIVE_LAMBDA = true;
 
 mat4 unpack_p(vec4 a, vec4 b, vec4 c) {
     return mat4(

@@ -1,0 +1,116 @@
+//! Denoiser properties on synthetic input (static scene, exact control over the noisy
+//! frames): no NaN/Inf and bounded output over a long static run (P wind-up), wRLS's
+//! robustness to spikes compared with plain RLS, and convergence on a static input.
+
+mod common;
+
+use common::harness::{noisy_frame, Harness};
+use common::*;
+
+const W: u32 = 16;
+const H: u32 = 16;
+
+fn finite_and_bounded(out: &[[f32; 4]], bound: f32) -> bool {
+    out.iter().all(|p| {
+        p[..3]
+            .iter()
+            .all(|c| c.is_finite() && *c >= 0.0 && *c <= bound)
+    })
+}
+
+#[test]
+fn long_static_runs_stay_finite_and_bounded_for_every_temporal_method() {
+    for name in ["ours", "rls", "wrls-nf", "rls-nf", "accum"] {
+        let mut h = Harness::new(name, W, H);
+        let n = (W * H) as usize;
+        for f in 0..2000u64 {
+            let out = h.step(&noisy_frame(n, 1.0, 0.5, f));
+            assert!(
+                finite_and_bounded(&out, 100.0),
+                "{name}: non-finite or unbounded output at frame {f}"
+            );
+        }
+    }
+    assert_validation_clean();
+}
+
+fn spike_response(name: &str) -> f32 {
+    let mut h = Harness::new(name, W, H);
+    let n = (W * H) as usize;
+    let mut before = Vec::new();
+    for f in 0..40u64 {
+        before = h.step(&noisy_frame(n, 1.0, 0.3, f));
+    }
+    let mut spiky = noisy_frame(n, 1.0, 0.3, 40);
+    let spikes = [(3usize, 4usize), (10, 7), (12, 12)];
+    for &(x, y) in &spikes {
+        spiky[y * W as usize + x] = [100.0, 80.0, 60.0, 1.0];
+    }
+    let after = h.step(&spiky);
+    spikes
+        .iter()
+        .map(|&(x, y)| {
+            let i = y * W as usize + x;
+            (after[i][0] - before[i][0]).abs()
+        })
+        .sum::<f32>()
+        / spikes.len() as f32
+}
+
+#[test]
+fn weighted_rls_gives_spikes_far_less_influence_than_rls() {
+    let ours = spike_response("ours");
+    let rls = spike_response("rls");
+    println!("mean output change at 100× spikes: ours {ours:.4}, rls {rls:.4}");
+    assert!(
+        ours * 5.0 < rls,
+        "ours {ours} vs rls {rls}: weighting should suppress spikes"
+    );
+    let ours_nf = spike_response("wrls-nf");
+    let rls_nf = spike_response("rls-nf");
+    println!("without the feature: wrls-nf {ours_nf:.4}, rls-nf {rls_nf:.4}");
+    assert!(ours_nf * 5.0 < rls_nf);
+    assert_validation_clean();
+}
+
+#[test]
+fn ours_converges_on_a_static_input() {
+    let mut h = Harness::new("ours", W, H);
+    let n = (W * H) as usize;
+    let mut out = Vec::new();
+    for f in 0..64u64 {
+        out = h.step(&noisy_frame(n, 1.0, 0.5, 1000 + f));
+    }
+    // Single-frame noise has standard deviation 0.5/√3 ≈ 0.29 in red.
+    let rmse = (out.iter().map(|p| (p[0] - 1.0).powi(2)).sum::<f32>() / n as f32).sqrt();
+    println!("ours after 64 static frames: RMSE {rmse:.4} (input 0.289)");
+    assert!(rmse < 0.289 / 4.0, "RMSE {rmse}");
+    assert_validation_clean();
+}
+
+/// Frames after a step in the input (mean 1 → 3) until the output's mean is within 5%.
+fn step_recovery(name: &str) -> usize {
+    let mut h = Harness::new(name, W, H);
+    let n = (W * H) as usize;
+    for f in 0..60u64 {
+        h.step(&noisy_frame(n, 1.0, 0.5, 2000 + f));
+    }
+    for k in 0..200usize {
+        let out = h.step(&noisy_frame(n, 3.0, 1.5, 3000 + k as u64));
+        let mean = out.iter().map(|p| p[0]).sum::<f32>() / n as f32;
+        if (mean - 3.0).abs() < 0.15 {
+            return k + 1;
+        }
+    }
+    usize::MAX
+}
+
+#[test]
+fn ours_follows_a_sudden_change_within_a_few_frames() {
+    let ours = step_recovery("ours");
+    let fixed = step_recovery("ours-fixed-lambda");
+    let paper = step_recovery("wrls-paper");
+    println!("frames to within 5% after a 3× step: ours {ours}, fixed λ {fixed}, paper {paper}");
+    assert!(ours <= 8, "ours took {ours} frames");
+    assert_validation_clean();
+}

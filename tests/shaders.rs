@@ -1,0 +1,43 @@
+//! Every embedded SPIR-V module passes `spirv-val` (SPIRV-Tools, installed by
+//! tools/setup.sh) for Vulkan 1.3, and reflects into bindings the engine can bind.
+
+use dvr_engine::gpu::pipeline::shader_reflection;
+use dvr_engine::shaders::SHADERS;
+use std::process::Command;
+
+#[test]
+fn every_shader_passes_spirv_val() {
+    assert!(!SHADERS.is_empty());
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (name, bytes) in SHADERS {
+        let path = dir.path().join(format!("{name}.spv"));
+        std::fs::write(&path, bytes).expect("write spv");
+        let out = Command::new("spirv-val")
+            .args(["--target-env", "vulkan1.3"])
+            .arg(&path)
+            .output()
+            .expect("spirv-val is installed (apt-get install spirv-tools)");
+        assert!(
+            out.status.success(),
+            "{name}: spirv-val failed:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
+#[test]
+fn every_shader_reflects_named_bindings_in_set_zero() {
+    for (name, _) in SHADERS {
+        let r = shader_reflection(name).expect("reflects");
+        assert!(!r.bindings.is_empty(), "{name} binds nothing");
+        for b in &r.bindings {
+            assert_eq!(b.set, 0, "{name}: {} uses set {}", b.name, b.set);
+            assert!(
+                !b.name.is_empty(),
+                "{name}: binding {} has no name",
+                b.binding
+            );
+        }
+        assert!(r.local_size.iter().product::<u32>() > 0);
+    }
+}
