@@ -1,7 +1,7 @@
 //! `phantom`: a CT-like head for testing the renderer on thin, high-contrast structures.
 //!
 //! Layers from outside in, as signed distance functions evaluated at voxel centres:
-//! air, scalp (soft), an ellipsoidal skull shell (bone, the highest density), brain soft
+//! air, scalp (soft), an ellipsoidal skull shell (bone), brain soft
 //! tissue with a faint smooth texture, two ventricles (fluid, low density), and six
 //! contrast-filled vessels: helical and sinusoidal tubes 1-2 voxels across at any
 //! resolution, running through the soft tissue. The vessels are what a denoiser blurs
@@ -12,10 +12,10 @@ use super::procedural::{centre, coverage, ellipsoid, fill_slices, Waves};
 
 /// Densities of the tissue classes (normalised).
 pub(crate) const SCALP: f32 = 0.32;
-pub(crate) const BONE: f32 = 0.90;
+pub(crate) const BONE: f32 = 0.80;
 pub(crate) const TISSUE: f32 = 0.45;
 pub(crate) const CSF: f32 = 0.14;
-pub(crate) const VESSEL: f32 = 0.72;
+pub(crate) const VESSEL: f32 = 1.0;
 /// Amplitude bound of the soft-tissue texture (sum of the wave amplitudes).
 #[cfg(test)]
 pub(crate) const TEXTURE: f32 = 0.031;
@@ -218,7 +218,11 @@ mod tests {
         let max = (0..a.data.len())
             .filter_map(|i| a.data.get(i))
             .fold(0.0, f32::max);
-        assert!((max - BONE).abs() < 1e-3, "skull is the densest: {max}");
+        // Contrast-filled vessels are the densest class (above bone, as in CT angiography).
+        assert!(
+            (max - VESSEL).abs() < 1e-3 || (max - BONE).abs() < 1e-3,
+            "the densest voxel is vessel or bone: {max}"
+        );
         // A ventricle centre is fluid.
         let (vc, _) = VENTRICLES[0];
         let [x, y, z] = vc.map(|c| ((c + 1.0) / 2.0 * 48.0) as u32);
