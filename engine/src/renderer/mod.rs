@@ -300,107 +300,31 @@ impl Renderer {
     }
 
     /// Renders one frame of the animation: the noisy path-traced frame once, then every
-    /// denoiser on that same input.
+    /// denoiser on that same input. Returns the results of the frame that last used this
+    /// slot (two frames ago), if any.
     pub fn frame(
         &mut self,
         inputs: &FrameInputs,
         request: &FrameRequest,
     ) -> Result<Option<FrameResult>> {
-        let slot_index = (self.frame_index % SLOTS as u64) as usize;
-        let completed = self.wait_slot(slot_index)?;
-
+        let slot = (self.frame_index % SLOTS as u64) as usize;
+        let completed = self.wait_slot(slot)?;
         let changes = self.changes(inputs, request.reset);
         if request.reset {
             self.graph.reset_history("");
         }
-        let tf_changed = self.current_lut.as_ref() != Some(&inputs.lut);
-        let ctx = &self.ctx;
-        let graph = &mut self.graph;
-        let size = self.settings.size;
         let mut frame = Frame::new();
 
-        // Transfer function and majorant grid, re-uploaded only when the TF changes.
-        let majorants = scene_gpu::majorants(
-            &self.bricks,
-            &inputs
-                .lut
-                .diffuse_opacity
-                .iter()
-                .map(|c| c[3])
-                .collect::<Vec<_>>(),
-            self.settings.density_scale,
-        );
-        let majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
-        if tf_changed {
-            let [a, b, c] = self.scene.tf;
-            if inputs.lut.diffuse_opacity.len() != self.lut_size as usize {
-                return Err(EngineError::Resource {
-                    resource: "transfer function".into(),
-                    problem: format!(
-                        "LUT has {} entries, renderer expects {}",
-                        inputs.lut.diffuse_opacity.len(),
-                        self.lut_size
-                    ),
-                });
-            }
-            scene_gpu::add_upload(
-                ctx,
-                graph,
-                &mut frame,
-                "upload_tf_diffuse",
-                a,
-                bytemuck::cast_slice(&inputs.lut.diffuse_opacity),
-            )?;
-            scene_gpu::add_upload(
-                ctx,
-                graph,
-                &mut frame,
-                "upload_tf_specular",
-                b,
-                bytemuck::cast_slice(&inputs.lut.specular_roughness),
-            )?;
-            scene_gpu::add_upload(
-                ctx,
-                graph,
-                &mut frame,
-                "upload_tf_emissive",
-                c,
-                bytemuck::cast_slice(&inputs.lut.emissive),
-            )?;
-            scene_gpu::add_upload(
-                ctx,
-                graph,
-                &mut frame,
-                "upload_majorant",
-                self.scene.majorant,
-                bytemuck::cast_slice(&majorants),
-            )?;
-        }
-
-        // Frame uniforms for this slot.
+        // Scene state: the TF (only when it changed) and this frame's uniforms.
+        let majorant_max = self.upload_transfer_function(&mut frame, &inputs.lut)?;
         let uniforms = self.uniforms(inputs, majorant_max);
-        let slot = &self.slots[slot_index];
-        let ubo = slot.uniforms;
-        self.graph
-            .buffer_mut(ubo)
-            .write(bytemuck::bytes_of(&uniforms))?;
-        let graph = &mut self.graph;
-        let scene = SceneBindings {
-            uniforms: ubo,
-            volume: self.scene.volume,
-            tf_diffuse_opacity: self.scene.tf[0],
-            tf_specular_roughness: self.scene.tf[1],
-            tf_emissive: self.scene.tf[2],
-            majorant: self.scene.majorant,
-            environment: self.scene.environment,
-        };
+        let scene = self.write_uniforms(slot, &uniforms)?;
+        let (ctx, graph, passes, size) =
+            (&self.ctx, &mut self.graph, &self.passes, self.settings.size);
 
-        // The frame: features → path trace → motion → denoisers.
-        let features = self
-            .passes
-            .features
-            .add(ctx, graph, &mut frame, &scene, size)?;
-        let noisy = self.passes.path_trace.add(
+        // features → path trace → motion → each denoiser on the same noisy frame.
+        let features = passes.features.add(ctx, graph, &mut frame, &scene, size)?;
+        let noisy = passes.path_trace.add(
             ctx,
             graph,
             &mut frame,
@@ -410,17 +334,17 @@ impl Renderer {
             0,
             self.settings.spp,
         )?;
-        let motion = self.passes.motion.add(
+        let motion = passes.motion.add(
             ctx,
             graph,
             &mut frame,
-            ubo,
+            scene.uniforms,
             noisy.first_hit.cur,
             features.position.cur,
             size,
         )?;
         let input = DenoiseInputs {
-            uniforms: ubo,
+            uniforms: scene.uniforms,
             noisy: noisy.radiance,
             moments: noisy.moments,
             features,
@@ -433,23 +357,81 @@ impl Renderer {
         };
         let mut outputs: Vec<(String, ImageHandle)> = Vec::new();
         for d in &self.denoisers {
-            let out = d.add(ctx, graph, &mut frame, &input)?;
-            outputs.push((d.name().to_string(), out));
+            outputs.push((d.name().to_string(), d.add(ctx, graph, &mut frame, &input)?));
         }
 
         let readbacks = if request.readback {
-            add_readbacks(ctx, graph, &mut frame, slot_index, &outputs, size)?
+            add_readbacks(ctx, graph, &mut frame, slot, &outputs, size)?
         } else {
             Vec::new()
         };
-        let slot = &mut self.slots[slot_index];
-        submit(ctx, graph, slot, frame)?;
-        slot.pending = Some((self.frame_index, readbacks));
+        submit(ctx, graph, &mut self.slots[slot], frame)?;
+        self.slots[slot].pending = Some((self.frame_index, readbacks));
         self.graph.end_frame();
-        self.current_lut = Some(inputs.lut.clone());
         self.last_inputs = Some(inputs.clone());
         self.frame_index += 1;
         Ok(completed)
+    }
+
+    /// Adds uploads of the TF LUTs and the majorant grid when the TF differs from the one
+    /// on the device; returns the largest extinction (the global majorant).
+    fn upload_transfer_function(&mut self, frame: &mut Frame, lut: &LutUpload) -> Result<f32> {
+        if lut.diffuse_opacity.len() != self.lut_size as usize {
+            return Err(EngineError::Resource {
+                resource: "transfer function".into(),
+                problem: format!(
+                    "LUT has {} entries, renderer expects {}",
+                    lut.diffuse_opacity.len(),
+                    self.lut_size
+                ),
+            });
+        }
+        let opacity: Vec<f32> = lut.diffuse_opacity.iter().map(|c| c[3]).collect();
+        let majorants = scene_gpu::majorants(&self.bricks, &opacity, self.settings.density_scale);
+        let majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
+        if self.current_lut.as_ref() != Some(lut) {
+            let (ctx, graph) = (&self.ctx, &mut self.graph);
+            let [a, b, c] = self.scene.tf;
+            for (name, image, bytes) in [
+                (
+                    "upload_tf_diffuse",
+                    a,
+                    bytemuck::cast_slice(&lut.diffuse_opacity),
+                ),
+                (
+                    "upload_tf_specular",
+                    b,
+                    bytemuck::cast_slice(&lut.specular_roughness),
+                ),
+                ("upload_tf_emissive", c, bytemuck::cast_slice(&lut.emissive)),
+                (
+                    "upload_majorant",
+                    self.scene.majorant,
+                    bytemuck::cast_slice(&majorants),
+                ),
+            ] {
+                scene_gpu::add_upload(ctx, graph, frame, name, image, bytes)?;
+            }
+            self.current_lut = Some(lut.clone());
+        }
+        Ok(majorant_max)
+    }
+
+    /// Writes `uniforms` into slot `slot`'s uniform buffer; returns the scene bindings.
+    fn write_uniforms(&mut self, slot: usize, uniforms: &FrameUniforms) -> Result<SceneBindings> {
+        let ubo = self.slots[slot].uniforms;
+        self.graph
+            .buffer_mut(ubo)
+            .write(bytemuck::bytes_of(uniforms))?;
+        Ok(SceneBindings {
+            uniforms: ubo,
+            volume: self.scene.volume,
+            tf_diffuse_opacity: self.scene.tf[0],
+            tf_specular_roughness: self.scene.tf[1],
+            tf_emissive: self.scene.tf[2],
+            majorant: self.scene.majorant,
+            environment: self.scene.environment,
+        })
     }
 
     fn changes(&self, inputs: &FrameInputs, reset: bool) -> Changes {
@@ -478,15 +460,7 @@ impl Renderer {
         let timings = slot.timestamps.read(&self.ctx)?;
         let mut images = Vec::new();
         for (name, buffer) in readbacks {
-            let bytes =
-                self.graph
-                    .buffer_ref(buffer)
-                    .mapped()
-                    .ok_or_else(|| EngineError::Resource {
-                        resource: name.clone(),
-                        problem: "readback buffer is not host visible".into(),
-                    })?;
-            images.push((name, bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec()));
+            images.push((name, read_pixels(&self.graph, buffer)?));
         }
         Ok(Some(FrameResult {
             index,
@@ -509,7 +483,8 @@ impl Renderer {
     }
 
     /// Renders a high-sample reference of one animation frame: `spp` samples accumulated
-    /// in batches of `batch`, independent of the per-frame noise stream.
+    /// in batches of `batch`, from a sample stream of its own (independent of the
+    /// per-frame noise the denoisers see).
     pub fn reference(
         &mut self,
         inputs: &FrameInputs,
@@ -521,75 +496,16 @@ impl Renderer {
         self.graph.reset_history("reference.");
         let mut done = 0;
         let mut image = Vec::new();
-        // Upload the TF/majorant through a normal frame first, so the scene state matches.
-        let majorants = scene_gpu::majorants(
-            &self.bricks,
-            &inputs
-                .lut
-                .diffuse_opacity
-                .iter()
-                .map(|c| c[3])
-                .collect::<Vec<_>>(),
-            self.settings.density_scale,
-        );
-        let majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
-        let mut uniforms = self.uniforms(inputs, majorant_max);
-        // References draw from their own sample stream: frame index far from any capture.
-        uniforms.counts.y = i32::MAX - self.frame_index as i32;
         while done < spp {
             let n = batch.min(spp - done);
-            let ctx = &self.ctx;
-            let graph = &mut self.graph;
-            let ubo = self.slots[0].uniforms;
-            graph.buffer_mut(ubo).write(bytemuck::bytes_of(&uniforms))?;
             let mut frame = Frame::new();
-            if self.current_lut.as_ref() != Some(&inputs.lut) {
-                let [a, b, c] = self.scene.tf;
-                scene_gpu::add_upload(
-                    ctx,
-                    graph,
-                    &mut frame,
-                    "upload_tf_diffuse",
-                    a,
-                    bytemuck::cast_slice(&inputs.lut.diffuse_opacity),
-                )?;
-                scene_gpu::add_upload(
-                    ctx,
-                    graph,
-                    &mut frame,
-                    "upload_tf_specular",
-                    b,
-                    bytemuck::cast_slice(&inputs.lut.specular_roughness),
-                )?;
-                scene_gpu::add_upload(
-                    ctx,
-                    graph,
-                    &mut frame,
-                    "upload_tf_emissive",
-                    c,
-                    bytemuck::cast_slice(&inputs.lut.emissive),
-                )?;
-                scene_gpu::add_upload(
-                    ctx,
-                    graph,
-                    &mut frame,
-                    "upload_majorant",
-                    self.scene.majorant,
-                    bytemuck::cast_slice(&majorants),
-                )?;
-                self.current_lut = Some(inputs.lut.clone());
-            }
-            let scene = SceneBindings {
-                uniforms: ubo,
-                volume: self.scene.volume,
-                tf_diffuse_opacity: self.scene.tf[0],
-                tf_specular_roughness: self.scene.tf[1],
-                tf_emissive: self.scene.tf[2],
-                majorant: self.scene.majorant,
-                environment: self.scene.environment,
-            };
-            let size = self.settings.size;
-            let batch_out = self.passes.path_trace.add(
+            let majorant_max = self.upload_transfer_function(&mut frame, &inputs.lut)?;
+            let mut uniforms = self.uniforms(inputs, majorant_max);
+            uniforms.counts.y = i32::MAX - self.frame_index as i32;
+            let scene = self.write_uniforms(0, &uniforms)?;
+            let (ctx, graph, passes, size) =
+                (&self.ctx, &mut self.graph, &self.passes, self.settings.size);
+            let batch_out = passes.path_trace.add(
                 ctx,
                 graph,
                 &mut frame,
@@ -599,7 +515,7 @@ impl Renderer {
                 done,
                 n,
             )?;
-            let mean = self.passes.accumulate.add(
+            let mean = passes.accumulate.add(
                 ctx,
                 graph,
                 &mut frame,
@@ -624,19 +540,23 @@ impl Renderer {
             ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, frame))?;
             graph.end_frame();
             if let Some((_, buffer)) = readbacks.first() {
-                let bytes =
-                    graph
-                        .buffer_ref(*buffer)
-                        .mapped()
-                        .ok_or_else(|| EngineError::Resource {
-                            resource: "reference readback".into(),
-                            problem: "not host visible".into(),
-                        })?;
-                image = bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec();
+                image = read_pixels(graph, *buffer)?;
             }
         }
         Ok(image)
     }
+}
+
+/// The rgba32f pixels of a host-visible readback buffer.
+fn read_pixels(graph: &RenderGraph, buffer: BufferHandle) -> Result<Vec<[f32; 4]>> {
+    let bytes = graph
+        .buffer_ref(buffer)
+        .mapped()
+        .ok_or_else(|| EngineError::Resource {
+            resource: "readback".into(),
+            problem: "buffer is not host visible".into(),
+        })?;
+    Ok(bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec())
 }
 
 fn add_readbacks<'f>(

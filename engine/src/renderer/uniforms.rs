@@ -197,7 +197,11 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 alpha,
                 h,
                 delta,
-                tolerance
+                tolerance,
+                lambda_min,
+                change_ratio,
+                pad0,
+                pad1
             }),
         ),
         (
