@@ -92,13 +92,29 @@ fn main() {
     let result = run(cli);
     let validation_messages = dvr_engine::gpu::validation::message_count();
     if let Err(e) = result {
-        eprintln!("dvr: error: {e:#}");
+        eprintln!("dvr: error: {}", error_chain(&e));
         std::process::exit(1);
     }
     if validation_messages > 0 {
         eprintln!("dvr: the Vulkan validation layer reported {validation_messages} message(s)");
         std::process::exit(2);
     }
+}
+
+/// The error and its causes on one line; a cause whose text the message already
+/// quotes (the engine's errors embed their source) is not repeated.
+fn error_chain(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let part = cause.to_string();
+        if !text.contains(part.as_str()) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&part);
+        }
+    }
+    text
 }
 
 fn run(cli: Cli) -> Result<()> {

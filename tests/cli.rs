@@ -1,0 +1,259 @@
+//! The `dvr` binary end to end, as a user runs it: capture, reference and profile write
+//! what they promise with the validation layer on, and bad input gets a clear error that
+//! names the file or value, never a panic.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn dvr(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_dvr"))
+        .args(args)
+        .env("DVR_VALIDATION", "1")
+        .output()
+        .expect("run dvr")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn assert_ok(o: &Output) {
+    assert!(
+        o.status.success(),
+        "dvr failed ({:?}):\n{}",
+        o.status.code(),
+        stderr(o)
+    );
+}
+
+/// Fails with exit status 1 and a message containing every one of `needles`.
+fn assert_error(o: &Output, needles: &[&str]) {
+    let err = stderr(o);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "expected a clean error exit, got:\n{err}"
+    );
+    assert!(!err.contains("panicked"), "panicked:\n{err}");
+    for n in needles {
+        assert!(err.contains(n), "message should mention {n:?}:\n{err}");
+    }
+}
+
+const SMALL: &[&str] = &["--frames", "3", "--size", "32x24", "--volume-size", "32"];
+
+#[test]
+fn capture_writes_frames_timings_and_page_for_every_denoiser() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("cap");
+    let mut args = vec![
+        "capture",
+        "--scene",
+        "cloud/orbit",
+        "--denoiser",
+        "none,accum,ours",
+    ];
+    args.extend_from_slice(SMALL);
+    args.extend_from_slice(&["--out", out.to_str().expect("utf-8 path")]);
+    assert_ok(&dvr(&args));
+    for m in ["none", "accum", "ours"] {
+        for f in 0..3 {
+            for ext in ["exr", "png"] {
+                let p = out.join(m).join(format!("{f:04}.{ext}"));
+                assert!(p.is_file(), "missing {}", p.display());
+            }
+        }
+        let png = image::open(out.join(m).join("0002.png")).expect("png decodes");
+        assert_eq!((png.width(), png.height()), (32, 24));
+    }
+    let timings: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("timings.json")).expect("timings"))
+            .expect("timings.json parses");
+    let frames = timings["frames"].as_array().expect("frames");
+    assert_eq!(frames.len(), 3);
+    let passes: Vec<&str> = frames[2]
+        .as_array()
+        .expect("passes")
+        .iter()
+        .filter_map(|p| p["pass"].as_str())
+        .collect();
+    for want in [
+        "surface_features",
+        "path_trace",
+        "motion",
+        "accum",
+        "ours.update",
+        "ours.spatial",
+    ] {
+        assert!(passes.contains(&want), "no timing for {want}: {passes:?}");
+    }
+    assert!(out.join("index.html").is_file());
+}
+
+#[test]
+fn profile_prints_a_table_and_writes_json_and_a_chrome_trace() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let json = dir.path().join("p.json");
+    let trace = dir.path().join("t.json");
+    let o = dvr(&[
+        "profile",
+        "--scene",
+        "phantom/orbit",
+        "--frames",
+        "6",
+        "--size",
+        "32x32",
+        "--volume-size",
+        "32",
+        "--denoiser",
+        "ours",
+        "--json",
+        json.to_str().expect("utf-8"),
+        "--trace",
+        trace.to_str().expect("utf-8"),
+    ]);
+    assert_ok(&o);
+    let table = String::from_utf8_lossy(&o.stdout);
+    for row in ["path_trace", "ours.update", "total", "p95"] {
+        assert!(table.contains(row), "table lacks {row}:\n{table}");
+    }
+    let p: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("parses");
+    assert!(p["total"]["mean_ms"].as_f64().expect("mean") > 0.0);
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&trace).expect("trace")).expect("parses");
+    assert!(t["traceEvents"].as_array().expect("events").len() >= 6 * 4);
+}
+
+#[test]
+fn reference_writes_one_exr_per_frame() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut args = vec![
+        "reference",
+        "--scene",
+        "mri/area-light",
+        "--ref-spp",
+        "8",
+        "--out",
+        dir.path().to_str().expect("utf-8"),
+    ];
+    args.extend_from_slice(SMALL);
+    assert_ok(&dvr(&args));
+    for f in 0..3 {
+        assert!(dir
+            .path()
+            .join("reference")
+            .join(format!("{f:04}.exr"))
+            .is_file());
+    }
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).expect("write");
+    p.to_str().expect("utf-8").to_string()
+}
+
+#[test]
+fn bad_inputs_get_clear_errors() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let run = |scene: &str| {
+        dvr(&[
+            "capture",
+            "--scene",
+            scene,
+            "--frames",
+            "1",
+            "--size",
+            "8x8",
+            "--out",
+            d.join("o").to_str().expect("utf-8"),
+        ])
+    };
+
+    // A scene file that is not TOML.
+    let bad = write(d, "broken.toml", "[volume\nbuiltin = ");
+    assert_error(&run(&bad), &["broken.toml"]);
+
+    // A raw volume shorter than its dims say.
+    let raw = d.join("short.raw");
+    std::fs::write(&raw, vec![0u8; 100]).expect("write raw");
+    let scene = write(
+        d,
+        "short.toml",
+        "[volume]\nfile = \"short.raw\"\ndims = [8, 8, 8]\nformat = \"u8\"\n[transfer]\na = \"cloud\"\n[[light]]\nkind = \"point\"\nposition = [1.0, 1.0, 1.0]\nintensity = 1.0\n",
+    );
+    assert_error(&run(&scene), &["short.raw", "512"]);
+
+    // A float volume with NaN.
+    let nan = d.join("nan.raw");
+    let mut bytes = Vec::new();
+    for i in 0..8u32 {
+        let v = if i == 5 { f32::NAN } else { 0.5 };
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(&nan, bytes).expect("write raw");
+    let scene = write(
+        d,
+        "nan.toml",
+        "[volume]\nfile = \"nan.raw\"\ndims = [2, 2, 2]\nformat = \"f32\"\n[transfer]\na = \"cloud\"\n[[light]]\nkind = \"point\"\nposition = [1.0, 1.0, 1.0]\nintensity = 1.0\n",
+    );
+    assert_error(&run(&scene), &["nan.raw", "NaN"]);
+
+    // An unknown built-in scene, a missing file, an unknown denoiser, an absurd size.
+    assert_error(&run("nowhere/orbit"), &["nowhere/orbit"]);
+    let o = dvr(&[
+        "capture",
+        "--scene",
+        "cloud/orbit",
+        "--frames",
+        "1",
+        "--size",
+        "8x8",
+        "--volume-size",
+        "16",
+        "--denoiser",
+        "magic",
+        "--out",
+        d.join("o").to_str().expect("utf-8"),
+    ]);
+    assert_error(&o, &["magic", "ours"]);
+    let o = dvr(&["capture", "--size", "0x5"]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("0x5"),
+        "{}",
+        stderr(&o)
+    );
+
+    // A malformed TF file referenced by a scene.
+    write(
+        d,
+        "bad-tf.toml",
+        "name = \"x\"\n[[point]]\ndensity = 0.5\nopacity = 2.0\ndiffuse = [1, 1, 1]\n",
+    );
+    let scene = write(
+        d,
+        "tf.toml",
+        "[volume]\nbuiltin = \"cloud\"\nsize = 16\n[transfer]\na = \"bad-tf.toml\"\n[[light]]\nkind = \"point\"\nposition = [1.0, 1.0, 1.0]\nintensity = 1.0\n",
+    );
+    assert_error(&run(&scene), &["bad-tf.toml"]);
+}
+
+#[test]
+fn a_missing_device_is_reported_clearly() {
+    let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
+        .args([
+            "capture",
+            "--frames",
+            "1",
+            "--size",
+            "8x8",
+            "--volume-size",
+            "16",
+        ])
+        .env("DVR_DEVICE", "no-such-gpu-9000")
+        .output()
+        .expect("run dvr");
+    assert_error(&o, &["no-such-gpu-9000", "matches no Vulkan device"]);
+}
