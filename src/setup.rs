@@ -7,22 +7,17 @@ use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
 use dvr_engine::passes::path_trace::{Estimator, PathTraceFeatures, Phase};
 use dvr_engine::passes::Extent;
-use dvr_engine::renderer::scene_gpu::{
-    BrickRanges, EnvironmentUpload, LutUpload, VolumeFormat, VolumeUpload,
-};
+use dvr_engine::renderer::scene_gpu::{EnvironmentUpload, LutUpload, VolumeUpload};
 use dvr_engine::renderer::uniforms::{self, GpuLight};
 use dvr_engine::renderer::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
 use dvr_engine::scene::{self, EnvSource, Light, Scene, VolumeSource};
 use dvr_engine::transfer::{TfLut, LUT_SIZE};
-use dvr_engine::volume::{MajorantGrid, Volume, VolumeData};
+use dvr_engine::volume::Volume;
 use glam::{Vec3, Vec4};
 use std::path::Path;
 
 /// The scene `dvr` renders when none is named.
 pub const DEFAULT_SCENE: &str = "phantom/orbit";
-
-/// Brick edge of the majorant grid, in voxels.
-pub const BRICK: u32 = 8;
 
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
@@ -51,37 +46,6 @@ pub struct Setup {
     pub frames: u32,
     lut_a: TfLut,
     lut_b: Option<TfLut>,
-}
-
-fn to_volume_upload(v: &Volume) -> VolumeUpload {
-    let grid = MajorantGrid::build(v, BRICK);
-    let format = match v.data {
-        VolumeData::U8(_) => VolumeFormat::R8,
-        VolumeData::U16(_) => VolumeFormat::R16,
-        VolumeData::F32(_) => VolumeFormat::R32F,
-    };
-    let extent = v.extent();
-    let longest = extent.iter().copied().fold(f32::MIN, f32::max).max(1e-6);
-    VolumeUpload {
-        name: v.name.clone(),
-        dims: v.dims,
-        format,
-        bytes: v.data.as_bytes().to_vec(),
-        world_size: extent.map(|e| e / longest),
-        bricks: BrickRanges {
-            grid: grid.dims,
-            min: grid.min,
-            max: grid.max,
-        },
-    }
-}
-
-fn to_lut(l: &TfLut) -> LutUpload {
-    LutUpload {
-        diffuse_opacity: l.diffuse_opacity.clone(),
-        specular_roughness: l.specular_roughness.clone(),
-        emissive: l.emissive.clone(),
-    }
 }
 
 fn v3(d: glam::DVec3) -> Vec3 {
@@ -210,7 +174,7 @@ impl Setup {
         Ok(Self {
             name: scene.name.clone(),
             frames: scene.frames,
-            volume: to_volume_upload(&volume),
+            volume: VolumeUpload::from_volume(&volume),
             environment,
             settings,
             scene,
@@ -246,8 +210,10 @@ impl Setup {
         let aspect = self.width() as f32 / self.height() as f32;
         let camera = CameraMatrices::look_at(c.position, c.target, c.up, c.fov_y, aspect);
         let lut = match &self.lut_b {
-            Some(b) if state.tf_blend > 0.0 => to_lut(&TfLut::lerp(&self.lut_a, b, state.tf_blend)),
-            _ => to_lut(&self.lut_a),
+            Some(b) if state.tf_blend > 0.0 => {
+                LutUpload::from(&TfLut::lerp(&self.lut_a, b, state.tf_blend))
+            }
+            _ => LutUpload::from(&self.lut_a),
         };
         FrameInputs {
             camera,

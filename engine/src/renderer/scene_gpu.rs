@@ -54,12 +54,53 @@ pub struct VolumeUpload {
     pub bricks: BrickRanges,
 }
 
+impl VolumeUpload {
+    /// Brick edge of the majorant grid, in voxels.
+    pub const BRICK: u32 = 8;
+
+    /// A loaded volume as a texture upload: world space is the volume centred at the
+    /// origin with its longest side 1 unit; bricks of [`Self::BRICK`] voxels.
+    pub fn from_volume(v: &crate::volume::Volume) -> Self {
+        use crate::volume::{MajorantGrid, VolumeData};
+        let grid = MajorantGrid::build(v, Self::BRICK);
+        let format = match v.data {
+            VolumeData::U8(_) => VolumeFormat::R8,
+            VolumeData::U16(_) => VolumeFormat::R16,
+            VolumeData::F32(_) => VolumeFormat::R32F,
+        };
+        let extent = v.extent();
+        let longest = extent.iter().copied().fold(f32::MIN, f32::max).max(1e-6);
+        Self {
+            name: v.name.clone(),
+            dims: v.dims,
+            format,
+            bytes: v.data.as_bytes().to_vec(),
+            world_size: extent.map(|e| e / longest),
+            bricks: BrickRanges {
+                grid: grid.dims,
+                min: grid.min,
+                max: grid.max,
+            },
+        }
+    }
+}
+
 /// One transfer function sampled into LUTs (rgba each, same length).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LutUpload {
     pub diffuse_opacity: Vec<[f32; 4]>,
     pub specular_roughness: Vec<[f32; 4]>,
     pub emissive: Vec<[f32; 4]>,
+}
+
+impl From<&crate::transfer::TfLut> for LutUpload {
+    fn from(l: &crate::transfer::TfLut) -> Self {
+        Self {
+            diffuse_opacity: l.diffuse_opacity.clone(),
+            specular_roughness: l.specular_roughness.clone(),
+            emissive: l.emissive.clone(),
+        }
+    }
 }
 
 /// An equirectangular RGB environment map.
