@@ -4,10 +4,14 @@
 
 mod accum;
 mod passthrough;
+pub mod svgf;
+pub mod taa;
 pub mod wrls;
 
 pub use accum::Accum;
 pub use passthrough::Passthrough;
+pub use svgf::Svgf;
+pub use taa::Taa;
 pub use wrls::{Wrls, WrlsVariant};
 
 use crate::error::{EngineError, Result};
@@ -65,13 +69,17 @@ pub trait Denoiser {
 }
 
 /// Names accepted by `--denoiser`.
-pub const NAMES: &[&str] = &["none", "accum", "ours", "rls", "wrls-nf", "rls-nf"];
+pub const NAMES: &[&str] = &[
+    "none", "accum", "taa", "svgf", "ours", "rls", "wrls-nf", "rls-nf",
+];
 
 /// Builds a denoiser by name.
 pub fn create(ctx: &GpuContext, name: &str) -> Result<Box<dyn Denoiser>> {
     Ok(match name {
         "none" => Box::new(Passthrough),
         "accum" => Box::new(Accum::new(ctx)?),
+        "taa" => Box::new(Taa::new(ctx, 0)?),
+        "svgf" => Box::new(Svgf::new(ctx, 0)?),
         n if WrlsVariant::from_name(n).is_some() => {
             let variant = WrlsVariant::from_name(n).unwrap_or(WrlsVariant {
                 weighted: true,
