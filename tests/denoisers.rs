@@ -20,7 +20,16 @@ fn finite_and_bounded(out: &[[f32; 4]], bound: f32) -> bool {
 
 #[test]
 fn long_static_runs_stay_finite_and_bounded_for_every_temporal_method() {
-    for name in ["ours", "rls", "wrls-nf", "rls-nf", "accum"] {
+    for name in [
+        "ours",
+        "wrls-paper",
+        "rls",
+        "wrls-nf",
+        "rls-nf",
+        "accum",
+        "taa",
+        "svgf",
+    ] {
         let mut h = Harness::new(name, W, H);
         let n = (W * H) as usize;
         for f in 0..2000u64 {

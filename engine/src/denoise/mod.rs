@@ -4,10 +4,14 @@
 
 mod accum;
 mod passthrough;
+pub mod svgf;
+pub mod taa;
 pub mod wrls;
 
 pub use accum::Accum;
 pub use passthrough::Passthrough;
+pub use svgf::Svgf;
+pub use taa::Taa;
 pub use wrls::{Wrls, WrlsVariant};
 
 use crate::error::{EngineError, Result};
@@ -68,6 +72,8 @@ pub trait Denoiser {
 pub const NAMES: &[&str] = &[
     "none",
     "accum",
+    "taa",
+    "svgf",
     "ours",
     "ours-fixed-lambda",
     "wrls-paper",
@@ -81,6 +87,8 @@ pub fn create(ctx: &GpuContext, name: &str) -> Result<Box<dyn Denoiser>> {
     Ok(match name {
         "none" => Box::new(Passthrough),
         "accum" => Box::new(Accum::new(ctx)?),
+        "taa" => Box::new(Taa::new(ctx, 0)?),
+        "svgf" => Box::new(Svgf::new(ctx, 0)?),
         n if WrlsVariant::from_name(n).is_some() => {
             let variant = WrlsVariant::from_name(n).ok_or_else(|| EngineError::Pass {
                 pass: "denoise".into(),

@@ -103,6 +103,64 @@ pub struct WrlsSpatialPush {
     pub sigma_range: f32,
 }
 
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct TaaPush {
+    pub camera: Vec4,
+    pub width: u32,
+    pub height: u32,
+    pub history_valid: u32,
+    pub alpha: f32,
+    pub gamma: f32,
+    pub tolerance: f32,
+    pub pad0: f32,
+    pub pad1: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct SvgfTemporalPush {
+    pub camera: Vec4,
+    pub width: u32,
+    pub height: u32,
+    pub history_valid: u32,
+    pub tolerance: f32,
+    pub color_alpha: f32,
+    pub moments_alpha: f32,
+    pub demod_eps: f32,
+    pub feature_step: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct SvgfVariancePush {
+    pub width: u32,
+    pub height: u32,
+    pub min_history: f32,
+    pub sigma_z: f32,
+    pub sigma_n: f32,
+    pub pad0: f32,
+    pub pad1: f32,
+    pub pad2: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct SvgfAtrousPush {
+    pub width: u32,
+    pub height: u32,
+    pub step: i32,
+    pub modulate: u32,
+    pub sigma_z: f32,
+    pub sigma_n: f32,
+    pub sigma_l: f32,
+    pub luminance_eps: f32,
+    pub demod_eps: f32,
+    pub pad0: f32,
+    pub pad1: f32,
+    pub pad2: f32,
+}
+
 /// Field names and offsets of a mirror struct, for the layout test.
 #[macro_export]
 macro_rules! field_offsets {
@@ -213,6 +271,72 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 height,
                 sigma_spatial,
                 sigma_range
+            }),
+        ),
+        (
+            "taa",
+            "push",
+            std::mem::size_of::<TaaPush>(),
+            field_offsets!(TaaPush {
+                camera,
+                width,
+                height,
+                history_valid,
+                alpha,
+                gamma,
+                tolerance,
+                pad0,
+                pad1
+            }),
+        ),
+        (
+            "svgf_temporal",
+            "push",
+            std::mem::size_of::<SvgfTemporalPush>(),
+            field_offsets!(SvgfTemporalPush {
+                camera,
+                width,
+                height,
+                history_valid,
+                tolerance,
+                color_alpha,
+                moments_alpha,
+                demod_eps,
+                feature_step
+            }),
+        ),
+        (
+            "svgf_variance",
+            "push",
+            std::mem::size_of::<SvgfVariancePush>(),
+            field_offsets!(SvgfVariancePush {
+                width,
+                height,
+                min_history,
+                sigma_z,
+                sigma_n,
+                pad0,
+                pad1,
+                pad2
+            }),
+        ),
+        (
+            "svgf_atrous",
+            "push",
+            std::mem::size_of::<SvgfAtrousPush>(),
+            field_offsets!(SvgfAtrousPush {
+                width,
+                height,
+                step,
+                modulate,
+                sigma_z,
+                sigma_n,
+                sigma_l,
+                luminance_eps,
+                demod_eps,
+                pad0,
+                pad1,
+                pad2
             }),
         ),
     ]

@@ -1,0 +1,453 @@
+//! `svgf`: Spatiotemporal Variance-Guided Filtering (Schied et al. 2017), with the shared
+//! reprojection (include/reproject.glsl) in place of the paper's, as the TVCG paper did.
+//!
+//! Passes (shaders of the same names, maths shared in include/svgf.glsl):
+//! - `svgf.temporal`: demodulate the noisy colour by the TF albedo (+ `demod_eps`),
+//!   blend it and its luminance moments with the reprojected histories (α = 0.2, or 1/n
+//!   for a history of n < 5 frames), and pack the edge-stopping features.
+//! - `svgf.variance`: variance from the moments; a 7×7 depth/normal-weighted spatial
+//!   estimate where the history is shorter than 4 frames.
+//! - `svgf.atrous0..4`: 5×5 B3-spline à-trous with steps 1…16 and depth/normal/luminance
+//!   edge-stopping; the luminance scale uses the 3×3-prefiltered variance, and variance
+//!   is carried with squared weights. Iteration 0 writes the colour history; the last
+//!   multiplies the albedo back in.
+//!
+//! Images: histories `svgf.color` (first iteration's output, demodulated rgb + variance)
+//! and `svgf.moments` (m1, m2, history length); transients `svgf.geometry` (packed
+//! features), `svgf.ping`/`svgf.pong` (temporal → ping, variance → pong, then the
+//! iterations alternate) and the output `svgf.out`.
+//!
+//! Invalid features (no surface: background, rays that never reach the opacity
+//! threshold) are filtered too: among themselves with depth/normal weight 1, never with
+//! valid pixels (weight 0), and they are not demodulated (factor 1).
+//!
+//! The depth weight's gradient is floored at the surface features' depth quantum (their
+//! march step, `STEP_VOXELS` voxels): that depth is terraced, and a one-step jump between
+//! terraces must not read as an edge. Histories are not reset when the camera, lights or
+//! transfer function change: reprojection follows motion, and shading changes are
+//! followed at the moving averages' rate (the method's known lag).
+
+use super::{DenoiseInputs, Denoiser};
+use crate::error::Result;
+use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
+use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
+use crate::passes::surface_features::STEP_VOXELS;
+use crate::renderer::uniforms::{SvgfAtrousPush, SvgfTemporalPush, SvgfVariancePush};
+use ash::vk;
+
+/// Number of à-trous iterations (steps 1, 2, 4, 8, 16).
+pub const ITERATIONS: usize = 5;
+
+/// The paper's parameters, and this implementation's few extra constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SvgfParams {
+    /// Weight of the new frame in the colour average (α).
+    pub color_alpha: f32,
+    /// Weight of the new frame in the moments average.
+    pub moments_alpha: f32,
+    /// History length below which variance is estimated spatially.
+    pub min_history: f32,
+    pub sigma_z: f32,
+    pub sigma_n: f32,
+    pub sigma_l: f32,
+    /// Added to σl·σ so a zero-variance neighbourhood does not divide by zero.
+    pub luminance_eps: f32,
+    /// Added to the albedo before demodulating: a black albedo channel amplifies the
+    /// colour by at most 1/eps before filtering (and is multiplied back exactly).
+    pub demod_eps: f32,
+    /// Disocclusion tolerance, relative to the distance from the camera (as `ours`).
+    pub tolerance: f32,
+}
+
+impl Default for SvgfParams {
+    fn default() -> Self {
+        Self {
+            color_alpha: 0.2,
+            moments_alpha: 0.2,
+            min_history: 4.0,
+            sigma_z: 1.0,
+            sigma_n: 128.0,
+            sigma_l: 4.0,
+            luminance_eps: 1e-6,
+            demod_eps: 0.01,
+            tolerance: 0.05,
+        }
+    }
+}
+
+pub struct Svgf {
+    temporal: ComputePipeline,
+    variance: ComputePipeline,
+    atrous: ComputePipeline,
+    pub params: SvgfParams,
+    /// 0: motion from the first real collision (the paper's, as `ours`), 1: from features.
+    pub motion_source: i32,
+}
+
+impl Svgf {
+    /// History keys (for tests and resets).
+    pub const COLOR_HISTORY: &'static str = "svgf.color";
+    pub const MOMENTS_HISTORY: &'static str = "svgf.moments";
+
+    pub fn new(ctx: &GpuContext, motion_source: i32) -> Result<Self> {
+        Ok(Self {
+            temporal: ComputePipeline::new(
+                ctx,
+                "svgf_temporal",
+                &[("MOTION_SOURCE", SpecValue::I32(motion_source))],
+            )?,
+            variance: ComputePipeline::new(ctx, "svgf_variance", &[])?,
+            atrous: ComputePipeline::new(ctx, "svgf_atrous", &[])?,
+            params: SvgfParams::default(),
+            motion_source,
+        })
+    }
+}
+
+impl Denoiser for Svgf {
+    fn name(&self) -> &str {
+        "svgf"
+    }
+
+    fn add<'f>(
+        &'f self,
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        frame: &mut Frame<'f>,
+        input: &DenoiseInputs,
+    ) -> Result<ImageHandle> {
+        let size = input.size;
+        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let color = graph.history(ctx, Self::COLOR_HISTORY, desc)?;
+        let moments = graph.history(ctx, Self::MOMENTS_HISTORY, desc)?;
+        let geometry = graph.image(ctx, "svgf.geometry", desc)?;
+        let ping = graph.image(ctx, "svgf.ping", desc)?;
+        let pong = graph.image(ctx, "svgf.pong", desc)?;
+        let out = graph.image(ctx, "svgf.out", desc)?;
+        let (pos_cur, pos_prev) = if self.motion_source == 0 {
+            (input.first_hit.cur, input.first_hit.prev)
+        } else {
+            (input.features.position.cur, input.features.position.prev)
+        };
+        let valid =
+            color.valid && moments.valid && input.first_hit.valid && input.features.position.valid;
+        let p = self.params;
+        let (noisy, motion) = (input.noisy, input.motion);
+        let (albedo, normal) = (input.features.albedo, input.features.normal);
+        let uniforms = input.uniforms;
+
+        let push = SvgfTemporalPush {
+            camera: input.camera.extend(1.0),
+            width: size.width,
+            height: size.height,
+            history_valid: valid as u32,
+            tolerance: p.tolerance,
+            color_alpha: p.color_alpha,
+            moments_alpha: p.moments_alpha,
+            demod_eps: p.demod_eps,
+            feature_step: STEP_VOXELS,
+        };
+        frame.add_pass(
+            "svgf.temporal",
+            |b| {
+                b.uniform(uniforms)
+                    .read(noisy)
+                    .read(albedo)
+                    .read(normal)
+                    .read(motion)
+                    .read(pos_cur)
+                    .sampled(pos_prev)
+                    .sampled(color.prev)
+                    .sampled(moments.prev)
+                    .write(ping)
+                    .write(moments.cur)
+                    .write(geometry);
+            },
+            move |pc| {
+                let binds = [
+                    ("frame", Bind::Buffer(uniforms)),
+                    ("noisy", Bind::Image(noisy)),
+                    ("feature_albedo", Bind::Image(albedo)),
+                    ("feature_normal", Bind::Image(normal)),
+                    ("motion", Bind::Image(motion)),
+                    ("position_cur", Bind::Image(pos_cur)),
+                    ("position_prev", Bind::ImageNearest(pos_prev)),
+                    ("color_prev", Bind::Image(color.prev)),
+                    ("moments_prev", Bind::Image(moments.prev)),
+                    ("integrated", Bind::Image(ping)),
+                    ("moments_cur", Bind::Image(moments.cur)),
+                    ("geometry", Bind::Image(geometry)),
+                ];
+                let groups = self.temporal.groups_2d(size.width, size.height);
+                pc.dispatch(&self.temporal, &binds, &push, groups)
+            },
+        );
+
+        let vpush = SvgfVariancePush {
+            width: size.width,
+            height: size.height,
+            min_history: p.min_history,
+            sigma_z: p.sigma_z,
+            sigma_n: p.sigma_n,
+            pad0: 0.0,
+            pad1: 0.0,
+            pad2: 0.0,
+        };
+        frame.add_pass(
+            "svgf.variance",
+            |b| {
+                b.read(ping).read(moments.cur).read(geometry).write(pong);
+            },
+            move |pc| {
+                let binds = [
+                    ("integrated", Bind::Image(ping)),
+                    ("moments", Bind::Image(moments.cur)),
+                    ("geometry", Bind::Image(geometry)),
+                    ("estimated", Bind::Image(pong)),
+                ];
+                let groups = self.variance.groups_2d(size.width, size.height);
+                pc.dispatch(&self.variance, &binds, &vpush, groups)
+            },
+        );
+
+        // pong → colour history → ping → pong → ping → out.
+        let mut src = pong;
+        for i in 0..ITERATIONS {
+            let last = i + 1 == ITERATIONS;
+            let dst = match i {
+                0 => color.cur,
+                _ if last => out,
+                _ if i % 2 == 1 => ping,
+                _ => pong,
+            };
+            let apush = SvgfAtrousPush {
+                width: size.width,
+                height: size.height,
+                step: 1 << i,
+                modulate: last as u32,
+                sigma_z: p.sigma_z,
+                sigma_n: p.sigma_n,
+                sigma_l: p.sigma_l,
+                luminance_eps: p.luminance_eps,
+                demod_eps: p.demod_eps,
+                pad0: 0.0,
+                pad1: 0.0,
+                pad2: 0.0,
+            };
+            frame.add_pass(
+                format!("svgf.atrous{i}"),
+                |b| {
+                    b.read(src).read(geometry).read(albedo).write(dst);
+                },
+                move |pc| {
+                    let binds = [
+                        ("color_in", Bind::Image(src)),
+                        ("geometry", Bind::Image(geometry)),
+                        ("feature_albedo", Bind::Image(albedo)),
+                        ("color_out", Bind::Image(dst)),
+                    ];
+                    let groups = self.atrous.groups_2d(size.width, size.height);
+                    pc.dispatch(&self.atrous, &binds, &apush, groups)
+                },
+            );
+            src = dst;
+        }
+        Ok(out)
+    }
+
+    fn destroy(&mut self, ctx: &GpuContext) {
+        self.temporal.destroy(ctx);
+        self.variance.destroy(ctx);
+        self.atrous.destroy(ctx);
+    }
+}
+
+/// CPU mirror of the edge-stopping maths in shaders/glsl/include/svgf.glsl (the functions
+/// marked `[mirror]` there), for tests and CPU references. The GLSL is what runs: CHANGE
+/// BOTH TOGETHER. `tests/svgf.rs` compares a CPU filter built from these functions with
+/// the GPU passes, so a one-sided change fails a test.
+pub mod edge {
+    use glam::Vec3;
+
+    /// The 1D B3-spline kernel [1/16, 1/4, 3/8, 1/4, 1/16], indexed by |offset|.
+    pub const B3: [f32; 3] = [3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0];
+
+    /// `svgf_depth_slope`: the depth gradient floored at the features' depth quantum.
+    pub fn depth_slope(gradient: f32, quantum: f32) -> f32 {
+        gradient.max(quantum)
+    }
+
+    /// `svgf_phi_z`: depth scale for a tap `dist` pixels away.
+    pub fn phi_z(sigma_z: f32, slope: f32, dist: f32) -> f32 {
+        sigma_z * slope * dist
+    }
+
+    /// `svgf_phi_l`: luminance scale from the (prefiltered) variance.
+    pub fn phi_l(sigma_l: f32, variance: f32, eps: f32) -> f32 {
+        sigma_l * variance.max(0.0).sqrt() + eps
+    }
+
+    /// `svgf_geometry_weight`: depth × normal weight, 0 between valid and invalid pixels,
+    /// 1 between two invalid ones.
+    #[allow(clippy::too_many_arguments)]
+    pub fn geometry_weight(
+        valid_p: bool,
+        valid_q: bool,
+        z_p: f32,
+        z_q: f32,
+        phi_z: f32,
+        n_p: Vec3,
+        n_q: Vec3,
+        sigma_n: f32,
+    ) -> f32 {
+        if valid_p != valid_q {
+            return 0.0;
+        }
+        if !valid_p {
+            return 1.0;
+        }
+        let w_n = n_p.dot(n_q).max(0.0).powf(sigma_n);
+        let e_z = (z_p - z_q).abs() / phi_z.max(1e-20);
+        (-e_z).exp() * w_n
+    }
+
+    /// `svgf_luminance_weight`.
+    pub fn luminance_weight(l_p: f32, l_q: f32, phi_l: f32) -> f32 {
+        (-(l_p - l_q).abs() / phi_l).exp()
+    }
+
+    /// `luminance` in include/common.glsl.
+    pub fn luminance(c: [f32; 3]) -> f32 {
+        0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+    }
+
+    #[cfg(test)]
+    mod tests {
+        use super::*;
+        use crate::denoise::svgf::SvgfParams;
+
+        const P: SvgfParams = SvgfParams {
+            color_alpha: 0.2,
+            moments_alpha: 0.2,
+            min_history: 4.0,
+            sigma_z: 1.0,
+            sigma_n: 128.0,
+            sigma_l: 4.0,
+            luminance_eps: 1e-6,
+            demod_eps: 0.01,
+            tolerance: 0.05,
+        };
+
+        #[test]
+        fn test_params_are_the_defaults() {
+            assert_eq!(P, SvgfParams::default());
+        }
+
+        /// The full weight of a tap on the same flat surface, luminance `l_q` against
+        /// `l_p`, with standard deviation `sigma` of luminance at the centre.
+        fn flat_weight(l_p: f32, l_q: f32, sigma: f32) -> f32 {
+            let z = 2.0;
+            let phi = phi_z(P.sigma_z, 0.01, 1.0);
+            geometry_weight(true, true, z, z, phi, Vec3::Z, Vec3::Z, P.sigma_n)
+                * luminance_weight(l_p, l_q, phi_l(P.sigma_l, sigma * sigma, P.luminance_eps))
+        }
+
+        #[test]
+        fn luminance_step_of_ten_edge_scales_stops_the_filter() {
+            // A step of 10 σl·σ (ten luminance scales): weight e^-10.
+            for sigma in [1e-3f32, 0.1, 1.0, 30.0] {
+                let w = flat_weight(1.0, 1.0 + 10.0 * P.sigma_l * sigma, sigma);
+                assert!(w < 1e-3, "σ {sigma}: weight {w}");
+                let w_down = flat_weight(1.0 + 10.0 * P.sigma_l * sigma, 1.0, sigma);
+                assert!(w_down < 1e-3, "σ {sigma}: weight {w_down}");
+            }
+        }
+
+        #[test]
+        fn luminance_step_of_ten_sigma_is_attenuated_per_iteration() {
+            // A step of 10σ is 10/σl = 2.5 luminance scales: e^-2.5 ≈ 0.082 per iteration
+            // with the paper's σl = 4 (the step has to be 4× larger to reach 1e-3).
+            let sigma = 0.5;
+            let w = flat_weight(1.0, 1.0 + 10.0 * sigma, sigma);
+            assert!((w - (-2.5f32).exp()).abs() < 1e-4, "weight {w}");
+            assert!(w < 0.1);
+        }
+
+        #[test]
+        fn flat_region_keeps_weight_near_one() {
+            // σ-normalised differences near 0 (|Δl| ≤ 0.1 σ) on the same surface.
+            for sigma in [1e-3f32, 0.1, 1.0, 30.0] {
+                for d in [0.0f32, 0.01, 0.05, 0.1] {
+                    let w = flat_weight(1.0, 1.0 + d * sigma, sigma);
+                    assert!(w > 0.9, "σ {sigma}, Δ {d}σ: weight {w}");
+                }
+            }
+            // Depth that changes along the surface at its own gradient, a tap 2 px away.
+            let (z, dz) = (2.0, 0.01);
+            let phi = phi_z(P.sigma_z, dz, 2.0);
+            let w = geometry_weight(true, true, z, z + 2.0 * dz, phi, Vec3::Z, Vec3::Z, 128.0);
+            assert!((w - (-1.0f32).exp()).abs() < 1e-6, "depth weight {w}");
+        }
+
+        #[test]
+        fn normal_weight() {
+            let phi = phi_z(P.sigma_z, 0.01, 1.0);
+            let w = |n: Vec3| geometry_weight(true, true, 1.0, 1.0, phi, Vec3::Z, n, P.sigma_n);
+            assert_eq!(w(-Vec3::Z), 0.0, "opposite normals");
+            assert_eq!(w(Vec3::X), 0.0, "perpendicular normals");
+            assert!((w(Vec3::Z) - 1.0).abs() < 1e-6);
+            // 10° apart: cos^128 ≈ 0.14; 2° apart: ≈ 0.92.
+            let tilt = |deg: f32| Vec3::new(deg.to_radians().sin(), 0.0, deg.to_radians().cos());
+            assert!(w(tilt(10.0)) < 0.2);
+            assert!(w(tilt(2.0)) > 0.9);
+        }
+
+        #[test]
+        fn depth_discontinuity_stops_the_filter() {
+            let (z, quantum) = (2.0, 0.002);
+            let phi = phi_z(P.sigma_z, depth_slope(0.002, quantum), 1.0);
+            let w = geometry_weight(true, true, z, z + 0.1, phi, Vec3::Z, Vec3::Z, P.sigma_n);
+            assert!(w < 1e-6, "weight {w}");
+            // Inside a terrace (gradient 0) the quantum floor keeps a one-step jump from
+            // cutting the surface apart: e^-1 for the next pixel, more further out.
+            let slope = depth_slope(0.0, quantum);
+            assert_eq!(slope, quantum);
+            for dist in [1.0f32, 2.0, 4.0] {
+                let phi = phi_z(P.sigma_z, slope, dist);
+                let w = geometry_weight(true, true, z, z + quantum, phi, Vec3::Z, Vec3::Z, 128.0);
+                // (z + quantum) − z is not exactly the quantum in f32.
+                assert!(
+                    (w - (-1.0 / dist).exp()).abs() < 1e-4,
+                    "weight {w} at {dist} px"
+                );
+            }
+        }
+
+        #[test]
+        fn invalid_pixels_mix_only_with_invalid_ones() {
+            let phi = phi_z(P.sigma_z, 0.01, 1.0);
+            let g = |vp, vq| geometry_weight(vp, vq, 1.0, -1.0, phi, Vec3::Z, Vec3::ZERO, 128.0);
+            assert_eq!(g(true, false), 0.0);
+            assert_eq!(g(false, true), 0.0);
+            assert_eq!(g(false, false), 1.0);
+        }
+
+        #[test]
+        fn zero_variance_does_not_divide_by_zero() {
+            let phi = phi_l(P.sigma_l, 0.0, P.luminance_eps);
+            assert!(phi > 0.0);
+            assert_eq!(luminance_weight(0.5, 0.5, phi), 1.0);
+            assert!(luminance_weight(0.5, 0.6, phi) < 1e-6);
+            assert_eq!(phi_l(P.sigma_l, -1.0, P.luminance_eps), P.luminance_eps);
+        }
+
+        #[test]
+        fn b3_kernel_sums_to_one() {
+            let k = [B3[2], B3[1], B3[0], B3[1], B3[2]];
+            let s1: f32 = k.iter().sum();
+            assert!((s1 - 1.0).abs() < 1e-7);
+            let s2: f32 = k.iter().flat_map(|a| k.iter().map(move |b| a * b)).sum();
+            assert!((s2 - 1.0).abs() < 1e-6);
+        }
+    }
+}

@@ -1,0 +1,123 @@
+//! `taa`: temporal anti-aliasing used as a denoiser. One pass, `taa` (shaders/glsl/taa.comp):
+//! an exponential moving average of the reprojected history and the noisy frame, with the
+//! history clipped to the variance box of the frame's 3×3 neighbourhood in YCoCg (Salvi
+//! 2016; clip towards the mean as in Karis 2014). One history, `taa.color`, which is also
+//! the output: the average is what the next frame reprojects. Like `svgf` it is not reset
+//! on camera, light or TF changes; the clip box limits how long stale colour survives.
+
+use super::{DenoiseInputs, Denoiser};
+use crate::error::Result;
+use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
+use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
+use crate::renderer::uniforms::TaaPush;
+use ash::vk;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TaaParams {
+    /// Weight of the new frame in the moving average.
+    pub alpha: f32,
+    /// Half-size of the clip box in standard deviations of the neighbourhood.
+    pub gamma: f32,
+    /// Disocclusion tolerance, relative to the distance from the camera (as `ours`).
+    pub tolerance: f32,
+}
+
+impl Default for TaaParams {
+    fn default() -> Self {
+        Self {
+            alpha: 0.1,
+            gamma: 1.0,
+            tolerance: 0.05,
+        }
+    }
+}
+
+pub struct Taa {
+    pipeline: ComputePipeline,
+    pub params: TaaParams,
+    /// 0: motion from the first real collision (the paper's, as `ours`), 1: from features.
+    pub motion_source: i32,
+}
+
+impl Taa {
+    /// The history key (for tests and resets).
+    pub const HISTORY: &'static str = "taa.color";
+
+    pub fn new(ctx: &GpuContext, motion_source: i32) -> Result<Self> {
+        Ok(Self {
+            pipeline: ComputePipeline::new(
+                ctx,
+                "taa",
+                &[("MOTION_SOURCE", SpecValue::I32(motion_source))],
+            )?,
+            params: TaaParams::default(),
+            motion_source,
+        })
+    }
+}
+
+impl Denoiser for Taa {
+    fn name(&self) -> &str {
+        "taa"
+    }
+
+    fn add<'f>(
+        &'f self,
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        frame: &mut Frame<'f>,
+        input: &DenoiseInputs,
+    ) -> Result<ImageHandle> {
+        let size = input.size;
+        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let color = graph.history(ctx, Self::HISTORY, desc)?;
+        let (pos_cur, pos_prev) = if self.motion_source == 0 {
+            (input.first_hit.cur, input.first_hit.prev)
+        } else {
+            (input.features.position.cur, input.features.position.prev)
+        };
+        let valid = color.valid && input.first_hit.valid && input.features.position.valid;
+        let p = self.params;
+        let push = TaaPush {
+            camera: input.camera.extend(1.0),
+            width: size.width,
+            height: size.height,
+            history_valid: valid as u32,
+            alpha: p.alpha,
+            gamma: p.gamma,
+            tolerance: p.tolerance,
+            pad0: 0.0,
+            pad1: 0.0,
+        };
+        let noisy = input.noisy;
+        let motion = input.motion;
+        frame.add_pass(
+            "taa",
+            |b| {
+                b.read(noisy)
+                    .read(motion)
+                    .read(pos_cur)
+                    .sampled(pos_prev)
+                    .sampled(color.prev)
+                    .write(color.cur);
+            },
+            move |pc| {
+                let binds = [
+                    ("noisy", Bind::Image(noisy)),
+                    ("motion", Bind::Image(motion)),
+                    ("position_cur", Bind::Image(pos_cur)),
+                    ("position_prev", Bind::ImageNearest(pos_prev)),
+                    ("history_prev", Bind::Image(color.prev)),
+                    ("history_cur", Bind::Image(color.cur)),
+                ];
+                let groups = self.pipeline.groups_2d(size.width, size.height);
+                pc.dispatch(&self.pipeline, &binds, &push, groups)
+            },
+        );
+        Ok(color.cur)
+    }
+
+    fn destroy(&mut self, ctx: &GpuContext) {
+        self.pipeline.destroy(ctx);
+    }
+}
