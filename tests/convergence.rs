@@ -50,33 +50,18 @@ fn error_falls_as_one_over_spp_for_delta_tracking() {
     let (mut reference, inputs) = phantom_renderer(7);
     let truth = reference.reference(&inputs, 4096, 4).expect("reference");
     drop(reference);
+    // An independent sample stream (another seed) against the reference.
     let (mut r, _) = phantom_renderer(1234);
     let e: Vec<f64> = [4u32, 16, 64]
         .iter()
         .map(|&n| mse(&r.reference(&inputs, n, 4).expect("render"), &truth))
         .collect();
-    let e: Vec<f64> = [4u32, 16, 64]
-        .iter()
-        .map(|&n| mse(&r.reference(&inputs, n, 4).expect("render"), &truth))
-        .collect();
-    let a = r.reference(&inputs, 1024, 256).expect("render");
-    let stats = |img: &[[f32; 4]]| {
-        let mean = img.iter().map(|p| p[0] as f64).sum::<f64>() / img.len() as f64;
-        let max = img.iter().map(|p| p[0]).fold(0.0f32, f32::max);
-        (mean, max)
-    };
-    println!(
-        "truth {:?} a1024 {:?} mse {}",
-        stats(&truth),
-        stats(&a),
-        mse(&a, &truth)
-    );
     println!(
         "MSE at 4/16/64 spp: {e:?}; ratios {:.2} {:.2}",
         e[0] / e[1],
         e[1] / e[2]
     );
-    // Expected 4× per step (slightly less, from the reference's own noise).
+    // Expected 4× per step (3.9× for the last one, from the reference's own noise).
     for k in 0..2 {
         let ratio = e[k] / e[k + 1];
         assert!(
