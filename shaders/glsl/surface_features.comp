@@ -37,20 +37,41 @@ void main() {
     vec4 nrm = vec4(0.0, 0.0, 0.0, 0.0);
     vec4 alb = vec4(0.0);
     if (span.x < span.y) {
-        for (float t = span.x; t < span.y; t += step_len) {
-            vec3 p = o + d * t;
-            float a = 1.0 - exp(-extinction_at(p) * step_len);
-            alpha += (1.0 - alpha) * a;
-            if (alpha >= threshold) {
-                float density = density_at(p);
-                vec3 g = density_gradient(p);
-                vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
-                if (dot(n, d) > 0.0) n = -n;
-                pos = vec4(p, 1.0);
-                nrm = vec4(n, t);
-                alb = vec4(tf_albedo_opacity(density).rgb, 1.0);
-                break;
+        // March the bricks the majorant grid says hold anything; skip empty ones whole.
+        GridWalk w = grid_walk_begin(o, d, span.x);
+        float t = span.x;
+        float prev_alpha = 0.0;
+        bool found = false;
+        for (int guard = 0; guard < 4096 && !found; ++guard) {
+            float cell_exit = min(grid_walk_exit(w), span.y);
+            if (grid_majorant(w) > 0.0) {
+                for (; t < cell_exit; t += step_len) {
+                    vec3 p = o + d * t;
+                    float a = 1.0 - exp(-extinction_at(p) * step_len);
+                    prev_alpha = alpha;
+                    alpha += (1.0 - alpha) * a;
+                    if (alpha >= threshold) {
+                        // Interpolate the crossing inside the last step, so depth and
+                        // position do not terrace at the step length.
+                        float f = (threshold - prev_alpha) / max(alpha - prev_alpha, 1e-6);
+                        float th = t - step_len * (1.0 - clamp(f, 0.0, 1.0));
+                        vec3 ph = o + d * th;
+                        float density = density_at(ph);
+                        vec3 g = density_gradient(ph);
+                        vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
+                        if (dot(n, d) > 0.0) n = -n;
+                        pos = vec4(ph, 1.0);
+                        nrm = vec4(n, th);
+                        alb = vec4(tf_albedo_opacity(density).rgb, 1.0);
+                        found = true;
+                        break;
+                    }
+                }
+            } else {
+                // Keep the march phase: continue from the first step past the cell.
+                t += max(ceil((cell_exit - t) / step_len), 0.0) * step_len;
             }
+            if (found || t >= span.y || !grid_walk_advance(w)) break;
         }
     }
     imageStore(feature_position, ivec2(pixel), pos);

@@ -103,11 +103,11 @@ impl Harness {
             uniforms,
             noisy: noisy_img,
             moments: moments_img,
-            features: FeatureImages {
+            features: Some(FeatureImages {
                 position: feature_position,
                 normal: normal_img,
                 albedo: albedo_img,
-            },
+            }),
             first_hit,
             motion: motion_img,
             size: Extent {

@@ -42,7 +42,9 @@ pub struct DenoiseInputs {
     pub noisy: ImageHandle,
     /// Luminance moments (x mean, y second moment).
     pub moments: ImageHandle,
-    pub features: FeatureImages,
+    /// Deterministic surface features; rendered only when a denoiser of this frame
+    /// uses them ([`Denoiser::uses_surface_features`]).
+    pub features: Option<FeatureImages>,
     /// Closest first real collision per pixel, this frame's and last frame's.
     pub first_hit: History,
     /// Motion to the previous frame in pixels: xy from the first collision, zw from features.
@@ -52,6 +54,28 @@ pub struct DenoiseInputs {
     pub camera: glam::Vec3,
     pub spp: u32,
     pub changes: Changes,
+}
+
+impl DenoiseInputs {
+    /// The surface features, or an error naming the denoiser that forgot to ask for them.
+    pub fn features(&self, denoiser: &str) -> Result<FeatureImages> {
+        self.features.ok_or_else(|| EngineError::Pass {
+            pass: denoiser.to_string(),
+            problem: "surface features were not rendered: the denoiser must return true \
+                      from uses_surface_features"
+                .into(),
+        })
+    }
+
+    /// The world positions reprojection tests against, for a motion source: 0 = the
+    /// closest first real collision (the paper's), 1 = the surface features.
+    pub fn positions(&self, denoiser: &str, motion_source: i32) -> Result<History> {
+        if motion_source == 0 {
+            Ok(self.first_hit)
+        } else {
+            Ok(self.features(denoiser)?.position)
+        }
+    }
 }
 
 pub trait Denoiser {
@@ -66,6 +90,11 @@ pub trait Denoiser {
         input: &DenoiseInputs,
     ) -> Result<ImageHandle>;
     fn destroy(&mut self, ctx: &GpuContext);
+    /// Whether the frame must render the surface-features pass for this denoiser (it
+    /// costs about as much as the path trace on lavapipe, so it runs only when used).
+    fn uses_surface_features(&self) -> bool {
+        false
+    }
 }
 
 /// Names accepted by `--denoiser`.

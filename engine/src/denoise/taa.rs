@@ -57,6 +57,10 @@ impl Taa {
 }
 
 impl Denoiser for Taa {
+    fn uses_surface_features(&self) -> bool {
+        self.motion_source == 1
+    }
+
     fn name(&self) -> &str {
         "taa"
     }
@@ -71,12 +75,9 @@ impl Denoiser for Taa {
         let size = input.size;
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
         let color = graph.history(ctx, Self::HISTORY, desc)?;
-        let (pos_cur, pos_prev) = if self.motion_source == 0 {
-            (input.first_hit.cur, input.first_hit.prev)
-        } else {
-            (input.features.position.cur, input.features.position.prev)
-        };
-        let valid = color.valid && input.first_hit.valid && input.features.position.valid;
+        let positions = input.positions(self.name(), self.motion_source)?;
+        let (pos_cur, pos_prev) = (positions.cur, positions.prev);
+        let valid = color.valid && positions.valid;
         let p = self.params;
         let push = TaaPush {
             camera: input.camera.extend(1.0),

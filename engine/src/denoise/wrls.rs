@@ -126,6 +126,10 @@ impl Wrls {
 }
 
 impl Denoiser for Wrls {
+    fn uses_surface_features(&self) -> bool {
+        self.motion_source == 1
+    }
+
     fn name(&self) -> &str {
         &self.name
     }
@@ -152,12 +156,9 @@ impl Denoiser for Wrls {
             graph.history(ctx, &format!("{n}.p2"), desc)?,
         ];
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
-        let (pos_cur, pos_prev) = if self.motion_source == 0 {
-            (input.first_hit.cur, input.first_hit.prev)
-        } else {
-            (input.features.position.cur, input.features.position.prev)
-        };
-        let valid = z.valid && input.first_hit.valid && input.features.position.valid;
+        let positions = input.positions(self.name(), self.motion_source)?;
+        let (pos_cur, pos_prev) = (positions.cur, positions.prev);
+        let valid = z.valid && positions.valid;
         let p = self.params;
         let push = WrlsUpdatePush {
             camera: input.camera.extend(1.0),

@@ -341,7 +341,11 @@ impl Renderer {
             (&self.ctx, &mut self.graph, &self.passes, self.settings.size);
 
         // features → path trace → motion → each denoiser on the same noisy frame.
-        let features = passes.features.add(ctx, graph, &mut frame, &scene, size)?;
+        let features = if self.denoisers.iter().any(|d| d.uses_surface_features()) {
+            Some(passes.features.add(ctx, graph, &mut frame, &scene, size)?)
+        } else {
+            None
+        };
         let noisy = passes.path_trace.add(
             ctx,
             graph,
@@ -358,7 +362,7 @@ impl Renderer {
             &mut frame,
             scene.uniforms,
             noisy.first_hit.cur,
-            features.position.cur,
+            features.map(|f| f.position.cur),
             size,
         )?;
         let input = DenoiseInputs {
