@@ -3,7 +3,6 @@
 //! profile (per-pass GPU timing), scenes (the built-in scenes).
 
 mod capture;
-mod output;
 mod profile;
 mod setup;
 

@@ -119,7 +119,11 @@ fn henyey_greenstein_white_furnace_conserves_energy() {
     };
     let volume = constant_volume(8, 1.0);
     let mut r = renderer(context(), s, &volume, &["none"]);
-    let inputs = inputs(front_camera(3.0, 30.0), vec![environment(1.0)], constant_lut(1.0, 1.0));
+    let inputs = inputs(
+        front_camera(3.0, 30.0),
+        vec![environment(1.0)],
+        constant_lut(1.0, 1.0),
+    );
     let m = mean_rgb(&r.reference(&inputs, 2048, 4).expect("reference render"));
     for c in m {
         assert!((c - 1.0).abs() < 0.01, "HG furnace mean {m:?}, expected 1");
@@ -145,7 +149,10 @@ fn emissive_slab_matches_the_emission_absorption_solution() {
     let inputs = inputs(front_camera(3.0, 2.0), vec![], lut);
     let l = mean_rgb(&r.reference(&inputs, 4096, 4).expect("reference render"))[0];
     let expected = 2.0 * (1.0 - (-1.5f64).exp());
-    assert!(((l - expected) / expected).abs() < 0.01, "L = {l}, expected {expected}");
+    assert!(
+        ((l - expected) / expected).abs() < 0.01,
+        "L = {l}, expected {expected}"
+    );
     assert_validation_clean();
 }
 
@@ -163,7 +170,11 @@ fn environment_map_is_z_up_equirectangular() {
             (0..w).map(move |_| [1.0 - v, 1.0 - v, 1.0 - v, 1.0])
         })
         .collect();
-    let env = EnvironmentUpload { width: w, height: h, rgba };
+    let env = EnvironmentUpload {
+        width: w,
+        height: h,
+        rgba,
+    };
     let mut s = settings(16, 1);
     s.filter_sigma = 0.0;
     s.features = PathTraceFeatures {
@@ -171,7 +182,14 @@ fn environment_map_is_z_up_equirectangular() {
         ..Default::default()
     };
     let volume = constant_volume(8, 0.0); // empty: the camera sees the environment
-    let r = dvr_engine::renderer::Renderer::new(context(), s, &volume, Some(&env), &["none"], LUT as u32);
+    let r = dvr_engine::renderer::Renderer::new(
+        context(),
+        s,
+        &volume,
+        Some(&env),
+        &["none"],
+        LUT as u32,
+    );
     let mut r = r.expect("renderer");
     let light = dvr_engine::renderer::uniforms::GpuLight {
         position_kind: glam::Vec4::new(0.0, 0.0, 0.0, LIGHT_ENV),
@@ -186,10 +204,24 @@ fn environment_map_is_z_up_equirectangular() {
         60f32.to_radians(),
         1.0,
     );
-    let img = r.reference(&inputs(camera, vec![light], constant_lut(0.0, 0.0)), 4, 4).expect("render");
-    let row = |y: usize| img[y * 16..y * 16 + 16].iter().map(|p| p[0] as f64).sum::<f64>() / 16.0;
+    let img = r
+        .reference(&inputs(camera, vec![light], constant_lut(0.0, 0.0)), 4, 4)
+        .expect("render");
+    let row = |y: usize| {
+        img[y * 16..y * 16 + 16]
+            .iter()
+            .map(|p| p[0] as f64)
+            .sum::<f64>()
+            / 16.0
+    };
     let (top, middle, bottom) = (row(0), (row(7) + row(8)) / 2.0, row(15));
-    assert!((middle - 0.5).abs() < 0.02, "horizon radiance {middle}, expected 0.5");
-    assert!(top > middle + 0.1 && bottom < middle - 0.1, "top {top}, middle {middle}, bottom {bottom}");
+    assert!(
+        (middle - 0.5).abs() < 0.02,
+        "horizon radiance {middle}, expected 0.5"
+    );
+    assert!(
+        top > middle + 0.1 && bottom < middle - 0.1,
+        "top {top}, middle {middle}, bottom {bottom}"
+    );
     assert_validation_clean();
 }

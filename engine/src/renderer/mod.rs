@@ -4,6 +4,7 @@
 //! on frame N−1; timestamps and readbacks of a slot are collected when it comes round.
 
 pub mod scene_gpu;
+pub mod scene_setup;
 pub mod uniforms;
 
 use crate::denoise::{self, Changes, DenoiseInputs, Denoiser};
