@@ -20,6 +20,10 @@ use crate::graph::{BufferHandle, Frame, History, ImageHandle, RenderGraph};
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::Extent;
 
+/// Disocclusion tolerance of the shared reprojection (include/reproject.glsl): how far,
+/// in pixels, last frame's surface may land from this pixel when projected back.
+pub const REPROJECTION_TOLERANCE_PX: f32 = 1.5;
+
 /// What changed since the previous frame (drives resets of history-based methods).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Changes {

@@ -55,7 +55,7 @@ pub struct SvgfParams {
     /// Added to the albedo before demodulating: a black albedo channel amplifies the
     /// colour by at most 1/eps before filtering (and is multiplied back exactly).
     pub demod_eps: f32,
-    /// Disocclusion tolerance, relative to the distance from the camera (as `ours`).
+    /// Disocclusion tolerance in pixels (see [`super::REPROJECTION_TOLERANCE_PX`]).
     pub tolerance: f32,
 }
 
@@ -70,7 +70,7 @@ impl Default for SvgfParams {
             sigma_l: 4.0,
             luminance_eps: 1e-6,
             demod_eps: 0.01,
-            tolerance: 0.05,
+            tolerance: super::REPROJECTION_TOLERANCE_PX,
         }
     }
 }
@@ -336,7 +336,7 @@ pub mod edge {
             sigma_l: 4.0,
             luminance_eps: 1e-6,
             demod_eps: 0.01,
-            tolerance: 0.05,
+            tolerance: super::REPROJECTION_TOLERANCE_PX,
         };
 
         #[test]

@@ -18,7 +18,7 @@ pub struct TaaParams {
     pub alpha: f32,
     /// Half-size of the clip box in standard deviations of the neighbourhood.
     pub gamma: f32,
-    /// Disocclusion tolerance, relative to the distance from the camera (as `ours`).
+    /// Disocclusion tolerance in pixels (see [`super::REPROJECTION_TOLERANCE_PX`]).
     pub tolerance: f32,
 }
 
@@ -27,7 +27,7 @@ impl Default for TaaParams {
         Self {
             alpha: 0.1,
             gamma: 1.0,
-            tolerance: 0.05,
+            tolerance: super::REPROJECTION_TOLERANCE_PX,
         }
     }
 }
@@ -79,6 +79,7 @@ impl Denoiser for Taa {
         let (pos_cur, pos_prev) = (positions.cur, positions.prev);
         let valid = color.valid && positions.valid;
         let p = self.params;
+        let uniforms = input.uniforms;
         let push = TaaPush {
             camera: input.camera.extend(1.0),
             width: size.width,
@@ -95,7 +96,8 @@ impl Denoiser for Taa {
         frame.add_pass(
             "taa",
             |b| {
-                b.read(noisy)
+                b.uniform(uniforms)
+                    .read(noisy)
                     .read(motion)
                     .read(pos_cur)
                     .sampled(pos_prev)
@@ -104,6 +106,7 @@ impl Denoiser for Taa {
             },
             move |pc| {
                 let binds = [
+                    ("frame", Bind::Buffer(uniforms)),
                     ("noisy", Bind::Image(noisy)),
                     ("motion", Bind::Image(motion)),
                     ("position_cur", Bind::Image(pos_cur)),
