@@ -336,7 +336,7 @@ pub mod edge {
             sigma_l: 4.0,
             luminance_eps: 1e-6,
             demod_eps: 0.01,
-            tolerance: super::REPROJECTION_TOLERANCE_PX,
+            tolerance: crate::denoise::REPROJECTION_TOLERANCE_PX,
         };
 
         #[test]
