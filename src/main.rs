@@ -39,6 +39,11 @@ pub struct SceneArgs {
     /// Edge length of procedural volumes (phantom, cloud).
     #[arg(long, default_value_t = 128)]
     pub volume_size: u32,
+    /// Position the temporal denoisers reproject with: `first-hit` (the closest first
+    /// real collision, the paper's) or `features` (opacity-threshold surface, or the
+    /// expected first collision through semi-transparent layers).
+    #[arg(long, default_value = "first-hit", value_parser = setup::parse_motion)]
+    pub motion: dvr_engine::denoise::MotionSource,
 }
 
 #[derive(Subcommand)]

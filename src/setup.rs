@@ -4,6 +4,7 @@
 use crate::profile::PassStats;
 use crate::SceneArgs;
 use anyhow::{Context, Result};
+use dvr_engine::denoise::MotionSource;
 use dvr_engine::gpu::GpuContext;
 use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
@@ -33,6 +34,17 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// A scene opened from the command line, made ready for rendering.
+pub fn parse_motion(s: &str) -> Result<MotionSource, String> {
+    match s {
+        "first-hit" => Ok(MotionSource::FirstHit),
+        "features" => Ok(MotionSource::Features),
+        other => Err(format!(
+            "unknown motion source {other:?}; use first-hit or features"
+        )),
+    }
+}
+
+/// A scene opened from the command line, made ready for rendering.
 pub struct Setup {
     pub name: String,
     pub frames: u32,
@@ -55,7 +67,8 @@ impl Setup {
             width: args.size.0,
             height: args.size.1,
         };
-        let inner = SceneSetup::new(scene, size, args.spp, args.volume_size)?;
+        let mut inner = SceneSetup::new(scene, size, args.spp, args.volume_size)?;
+        inner.settings.motion_source = args.motion;
         Ok(Self {
             name: inner.scene.name.clone(),
             frames: inner.scene.frames,

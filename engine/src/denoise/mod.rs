@@ -24,6 +24,28 @@ use crate::passes::Extent;
 /// in pixels, last frame's surface may land from this pixel when projected back.
 pub const REPROJECTION_TOLERANCE_PX: f32 = 1.5;
 
+/// Which per-pixel world position drives motion vectors and the disocclusion test.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MotionSource {
+    /// The closest first real collision among the frame's samples (the paper's choice).
+    #[default]
+    FirstHit,
+    /// The deterministic surface features: the opacity-threshold position, or the expected
+    /// first collision through semi-transparent layers.
+    Features,
+}
+
+impl MotionSource {
+    /// The value of the shaders' MOTION_SOURCE specialisation constant.
+    pub fn spec(self) -> i32 {
+        match self {
+            MotionSource::FirstHit => 0,
+            MotionSource::Features => 1,
+        }
+    }
+}
+
 /// What changed since the previous frame (drives resets of history-based methods).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Changes {
@@ -116,18 +138,19 @@ pub const NAMES: &[&str] = &[
 ];
 
 /// Builds a denoiser by name.
-pub fn create(ctx: &GpuContext, name: &str) -> Result<Box<dyn Denoiser>> {
+pub fn create(ctx: &GpuContext, name: &str, motion: MotionSource) -> Result<Box<dyn Denoiser>> {
+    let m = motion.spec();
     Ok(match name {
         "none" => Box::new(Passthrough),
         "accum" => Box::new(Accum::new(ctx)?),
-        "taa" => Box::new(Taa::new(ctx, 0)?),
-        "svgf" => Box::new(Svgf::new(ctx, 0)?),
+        "taa" => Box::new(Taa::new(ctx, m)?),
+        "svgf" => Box::new(Svgf::new(ctx, m)?),
         n if WrlsVariant::from_name(n).is_some() => {
             let variant = WrlsVariant::from_name(n).ok_or_else(|| EngineError::Pass {
                 pass: "denoise".into(),
                 problem: format!("unknown wRLS variant {n:?}"),
             })?;
-            Box::new(Wrls::new(ctx, n, variant, 0)?)
+            Box::new(Wrls::new(ctx, n, variant, m)?)
         }
         other => {
             return Err(EngineError::Pass {

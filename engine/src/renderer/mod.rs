@@ -52,6 +52,8 @@ pub struct RenderSettings {
     /// Extinction per unit opacity (1/world unit).
     pub density_scale: f32,
     pub seed: u32,
+    /// What the temporal denoisers reproject with.
+    pub motion_source: denoise::MotionSource,
 }
 
 impl Default for RenderSettings {
@@ -71,6 +73,7 @@ impl Default for RenderSettings {
             filter_sigma: 0.5,
             density_scale: 100.0,
             seed: 1,
+            motion_source: denoise::MotionSource::FirstHit,
         }
     }
 }
@@ -201,7 +204,7 @@ impl Renderer {
         };
         let denoisers = denoisers
             .iter()
-            .map(|n| denoise::create(&ctx, n))
+            .map(|n| denoise::create(&ctx, n, settings.motion_source))
             .collect::<Result<Vec<_>>>()?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
