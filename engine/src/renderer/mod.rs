@@ -302,7 +302,7 @@ impl Renderer {
                 self.volume_dims[0] as i32,
                 self.volume_dims[1] as i32,
                 self.volume_dims[2] as i32,
-                0,
+                self.bricks.brick as i32,
             ),
             counts: glam::IVec4::new(
                 inputs.lights.len().min(MAX_LIGHTS) as i32,
