@@ -78,7 +78,23 @@ pub fn method_colour(method: &str) -> RGBColor {
         "svgf" => RGBColor(140, 86, 75),
         "taa" => RGBColor(227, 119, 194),
         "rae" => RGBColor(188, 189, 34),
-        _ => RGBColor(23, 190, 207),
+        "wrls-paper" => RGBColor(23, 190, 207),
+        "ours-fixed-lambda" => RGBColor(255, 152, 150),
+        other => {
+            // Any other method: a stable pick from a second palette, by name.
+            const MORE: [RGBColor; 6] = [
+                RGBColor(174, 199, 232),
+                RGBColor(152, 223, 138),
+                RGBColor(197, 176, 213),
+                RGBColor(196, 156, 148),
+                RGBColor(219, 219, 141),
+                RGBColor(158, 218, 229),
+            ];
+            let h = other
+                .bytes()
+                .fold(0usize, |h, b| h.wrapping_mul(31).wrapping_add(b.into()));
+            MORE[h % MORE.len()]
+        }
     }
 }
 
