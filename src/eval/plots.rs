@@ -305,15 +305,26 @@ impl Chart for SpeedPlot {
                 ))?;
             }
         }
-        // Points are labelled where they are (a legend box would hide some of them).
+        // Points are labelled where they are (a legend box would hide some of them);
+        // labels of coinciding points are stacked upwards instead of drawn over each other.
+        let mut placed: Vec<(i32, i32)> = Vec::new();
         for (method, ms, psnr) in methods {
             let c = method_colour(method);
+            let (px, py) = chart.backend_coord(&(*ms, *psnr));
+            let mut dy = -14;
+            while placed
+                .iter()
+                .any(|&(x, y)| (x - px).abs() < 80 && (y - (py + dy)).abs() < 13)
+            {
+                dy -= 13;
+            }
+            placed.push((px, py + dy));
             chart.draw_series(std::iter::once(
                 EmptyElement::at((*ms, *psnr))
                     + Circle::new((0, 0), 5, c.filled())
                     + Text::new(
                         method.clone(),
-                        (7, -14),
+                        (7, dy),
                         ("sans-serif", 13).into_font().color(&c),
                     ),
             ))?;
