@@ -26,6 +26,9 @@ pub struct ReferenceKey {
     pub frames: u32,
     pub ref_spp: u32,
     pub volume_size: u32,
+    /// FNV-1a of the SPIR-V that makes references (path tracing and accumulation), so a
+    /// change to the path tracer invalidates them.
+    pub renderer_hash: String,
 }
 
 impl ReferenceKey {
@@ -41,8 +44,21 @@ impl ReferenceKey {
             frames: scene.frames,
             ref_spp,
             volume_size,
+            renderer_hash: renderer_hash(),
         })
     }
+}
+
+/// Hash of the shaders a reference depends on.
+fn renderer_hash() -> String {
+    let mut bytes = Vec::new();
+    for (name, spirv) in dvr_engine::shaders::SHADERS {
+        if matches!(*name, "path_trace" | "accumulate") {
+            bytes.extend_from_slice(name.as_bytes());
+            bytes.extend_from_slice(spirv);
+        }
+    }
+    format!("{:016x}", fnv1a(&bytes))
 }
 
 fn fnv1a(bytes: &[u8]) -> u64 {
@@ -71,6 +87,29 @@ impl ReferenceCache {
 
     fn key_path(&self) -> PathBuf {
         self.dir.join("reference.json")
+    }
+
+    /// What differs between the stored key and this one, for the log.
+    fn change_note(&self, old: &ReferenceKey) -> String {
+        format!(
+            "reference settings changed ({}x{}, {} frames, {} spp → {}x{}, {} frames, {} spp{}), re-rendering",
+            old.width,
+            old.height,
+            old.frames,
+            old.ref_spp,
+            self.key.width,
+            self.key.height,
+            self.key.frames,
+            self.key.ref_spp,
+            match (
+                old.scene_hash != self.key.scene_hash,
+                old.renderer_hash != self.key.renderer_hash
+            ) {
+                (true, _) => ", scene edited",
+                (false, true) => ", path tracer changed",
+                _ => "",
+            }
+        )
     }
 
     pub fn exr(&self, f: u32) -> PathBuf {
@@ -108,20 +147,15 @@ impl ReferenceCache {
         if self.key_matches() {
             return Ok(None);
         }
-        let note = self.stored_key().map(|old| {
-            format!(
-                "reference settings changed ({}x{}, {} frames, {} spp → {}x{}, {} frames, {} spp{}), re-rendering",
-                old.width,
-                old.height,
-                old.frames,
-                old.ref_spp,
-                self.key.width,
-                self.key.height,
-                self.key.frames,
-                self.key.ref_spp,
-                if old.scene_hash != self.key.scene_hash { ", scene edited" } else { "" }
-            )
-        });
+        let unreadable = self.key_path().exists() && self.stored_key().is_none();
+        let note = if unreadable {
+            Some(format!(
+                "{} is unreadable or from another version of dvr, re-rendering",
+                self.key_path().display()
+            ))
+        } else {
+            self.stored_key().map(|old| self.change_note(&old))
+        };
         for entry in std::fs::read_dir(&self.dir)
             .with_context(|| format!("reading {}", self.dir.display()))?
         {
@@ -227,5 +261,15 @@ mod tests {
         assert!(note.contains("16 spp → 8x8, 3 frames, 32 spp"), "{note}");
         assert!(!other.exr(0).is_file() && !other.png(1).is_file());
         assert!(other.key_matches() && !cache.key_matches());
+        // A key file this version cannot read (e.g. an older format) also re-renders.
+        std::fs::write(
+            tmp.path().join("reference/reference.json"),
+            "{\"scene\": 1}",
+        )
+        .unwrap();
+        assert_eq!(other.missing(), vec![0, 1, 2]);
+        let note = other.prepare().unwrap().expect("a note");
+        assert!(note.contains("unreadable"), "{note}");
+        assert!(other.key_matches());
     }
 }
