@@ -230,11 +230,13 @@ impl Chart for MetricPlot {
     }
 }
 
+/// (method, GPU ms, PSNR)
+type MethodPoint = (String, f64, f64);
+
 /// Mean GPU ms per frame vs mean PSNR per method, with the accumulation curve.
 struct SpeedPlot {
     title: String,
-    /// (method, ms, psnr)
-    methods: Vec<(String, f64, f64)>,
+    methods: Vec<MethodPoint>,
     /// (spp, ms, psnr)
     baseline: Vec<(u32, f64, f64)>,
 }
@@ -246,8 +248,7 @@ impl Chart for SpeedPlot {
     ) -> std::result::Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
         root.fill(&WHITE)?;
         let ok = |ms: f64, psnr: f64| ms.is_finite() && ms > 0.0 && psnr.is_finite();
-        let methods: Vec<&(String, f64, f64)> =
-            self.methods.iter().filter(|m| ok(m.1, m.2)).collect();
+        let methods: Vec<&MethodPoint> = self.methods.iter().filter(|m| ok(m.1, m.2)).collect();
         let baseline: Vec<&(u32, f64, f64)> =
             self.baseline.iter().filter(|b| ok(b.1, b.2)).collect();
         let xs = methods
@@ -305,26 +306,37 @@ impl Chart for SpeedPlot {
                 ))?;
             }
         }
-        // Points are labelled where they are (a legend box would hide some of them);
-        // labels of coinciding points are stacked upwards instead of drawn over each other.
+        // Points are labelled to their right (a legend box would hide some of them).
+        // Labels of nearby points are laid out top to bottom without overlapping, with a
+        // leader line when a label had to move away from its point.
+        let mut points: Vec<(&MethodPoint, (i32, i32))> = methods
+            .iter()
+            .map(|m| (*m, chart.backend_coord(&(m.1, m.2))))
+            .collect();
+        points.sort_by_key(|(_, (_, py))| *py);
         let mut placed: Vec<(i32, i32)> = Vec::new();
-        for (method, ms, psnr) in methods {
+        for ((method, ms, psnr), (px, py)) in points {
             let c = method_colour(method);
-            let (px, py) = chart.backend_coord(&(*ms, *psnr));
-            let mut dy = -14;
-            while placed
-                .iter()
-                .any(|&(x, y)| (x - px).abs() < 80 && (y - (py + dy)).abs() < 13)
-            {
-                dy -= 13;
+            let mut top = py - 7;
+            for &(x, y) in &placed {
+                if (x - px).abs() < 90 {
+                    top = top.max(y + 13);
+                }
             }
-            placed.push((px, py + dy));
+            placed.push((px, top));
+            let dy = top - py;
+            let leader = if dy > 4 {
+                vec![(4, 2), (10, dy + 7)]
+            } else {
+                Vec::new()
+            };
             chart.draw_series(std::iter::once(
                 EmptyElement::at((*ms, *psnr))
                     + Circle::new((0, 0), 5, c.filled())
+                    + PathElement::new(leader, c.stroke_width(1))
                     + Text::new(
                         method.clone(),
-                        (7, dy),
+                        (11, dy),
                         ("sans-serif", 13).into_font().color(&c),
                     ),
             ))?;
