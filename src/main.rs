@@ -1,8 +1,10 @@
 //! `dvr`: real-time Monte Carlo direct volume rendering with temporal denoising.
 //! Subcommands: capture (offscreen sequences), reference (high-sample references),
-//! profile (per-pass GPU timing), scenes (the built-in scenes).
+//! eval (denoisers against references: metrics, plots, HTML), profile (per-pass GPU
+//! timing), scenes (the built-in scenes).
 
 mod capture;
+mod eval;
 mod profile;
 mod setup;
 
@@ -70,6 +72,9 @@ enum Command {
         #[arg(long, default_value = "out/reference")]
         out: PathBuf,
     },
+    /// Evaluate denoisers against cached references: metrics.csv, summary.csv, plots
+    /// and an HTML results page.
+    Eval(eval::EvalArgs),
     /// Per-pass GPU timings over many frames: table, JSON and Chrome trace.
     Profile {
         #[command(flatten)]
@@ -133,6 +138,7 @@ fn run(cli: Cli) -> Result<()> {
             ref_spp,
             out,
         } => capture::reference(&scene, ref_spp, &out),
+        Command::Eval(args) => eval::eval(&args),
         Command::Profile {
             scene,
             denoiser,
