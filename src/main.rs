@@ -1,8 +1,10 @@
 //! `dvr`: real-time Monte Carlo direct volume rendering with temporal denoising.
-//! Subcommands: capture (offscreen sequences), reference (high-sample references),
-//! profile (per-pass GPU timing), scenes (the built-in scenes).
+//! Subcommands: explore (the interactive window), capture (offscreen sequences),
+//! reference (high-sample references), profile (per-pass GPU timing), scenes (the
+//! built-in scenes).
 
 mod capture;
+mod explore;
 mod output;
 mod profile;
 mod setup;
@@ -44,6 +46,9 @@ pub struct SceneArgs {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Open a window: the path tracer and a denoiser live, with an orbit camera, a
+    /// transfer-function editor, light and render controls and per-pass GPU timing.
+    Explore(explore::ExploreArgs),
     /// Render an animation offscreen with one or more denoisers: EXR + PNG per frame,
     /// per-pass GPU timings and an HTML page.
     Capture {
@@ -119,6 +124,7 @@ fn error_chain(e: &anyhow::Error) -> String {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
+        Command::Explore(args) => explore::run(args),
         Command::Capture {
             scene,
             denoiser,

@@ -1,6 +1,8 @@
 //! From a scene name or file to what the renderer takes: the volume as a texture upload
 //! with its brick ranges, the lights as GPU structs, the transfer function(s) as LUTs,
-//! and the render settings the scene asks for.
+//! and the render settings the scene asks for. The explorer edits the same scene state
+//! interactively and turns it into renderer inputs through the same functions
+//! ([`gpu_light`], [`frame_inputs`], [`path_trace_features`]).
 
 use crate::profile::PassStats;
 use crate::SceneArgs;
@@ -9,12 +11,14 @@ use dvr_engine::passes::path_trace::{Estimator, PathTraceFeatures, Phase};
 use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::{EnvironmentUpload, LutUpload, VolumeUpload};
 use dvr_engine::renderer::uniforms::{self, GpuLight};
+use dvr_engine::gpu::GpuContext;
 use dvr_engine::renderer::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
-use dvr_engine::scene::{self, EnvSource, Light, Scene, VolumeSource};
+use dvr_engine::scene::{self, Camera, EnvSource, Light, Scene, VolumeSource};
 use dvr_engine::transfer::{TfLut, LUT_SIZE};
 use dvr_engine::volume::Volume;
 use glam::{Vec3, Vec4};
 use std::path::Path;
+use std::sync::Arc;
 
 /// The scene `dvr` renders when none is named.
 pub const DEFAULT_SCENE: &str = "phantom/orbit";
@@ -37,6 +41,9 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
+/// Bins of [`Setup::histogram`].
+pub const HISTOGRAM_BINS: usize = 128;
+
 pub struct Setup {
     pub name: String,
     pub scene: Scene,
@@ -44,6 +51,9 @@ pub struct Setup {
     pub volume: VolumeUpload,
     pub environment: Option<EnvironmentUpload>,
     pub frames: u32,
+    /// Voxel counts of the normalised density in [`HISTOGRAM_BINS`] bins (the
+    /// explorer's transfer-function editor draws it).
+    pub histogram: Vec<u32>,
     lut_a: TfLut,
     lut_b: Option<TfLut>,
 }
@@ -52,7 +62,8 @@ fn v3(d: glam::DVec3) -> Vec3 {
     d.as_vec3()
 }
 
-fn gpu_light(l: &Light) -> GpuLight {
+/// A scene light as the path tracer's uniform block holds it.
+pub fn gpu_light(l: &Light) -> GpuLight {
     match l {
         Light::Point(p) => GpuLight {
             position_kind: v3(p.position).extend(uniforms::LIGHT_POINT),
@@ -106,14 +117,50 @@ fn load_environment(lights: &[Light]) -> Result<Option<EnvironmentUpload>> {
     Ok(None)
 }
 
+/// What the path tracer is specialised for, from a scene's render settings and lights.
+pub fn path_trace_features(r: &scene::RenderSettings, lights: &[Light]) -> PathTraceFeatures {
+    PathTraceFeatures {
+        estimator: match r.estimator {
+            scene::Estimator::Delta => Estimator::Delta,
+            scene::Estimator::RayMarch => Estimator::RayMarch,
+        },
+        phase: match r.phase {
+            scene::Phase::Isotropic => Phase::Isotropic,
+            scene::Phase::Hg => Phase::Hg,
+            scene::Phase::Hybrid => Phase::Hybrid,
+        },
+        emission: r.emission,
+        environment_map: lights.iter().any(
+            |l| matches!(l, Light::Environment(e) if matches!(e.source, EnvSource::Map { .. })),
+        ),
+    }
+}
+
+/// The renderer's inputs for one camera, light set and transfer function: the one
+/// place scene state becomes [`FrameInputs`] (capture and the explorer both use it).
+pub fn frame_inputs(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -> FrameInputs {
+    let c = camera;
+    FrameInputs {
+        camera: CameraMatrices::look_at(c.position, c.target, c.up, c.fov_y, aspect),
+        lights: lights.iter().map(gpu_light).collect(),
+        lut: LutUpload::from(lut),
+    }
+}
+
 impl Setup {
     pub fn new(args: &SceneArgs) -> Result<Self> {
-        let mut scene = Scene::open(&args.scene).with_context(|| {
+        let scene = Scene::open(&args.scene).with_context(|| {
             format!(
                 "opening scene {:?} (built-in scenes: `dvr scenes`)",
                 args.scene
             )
         })?;
+        Self::from_scene(scene, args)
+    }
+
+    /// A scene already opened (and perhaps edited, e.g. given another volume); `args`
+    /// supplies the size, frame count, spp and procedural volume size.
+    pub fn from_scene(mut scene: Scene, args: &SceneArgs) -> Result<Self> {
         if let Some(n) = args.frames {
             scene = scene.with_frames(n)?;
         }
@@ -139,21 +186,7 @@ impl Setup {
         if spp == 0 {
             bail!("--spp must be at least 1");
         }
-        let features = PathTraceFeatures {
-            estimator: match r.estimator {
-                scene::Estimator::Delta => Estimator::Delta,
-                scene::Estimator::RayMarch => Estimator::RayMarch,
-            },
-            phase: match r.phase {
-                scene::Phase::Isotropic => Phase::Isotropic,
-                scene::Phase::Hg => Phase::Hg,
-                scene::Phase::Hybrid => Phase::Hybrid,
-            },
-            emission: r.emission,
-            environment_map: scene.lights.iter().any(
-                |l| matches!(l, Light::Environment(e) if matches!(e.source, EnvSource::Map { .. })),
-            ),
-        };
+        let features = path_trace_features(r, &scene.lights);
         let settings = RenderSettings {
             size: Extent {
                 width: args.size.0,
@@ -174,6 +207,7 @@ impl Setup {
         Ok(Self {
             name: scene.name.clone(),
             frames: scene.frames,
+            histogram: volume.histogram(HISTOGRAM_BINS),
             volume: VolumeUpload::from_volume(&volume),
             environment,
             settings,
@@ -192,8 +226,12 @@ impl Setup {
     }
 
     pub fn renderer(&self, denoisers: &[&str]) -> Result<Renderer> {
-        let ctx = dvr_engine::gpu::GpuContext::headless()?;
-        Ok(Renderer::new(
+        self.renderer_on(Arc::new(GpuContext::headless()?), denoisers)
+    }
+
+    /// A renderer on a context the caller keeps (the explorer's, with its surface).
+    pub fn renderer_on(&self, ctx: Arc<GpuContext>, denoisers: &[&str]) -> Result<Renderer> {
+        Ok(Renderer::new_shared(
             ctx,
             self.settings.clone(),
             &self.volume,
@@ -206,20 +244,16 @@ impl Setup {
     /// The renderer's inputs for animation frame `f`.
     pub fn inputs(&self, f: u32) -> FrameInputs {
         let state = self.scene.frame_state(f);
-        let c = &state.camera;
         let aspect = self.width() as f32 / self.height() as f32;
-        let camera = CameraMatrices::look_at(c.position, c.target, c.up, c.fov_y, aspect);
+        let blended;
         let lut = match &self.lut_b {
             Some(b) if state.tf_blend > 0.0 => {
-                LutUpload::from(&TfLut::lerp(&self.lut_a, b, state.tf_blend))
+                blended = TfLut::lerp(&self.lut_a, b, state.tf_blend);
+                &blended
             }
-            _ => LutUpload::from(&self.lut_a),
+            _ => &self.lut_a,
         };
-        FrameInputs {
-            camera,
-            lights: state.lights.iter().map(gpu_light).collect(),
-            lut,
-        }
+        frame_inputs(&state.camera, aspect, &state.lights, lut)
     }
 }
 

@@ -23,6 +23,9 @@ pub struct DeviceInfo {
     pub max_memory_allocation_size: u64,
     pub max_storage_buffer_range: u32,
     pub max_push_constants_size: u32,
+    /// `shaderStorageImageWriteWithoutFormat` (enabled when present): the present pass
+    /// writes swapchain images of whatever format the surface offers.
+    pub storage_write_without_format: bool,
 }
 
 /// Instance, device, queue and allocator: everything that lives as long as the program.
@@ -134,9 +137,13 @@ impl GpuContext {
             .shader_storage_image_write_without_format(
                 supported.shader_storage_image_write_without_format == vk::TRUE,
             );
+        // dynamicRendering (core in 1.3, always supported) lets the explorer's UI draw
+        // into a swapchain image without a render pass, so the render graph keeps
+        // every layout transition.
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
             .synchronization2(true)
-            .maintenance4(true);
+            .maintenance4(true)
+            .dynamic_rendering(true);
         let priorities = [1.0f32];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
@@ -292,6 +299,9 @@ fn pick_device(
             max_memory_allocation_size: max_allocation(instance, p),
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             max_push_constants_size: props.limits.max_push_constants_size,
+            storage_write_without_format: unsafe { instance.get_physical_device_features(p) }
+                .shader_storage_image_write_without_format
+                == vk::TRUE,
         };
         candidates.push((p, info, family as u32));
     }
