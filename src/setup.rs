@@ -7,11 +7,11 @@
 use crate::profile::PassStats;
 use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
+use dvr_engine::gpu::GpuContext;
 use dvr_engine::passes::path_trace::{Estimator, PathTraceFeatures, Phase};
 use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::{EnvironmentUpload, LutUpload, VolumeUpload};
 use dvr_engine::renderer::uniforms::{self, GpuLight};
-use dvr_engine::gpu::GpuContext;
 use dvr_engine::renderer::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
 use dvr_engine::scene::{self, Camera, EnvSource, Light, Scene, VolumeSource};
 use dvr_engine::transfer::{TfLut, LUT_SIZE};

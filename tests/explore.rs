@@ -154,7 +154,10 @@ fn mean_abs_diff(a: &Shot, b: &Shot, w: u32, h: u32) -> f64 {
     for y in 0..h {
         for x in 0..w {
             let (p, q) = (a.px(x, y), b.px(x, y));
-            sum += (0..3).map(|c| (p[c] as f64 - q[c] as f64).abs()).sum::<f64>() / 3.0;
+            sum += (0..3)
+                .map(|c| (p[c] as f64 - q[c] as f64).abs())
+                .sum::<f64>()
+                / 3.0;
         }
     }
     sum / (w * h) as f64
@@ -180,7 +183,10 @@ fn explore_shot(x: &Xvfb, dir: &Path, name: &str, extra: &[&str]) -> Shot {
     let out = dvr(Some(&x.display), &args, dir);
     assert_clean(&out);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("ms/frame"), "no frame-rate summary:\n{stdout}");
+    assert!(
+        stdout.contains("ms/frame"),
+        "no frame-rate summary:\n{stdout}"
+    );
     Shot::open(&shot)
 }
 
@@ -237,7 +243,10 @@ fn window_shows_the_volume_and_the_panel_and_a_scripted_drag_turns_it() {
     // A scripted drag at frame 5 orbits the camera by 1.5 rad: a different view.
     let b = explore_shot(&x, dir.path(), "b.png", &["--script", "orbit:150,20@5"]);
     let d = mean_abs_diff(&a, &b, SIZE, SIZE);
-    assert!(d > 8.0, "the drag barely changed the view (mean |Δ| = {d:.2})");
+    assert!(
+        d > 8.0,
+        "the drag barely changed the view (mean |Δ| = {d:.2})"
+    );
 }
 
 #[test]
@@ -296,7 +305,10 @@ fn a_recorded_session_replays_to_the_same_frames() {
         let b = Shot::open(&cap.join("ours").join(&name));
         assert_eq!((a.width, a.height), (64, 64));
         let d = mean_abs_diff(&a, &b, 64, 64);
-        assert!(d < 0.5, "frame {f}: replay differs from the session (mean |Δ| = {d:.3})");
+        assert!(
+            d < 0.5,
+            "frame {f}: replay differs from the session (mean |Δ| = {d:.3})"
+        );
     }
     // The camera moved, so the frames before and after the drag differ.
     let first = Shot::open(&rec.join("frames").join("0000.png"));
@@ -311,5 +323,8 @@ fn without_a_display_it_says_how_to_get_one() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(!err.contains("panicked"), "{err}");
-    assert!(err.contains("needs a display") && err.contains("Xvfb :99"), "{err}");
+    assert!(
+        err.contains("needs a display") && err.contains("Xvfb :99"),
+        "{err}"
+    );
 }

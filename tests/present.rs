@@ -16,7 +16,12 @@ use gpu_allocator::MemoryLocation;
 
 fn read(ctx: &GpuContext, graph: &mut RenderGraph, image: ImageHandle, n: usize) -> Vec<[f32; 4]> {
     let buf = graph
-        .buffer(ctx, "test.readback", (n * 16) as u64, MemoryLocation::GpuToCpu)
+        .buffer(
+            ctx,
+            "test.readback",
+            (n * 16) as u64,
+            MemoryLocation::GpuToCpu,
+        )
         .expect("buffer");
     let mut f = Frame::new();
     f.add_pass(
@@ -58,10 +63,24 @@ fn present(
         )
         .expect("image");
     let mut f = Frame::new();
-    add_upload(&ctx, &mut graph, &mut f, "upload_left", l, bytemuck::cast_slice(left))
-        .expect("upload");
-    add_upload(&ctx, &mut graph, &mut f, "upload_right", r, bytemuck::cast_slice(right))
-        .expect("upload");
+    add_upload(
+        &ctx,
+        &mut graph,
+        &mut f,
+        "upload_left",
+        l,
+        bytemuck::cast_slice(left),
+    )
+    .expect("upload");
+    add_upload(
+        &ctx,
+        &mut graph,
+        &mut f,
+        "upload_right",
+        r,
+        bytemuck::cast_slice(right),
+    )
+    .expect("upload");
     pass.add(&mut f, l, r, size, target, target_size, &layout);
     ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
         .expect("submit");
@@ -74,7 +93,12 @@ fn present(
     let mut pass = pass;
     pass.destroy(&ctx);
     graph.destroy(&ctx);
-    assert_eq!(validation::message_count(), 0, "{:?}", validation::messages());
+    assert_eq!(
+        validation::message_count(),
+        0,
+        "{:?}",
+        validation::messages()
+    );
     out
 }
 
@@ -90,10 +114,7 @@ fn glsl_tone_map_matches_the_rust_one_on_a_ramp() {
     }
     values.extend([0.18, 1.0, 7.24, 1e4, -2.0, f32::NAN, f32::INFINITY]);
     let w = values.len() as u32;
-    let pixels: Vec<[f32; 4]> = values
-        .iter()
-        .map(|&v| [v, 0.5 * v, 2.0 * v, 1.0])
-        .collect();
+    let pixels: Vec<[f32; 4]> = values.iter().map(|&v| [v, 0.5 * v, 2.0 * v, 1.0]).collect();
     let size = Extent {
         width: w,
         height: 1,

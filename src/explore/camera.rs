@@ -53,7 +53,10 @@ impl OrbitCamera {
         let h = offset.dot(up);
         let planar = offset - up * h;
         let yaw = planar.dot(e2).atan2(planar.dot(e1));
-        let pitch = (h / distance).clamp(-1.0, 1.0).asin().clamp(-PITCH_LIMIT, PITCH_LIMIT);
+        let pitch = (h / distance)
+            .clamp(-1.0, 1.0)
+            .asin()
+            .clamp(-PITCH_LIMIT, PITCH_LIMIT);
         let home = (spec.target, distance, yaw, pitch, spec.fov_y_degrees);
         Self {
             target: spec.target,

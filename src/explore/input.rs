@@ -265,6 +265,11 @@ mod tests {
         }
         b.orbit(30.0, 0.0);
         assert_eq!(a, b);
-        assert!(!apply_to_camera(&mut a, &Command::Key(Key::Help), 256.0, |_| {}));
+        assert!(!apply_to_camera(
+            &mut a,
+            &Command::Key(Key::Help),
+            256.0,
+            |_| {}
+        ));
     }
 }

@@ -125,8 +125,12 @@ pub fn run(args: ExploreArgs) -> Result<()> {
     if !has_display() {
         bail!("{NO_DISPLAY} (neither DISPLAY nor WAYLAND_DISPLAY is set)");
     }
-    let mut scene = Scene::open(&args.scene)
-        .with_context(|| format!("opening scene {:?} (built-in scenes: `dvr scenes`)", args.scene))?;
+    let mut scene = Scene::open(&args.scene).with_context(|| {
+        format!(
+            "opening scene {:?} (built-in scenes: `dvr scenes`)",
+            args.scene
+        )
+    })?;
     if let Some(path) = &args.volume {
         scene.volume.source = VolumeSource::File {
             path: path.clone(),
@@ -270,10 +274,7 @@ impl Explorer {
         let (w, h) = self.args.size;
         let attributes = Window::default_attributes()
             .with_title(format!("dvr explore — {}", self.setup.name))
-            .with_inner_size(PhysicalSize::new(
-                w + (PANEL_WIDTH * ppp).round() as u32,
-                h,
-            ));
+            .with_inner_size(PhysicalSize::new(w + (PANEL_WIDTH * ppp).round() as u32, h));
         let window = Arc::new(
             event_loop
                 .create_window(attributes)
@@ -295,10 +296,9 @@ impl Explorer {
             device_extensions: vec![ash::khr::swapchain::NAME.as_ptr()],
             ..Default::default()
         })?);
-        let surface = unsafe {
-            ash_window::create_surface(&ctx.entry, &ctx.instance, display, handle, None)
-        }
-        .context("creating the window's Vulkan surface")?;
+        let surface =
+            unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, handle, None) }
+                .context("creating the window's Vulkan surface")?;
         let size = window.inner_size();
         let swapchain = Swapchain::new(
             &ctx,
@@ -310,7 +310,9 @@ impl Explorer {
             self.model.vsync,
         )?;
         let overlay = EguiOverlay::new(&ctx, swapchain.format)?;
-        let renderer = self.setup.renderer_on(Arc::clone(&ctx), &self.denoiser_list())?;
+        let renderer = self
+            .setup
+            .renderer_on(Arc::clone(&ctx), &self.denoiser_list())?;
         self.ui.stats.device = ctx.info.name.clone();
         self.ui.stats.present_mode = format!("{:?}", swapchain.present_mode);
         let max_texture_side = 4096;
@@ -335,7 +337,12 @@ impl Explorer {
     /// The renderer's denoisers: the shown one, and the right-hand one when split.
     fn denoiser_list(&self) -> Vec<&str> {
         let mut v = vec![self.model.left.as_str()];
-        if let Some(r) = self.model.right.as_deref().filter(|r| *r != self.model.left) {
+        if let Some(r) = self
+            .model
+            .right
+            .as_deref()
+            .filter(|r| *r != self.model.left)
+        {
             v.push(r);
         }
         v
@@ -542,7 +549,11 @@ impl Explorer {
             width: vw,
             height: vh,
         };
+        let mut finished = Vec::new();
         if renderer.settings.size != view {
+            // The graph reallocates its images at the new size: let the frames in
+            // flight that use the old ones finish first.
+            finished = renderer.flush()?;
             renderer.settings.size = view;
         }
         self.ui.stats.render_size = (vw, vh);
@@ -590,7 +601,7 @@ impl Explorer {
             rec.push(spec, &self.model.lights, &self.model.tf, &self.model.left)?;
         }
         self.frame += 1;
-        if let Some(r) = result {
+        for r in finished.into_iter().chain(result) {
             self.completed(r)?;
         }
         if self.args.frames.is_some_and(|n| self.frame >= n) {
@@ -706,8 +717,14 @@ fn save_screenshot(path: &Path, s: &Screenshot) -> Result<()> {
         .chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])
         .collect();
-    image::save_buffer(path, &rgb, s.width, s.height, image::ExtendedColorType::Rgb8)
-        .with_context(|| format!("writing {}", path.display()))
+    image::save_buffer(
+        path,
+        &rgb,
+        s.width,
+        s.height,
+        image::ExtendedColorType::Rgb8,
+    )
+    .with_context(|| format!("writing {}", path.display()))
 }
 
 impl ApplicationHandler for Explorer {

@@ -44,8 +44,8 @@ impl Recorder {
             std::fs::create_dir_all(&d).with_context(|| format!("creating {}", d.display()))?;
         }
         let path = dir.join("state.jsonl");
-        let log = std::fs::File::create(&path)
-            .with_context(|| format!("creating {}", path.display()))?;
+        let log =
+            std::fs::File::create(&path).with_context(|| format!("creating {}", path.display()))?;
         Ok(Self {
             dir: dir.to_path_buf(),
             frames: Vec::new(),
@@ -201,7 +201,8 @@ pub fn session_scene(
             });
         }
         for (index, (a, b)) in prev.lights.iter().zip(&cur.lights).enumerate() {
-            let changed = |x: Option<glam::DVec3>, y: Option<glam::DVec3>| (x != y).then_some(y).flatten();
+            let changed =
+                |x: Option<glam::DVec3>, y: Option<glam::DVec3>| (x != y).then_some(y).flatten();
             let key = LightKey {
                 index,
                 frame,
@@ -235,7 +236,8 @@ pub fn session_scene(
         });
     }
     s.animation = animation;
-    s.validate().context("the recorded session is not a valid scene")?;
+    s.validate()
+        .context("the recorded session is not a valid scene")?;
     Ok(s)
 }
 
@@ -273,7 +275,7 @@ mod tests {
         let s = session_scene(
             &b,
             &frames,
-            &[b.tf_a.clone()],
+            std::slice::from_ref(&b.tf_a),
             |i| format!("tf/{i:03}.toml"),
             64,
         )

@@ -69,10 +69,7 @@ pub fn move_point(tf: &mut TransferFunction, i: usize, density: f32, opacity: f3
     } else {
         tf.points[i - 1].density + MIN_GAP
     };
-    let hi = tf
-        .points
-        .get(i + 1)
-        .map_or(1.0, |n| n.density - MIN_GAP);
+    let hi = tf.points.get(i + 1).map_or(1.0, |n| n.density - MIN_GAP);
     let p = &mut tf.points[i];
     p.density = density.clamp(lo, hi.max(lo));
     p.opacity = opacity.clamp(0.0, 1.0);
@@ -197,14 +194,20 @@ pub fn show(ui: &mut egui::Ui, ed: &mut TfEditor, tf: &mut TransferFunction, his
         let d = (k as f32 + 0.5) / steps as f32;
         let s = tf.sample(d);
         let r = Rect::from_min_max(
-            egui::pos2(strip.left() + strip.width() * k as f32 / steps as f32, strip.top()),
+            egui::pos2(
+                strip.left() + strip.width() * k as f32 / steps as f32,
+                strip.top(),
+            ),
             egui::pos2(
                 strip.left() + strip.width() * (k + 1) as f32 / steps as f32,
                 strip.bottom(),
             ),
         );
-        ui.painter()
-            .rect_filled(r, 0.0, colour32(s.diffuse.map(|c| c * s.opacity.sqrt()), 1.0));
+        ui.painter().rect_filled(
+            r,
+            0.0,
+            colour32(s.diffuse.map(|c| c * s.opacity.sqrt()), 1.0),
+        );
     }
     // The selected point's properties.
     if let Some(i) = ed.selected.filter(|&i| i < tf.points.len()) {

@@ -8,9 +8,7 @@ use super::input::SHORTCUTS;
 use super::tf_editor::{self, TfEditor};
 use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::renderer::uniforms::MAX_LIGHTS;
-use dvr_engine::scene::{
-    self, AreaLight, EnvSource, EnvironmentLight, Facing, Light, PointLight,
-};
+use dvr_engine::scene::{self, AreaLight, EnvSource, EnvironmentLight, Facing, Light, PointLight};
 use dvr_engine::transfer::TransferFunction;
 use egui::{Color32, RichText};
 use glam::{DVec2, DVec3};
@@ -166,7 +164,11 @@ fn panel(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model, requests: &m
         if ui.small_button("?").on_hover_text("help (H)").clicked() {
             state.show_help = !state.show_help;
         }
-        if ui.small_button("📷").on_hover_text("screenshot (F12)").clicked() {
+        if ui
+            .small_button("📷")
+            .on_hover_text("screenshot (F12)")
+            .clicked()
+        {
             requests.screenshot = true;
         }
     });
@@ -320,7 +322,10 @@ fn lights(ui: &mut egui::Ui, state: &UiState, lights: &mut Vec<Light>) {
                                 // One environment at most.
                                 let allowed = k != 2 || !has_env || current == 2;
                                 if ui
-                                    .add_enabled(allowed, egui::Button::selectable(k == current, *name))
+                                    .add_enabled(
+                                        allowed,
+                                        egui::Button::selectable(k == current, *name),
+                                    )
                                     .clicked()
                                     && k != current
                                 {
@@ -382,11 +387,14 @@ fn lights(ui: &mut egui::Ui, state: &UiState, lights: &mut Vec<Light>) {
     }
     ui.add_enabled_ui(!state.recording && lights.len() < MAX_LIGHTS, |ui| {
         if ui.button("add point light").clicked() {
-            lights.push(convert(&Light::Point(PointLight {
-                position: DVec3::new(-0.9, 1.1, 1.0),
-                colour: DVec3::ONE,
-                intensity: 20.0,
-            }), 0));
+            lights.push(convert(
+                &Light::Point(PointLight {
+                    position: DVec3::new(-0.9, 1.1, 1.0),
+                    colour: DVec3::ONE,
+                    intensity: 20.0,
+                }),
+                0,
+            ));
         }
     });
 }
@@ -412,7 +420,11 @@ fn render_controls(ui: &mut egui::Ui, state: &UiState, model: &mut Model) {
         egui::ComboBox::from_id_salt("phase")
             .selected_text(format!("{:?}", r.phase).to_lowercase())
             .show_ui(ui, |ui| {
-                for p in [scene::Phase::Isotropic, scene::Phase::Hg, scene::Phase::Hybrid] {
+                for p in [
+                    scene::Phase::Isotropic,
+                    scene::Phase::Hg,
+                    scene::Phase::Hybrid,
+                ] {
                     ui.selectable_value(&mut r.phase, p, format!("{p:?}").to_lowercase());
                 }
             });
@@ -427,9 +439,7 @@ fn render_controls(ui: &mut egui::Ui, state: &UiState, model: &mut Model) {
     );
     ui.checkbox(&mut model.vsync, "vsync")
         .on_hover_text(format!("present mode: {}", state.stats.present_mode));
-    ui.label(
-        RichText::new("estimator and phase rebuild the renderer").small(),
-    );
+    ui.label(RichText::new("estimator and phase rebuild the renderer").small());
 }
 
 fn timing(ui: &mut egui::Ui, stats: &Stats) {
@@ -512,7 +522,9 @@ fn help(ctx: &egui::Context, open: &mut bool) {
                 }
             });
             ui.separator();
-            ui.label("Transfer function: drag points; double-click adds one, right-click removes it.");
+            ui.label(
+                "Transfer function: drag points; double-click adds one, right-click removes it.",
+            );
         });
 }
 

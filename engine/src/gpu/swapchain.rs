@@ -282,8 +282,8 @@ impl Swapchain {
         self.format = format.format;
         self.extent = extent;
         self.present_mode = present_mode;
-        self.images = unsafe { self.loader.get_swapchain_images(swapchain) }
-            .vk("vkGetSwapchainImagesKHR")?;
+        self.images =
+            unsafe { self.loader.get_swapchain_images(swapchain) }.vk("vkGetSwapchainImagesKHR")?;
         for (i, &image) in self.images.iter().enumerate() {
             let view_info = vk::ImageViewCreateInfo::default()
                 .image(image)
@@ -451,7 +451,10 @@ mod tests {
         let all = [P::FIFO, P::IMMEDIATE, P::MAILBOX];
         assert_eq!(choose_present_mode(&all, true), P::FIFO);
         assert_eq!(choose_present_mode(&all, false), P::MAILBOX);
-        assert_eq!(choose_present_mode(&[P::FIFO, P::IMMEDIATE], false), P::IMMEDIATE);
+        assert_eq!(
+            choose_present_mode(&[P::FIFO, P::IMMEDIATE], false),
+            P::IMMEDIATE
+        );
         assert_eq!(choose_present_mode(&[P::FIFO], false), P::FIFO);
     }
 

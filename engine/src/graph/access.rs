@@ -345,7 +345,10 @@ mod tests {
         let present = transition(&mut s, Access::Present, true).expect("final transition");
         assert_eq!(present.old_layout, L::TRANSFER_SRC_OPTIMAL);
         assert_eq!(present.new_layout, L::PRESENT_SRC_KHR);
-        assert!(present.src_stage.contains(S::COPY), "waits for the copy's read");
+        assert!(
+            present.src_stage.contains(S::COPY),
+            "waits for the copy's read"
+        );
     }
 
     #[test]

@@ -83,13 +83,16 @@ pub(crate) fn add_present_passes<'f>(
     size: Extent,
 ) -> Result<Option<PendingScreenshot>> {
     let output = |i: usize| {
-        outputs.get(i).map(|o| o.1).ok_or_else(|| EngineError::Pass {
-            pass: "present".into(),
-            problem: format!(
-                "denoiser index {i} out of range ({} denoisers)",
-                outputs.len()
-            ),
-        })
+        outputs
+            .get(i)
+            .map(|o| o.1)
+            .ok_or_else(|| EngineError::Pass {
+                pass: "present".into(),
+                problem: format!(
+                    "denoiser index {i} out of range ({} denoisers)",
+                    outputs.len()
+                ),
+            })
     };
     let left = output(target.left)?;
     let right = match target.right {
