@@ -136,6 +136,24 @@ pub fn path_trace_features(r: &scene::RenderSettings, lights: &[Light]) -> PathT
     }
 }
 
+/// A scene's `[render]` settings over `base` (which keeps its size, density scale and
+/// seed): the one mapping from a scene's render settings to the renderer's.
+pub fn render_settings(
+    r: &scene::RenderSettings,
+    lights: &[Light],
+    base: RenderSettings,
+) -> RenderSettings {
+    RenderSettings {
+        spp: r.spp,
+        max_bounces: r.max_bounces,
+        rr_depth: r.russian_roulette_depth,
+        features: path_trace_features(r, lights),
+        hg_g: r.hg_g as f32,
+        step_voxels: r.step_size as f32,
+        ..base
+    }
+}
+
 /// The renderer's inputs for one camera, light set and transfer function: the one
 /// place scene state becomes [`FrameInputs`] (capture and the explorer both use it).
 pub fn frame_inputs(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -> FrameInputs {
@@ -186,21 +204,18 @@ impl Setup {
         if spp == 0 {
             bail!("--spp must be at least 1");
         }
-        let features = path_trace_features(r, &scene.lights);
-        let settings = RenderSettings {
-            size: Extent {
-                width: args.size.0,
-                height: args.size.1,
+        let settings = render_settings(
+            &scene::RenderSettings { spp, ..*r },
+            &scene.lights,
+            RenderSettings {
+                size: Extent {
+                    width: args.size.0,
+                    height: args.size.1,
+                },
+                density_scale: scene.volume.density_scale as f32,
+                ..Default::default()
             },
-            spp,
-            max_bounces: r.max_bounces,
-            rr_depth: r.russian_roulette_depth,
-            features,
-            hg_g: r.hg_g as f32,
-            step_voxels: r.step_size as f32,
-            density_scale: scene.volume.density_scale as f32,
-            ..Default::default()
-        };
+        );
         let environment = load_environment(&scene.lights)?;
         let lut_a = scene.tf_a.lut();
         let lut_b = scene.tf_b.as_ref().map(|b| b.lut());

@@ -20,7 +20,7 @@ mod tf_editor;
 mod ui;
 
 use crate::output::{to_rgb, write_exr, write_png};
-use crate::setup::{self, frame_inputs, path_trace_features, Setup};
+use crate::setup::{self, frame_inputs, Setup};
 use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
 use ash::vk;
@@ -184,8 +184,9 @@ struct Explorer {
     pointer: Pointer,
     egui_ctx: egui::Context,
     egui_state: Option<egui_winit::State>,
-    window: Option<Arc<Window>>,
+    // Before `window`: the surface must go before the window it was made for.
     gfx: Option<Gfx>,
+    window: Option<Arc<Window>>,
     recorder: Option<Recorder>,
     /// Frames submitted so far.
     frame: u64,
@@ -243,8 +244,8 @@ impl Explorer {
             pointer: Pointer::default(),
             egui_ctx,
             egui_state: None,
-            window: None,
             gfx: None,
+            window: None,
             recorder,
             frame: 0,
             reset: false,
@@ -350,16 +351,7 @@ impl Explorer {
 
     /// The renderer settings for the model (size and seed from the current ones).
     fn render_settings(&self, current: &RenderSettings) -> RenderSettings {
-        let r = &self.model.render;
-        RenderSettings {
-            spp: r.spp,
-            max_bounces: r.max_bounces,
-            rr_depth: r.russian_roulette_depth,
-            hg_g: r.hg_g as f32,
-            step_voxels: r.step_size as f32,
-            features: path_trace_features(r, &self.model.lights),
-            ..current.clone()
-        }
+        setup::render_settings(&self.model.render, &self.model.lights, current.clone())
     }
 
     /// Brings the renderer and swapchain in line with the model.
