@@ -201,6 +201,10 @@ struct Explorer {
     frame_ms: Vec<f32>,
     /// UI textures egui released, freed after the frames in flight.
     free_textures: Vec<egui::TextureId>,
+    /// (pass, total GPU ms, frames) after the warm-up, for the summary.
+    pass_totals: Vec<(String, f64, u32)>,
+    /// GPU frame spans after the warm-up, ms.
+    gpu_spans: Vec<f64>,
     started: Instant,
     error: Option<anyhow::Error>,
 }
@@ -256,6 +260,8 @@ impl Explorer {
             frame_started: None,
             frame_ms: Vec::new(),
             free_textures: Vec::new(),
+            pass_totals: Vec::new(),
+            gpu_spans: Vec::new(),
             started: Instant::now(),
             error: None,
         })
@@ -638,6 +644,18 @@ impl Explorer {
         if r.screenshot.is_some() {
             self.last_screenshot = r.screenshot;
         }
+        if r.index >= WARMUP_FRAMES as u64 {
+            self.gpu_spans.push(ui::gpu_span_ms(&r.timings));
+            for t in &r.timings {
+                match self.pass_totals.iter_mut().find(|p| p.0 == t.pass) {
+                    Some(p) => {
+                        p.1 += t.ms;
+                        p.2 += 1;
+                    }
+                    None => self.pass_totals.push((t.pass.clone(), t.ms, 1)),
+                }
+            }
+        }
         self.ui.stats.push(frame_ms, r.timings);
         Ok(())
     }
@@ -698,6 +716,19 @@ impl Explorer {
                 self.ui.stats.render_size.0,
                 self.ui.stats.render_size.1,
             );
+            let passes: Vec<String> = self
+                .pass_totals
+                .iter()
+                .map(|(pass, ms, n)| format!("{pass} {:.1}", ms / f64::from(*n)))
+                .collect();
+            if !passes.is_empty() {
+                let span = self.gpu_spans.iter().sum::<f64>() / self.gpu_spans.len().max(1) as f64;
+                println!(
+                    "explore: GPU frame span {span:.1} ms; per pass (on lavapipe one pass \
+                     late once the UI has drawn, see ui::gpu_span_ms): {}",
+                    passes.join(", ")
+                );
+            }
         }
         Ok(())
     }
