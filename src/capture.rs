@@ -1,12 +1,12 @@
 //! The offscreen commands: capture (sequences), reference (high-sample frames) and the
 //! render loop behind profile.
 
-use crate::output::{to_rgb, write_exr, write_png};
 use crate::profile::{self, Profile};
 use crate::setup::Setup;
 use crate::SceneArgs;
 use anyhow::{Context, Result};
 use dvr_engine::gpu::timestamps::PassTiming;
+use dvr_engine::image_io::{to_rgb, write_exr, write_png};
 use dvr_engine::renderer::{FrameRequest, FrameResult};
 use std::path::Path;
 use std::time::Instant;

@@ -1,11 +1,11 @@
 //! `dvr`: real-time Monte Carlo direct volume rendering with temporal denoising.
 //! Subcommands: explore (the interactive window), capture (offscreen sequences),
-//! reference (high-sample references), profile (per-pass GPU timing), scenes (the
-//! built-in scenes).
+//! reference (high-sample references), eval (denoisers against references: metrics,
+//! plots, HTML), profile (per-pass GPU timing), scenes (the built-in scenes).
 
 mod capture;
+mod eval;
 mod explore;
-mod output;
 mod profile;
 mod setup;
 
@@ -42,6 +42,11 @@ pub struct SceneArgs {
     /// Edge length of procedural volumes (phantom, cloud).
     #[arg(long, default_value_t = 128)]
     pub volume_size: u32,
+    /// Position the temporal denoisers reproject with: `first-hit` (the closest first
+    /// real collision, the paper's) or `features` (opacity-threshold surface, or the
+    /// expected first collision through semi-transparent layers).
+    #[arg(long, default_value = "first-hit", value_parser = setup::parse_motion)]
+    pub motion: dvr_engine::denoise::MotionSource,
 }
 
 #[derive(Subcommand)]
@@ -71,6 +76,9 @@ enum Command {
         #[arg(long, default_value = "out/reference")]
         out: PathBuf,
     },
+    /// Evaluate denoisers against cached references: metrics.csv, summary.csv, plots
+    /// and an HTML results page.
+    Eval(eval::EvalArgs),
     /// Per-pass GPU timings over many frames: table, JSON and Chrome trace.
     Profile {
         #[command(flatten)]
@@ -135,6 +143,7 @@ fn run(cli: Cli) -> Result<()> {
             ref_spp,
             out,
         } => capture::reference(&scene, ref_spp, &out),
+        Command::Eval(args) => eval::eval(&args),
         Command::Profile {
             scene,
             denoiser,

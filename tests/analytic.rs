@@ -106,3 +106,123 @@ fn identical_seeds_give_identical_images() {
     assert_eq!(a, b);
     assert_validation_clean();
 }
+
+#[test]
+fn henyey_greenstein_white_furnace_conserves_energy() {
+    let mut s = settings(8, 1);
+    s.density_scale = 4.0;
+    s.max_bounces = 1000;
+    s.rr_depth = 4;
+    s.hg_g = 0.7;
+    s.features = PathTraceFeatures {
+        phase: dvr_engine::passes::path_trace::Phase::Hg,
+        ..Default::default()
+    };
+    let volume = constant_volume(8, 1.0);
+    let mut r = renderer(context(), s, &volume, &["none"]);
+    let inputs = inputs(
+        front_camera(3.0, 30.0),
+        vec![environment(1.0)],
+        constant_lut(1.0, 1.0),
+    );
+    let m = mean_rgb(&r.reference(&inputs, 2048, 4).expect("reference render"));
+    for c in m {
+        assert!((c - 1.0).abs() < 0.01, "HG furnace mean {m:?}, expected 1");
+    }
+    assert_validation_clean();
+}
+
+/// Emission–absorption through the slab (albedo 0, emissive TF, no lights): every
+/// collision adds the emitted radiance, so L = Le · (1 − exp(−μt·d)).
+#[test]
+fn emissive_slab_matches_the_emission_absorption_solution() {
+    let mut s = settings(8, 1);
+    s.density_scale = 1.5;
+    s.filter_sigma = 0.0;
+    s.features = PathTraceFeatures {
+        emission: true,
+        ..Default::default()
+    };
+    let volume = constant_volume(8, 1.0);
+    let mut lut = constant_lut(1.0, 0.0);
+    lut.emissive = vec![[2.0, 2.0, 2.0, 0.0]; LUT];
+    let mut r = renderer(context(), s, &volume, &["none"]);
+    let inputs = inputs(front_camera(3.0, 2.0), vec![], lut);
+    let l = mean_rgb(&r.reference(&inputs, 4096, 4).expect("reference render"))[0];
+    let expected = 2.0 * (1.0 - (-1.5f64).exp());
+    assert!(
+        ((l - expected) / expected).abs() < 0.01,
+        "L = {l}, expected {expected}"
+    );
+    assert_validation_clean();
+}
+
+/// An equirectangular environment map is looked up with z up: looking horizontally, the
+/// image's centre row sees the horizon (v = 0.5) and the top rows see the sky side.
+#[test]
+fn environment_map_is_z_up_equirectangular() {
+    use dvr_engine::renderer::scene_gpu::EnvironmentUpload;
+    use dvr_engine::renderer::uniforms::{ENV_MAP, LIGHT_ENV};
+    let (w, h) = (64u32, 32u32);
+    // Radiance 1 − v: bright at the zenith (v = 0), dark at the nadir.
+    let rgba: Vec<[f32; 4]> = (0..h)
+        .flat_map(|y| {
+            let v = (y as f32 + 0.5) / h as f32;
+            (0..w).map(move |_| [1.0 - v, 1.0 - v, 1.0 - v, 1.0])
+        })
+        .collect();
+    let env = EnvironmentUpload {
+        width: w,
+        height: h,
+        rgba,
+    };
+    let mut s = settings(16, 1);
+    s.filter_sigma = 0.0;
+    s.features = PathTraceFeatures {
+        environment_map: true,
+        ..Default::default()
+    };
+    let volume = constant_volume(8, 0.0); // empty: the camera sees the environment
+    let r = dvr_engine::renderer::Renderer::new(
+        context(),
+        s,
+        &volume,
+        Some(&env),
+        &["none"],
+        LUT as u32,
+    );
+    let mut r = r.expect("renderer");
+    let light = dvr_engine::renderer::uniforms::GpuLight {
+        position_kind: glam::Vec4::new(0.0, 0.0, 0.0, LIGHT_ENV),
+        radiance: glam::Vec4::new(0.0, 0.0, 0.0, ENV_MAP),
+        u_axis: glam::Vec4::new(0.0, 0.0, 0.0, 1.0), // w: intensity
+        v_axis: glam::Vec4::ZERO,
+    };
+    let camera = dvr_engine::renderer::CameraMatrices::look_at(
+        glam::Vec3::new(0.0, 3.0, 0.0),
+        glam::Vec3::ZERO,
+        glam::Vec3::Z,
+        60f32.to_radians(),
+        1.0,
+    );
+    let img = r
+        .reference(&inputs(camera, vec![light], constant_lut(0.0, 0.0)), 4, 4)
+        .expect("render");
+    let row = |y: usize| {
+        img[y * 16..y * 16 + 16]
+            .iter()
+            .map(|p| p[0] as f64)
+            .sum::<f64>()
+            / 16.0
+    };
+    let (top, middle, bottom) = (row(0), (row(7) + row(8)) / 2.0, row(15));
+    assert!(
+        (middle - 0.5).abs() < 0.02,
+        "horizon radiance {middle}, expected 0.5"
+    );
+    assert!(
+        top > middle + 0.1 && bottom < middle - 0.1,
+        "top {top}, middle {middle}, bottom {bottom}"
+    );
+    assert_validation_clean();
+}

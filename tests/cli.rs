@@ -51,12 +51,12 @@ fn capture_writes_frames_timings_and_page_for_every_denoiser() {
         "--scene",
         "cloud/orbit",
         "--denoiser",
-        "none,accum,ours",
+        "none,accum,ours,svgf",
     ];
     args.extend_from_slice(SMALL);
     args.extend_from_slice(&["--out", out.to_str().expect("utf-8 path")]);
     assert_ok(&dvr(&args));
-    for m in ["none", "accum", "ours"] {
+    for m in ["none", "accum", "ours", "svgf"] {
         for f in 0..3 {
             for ext in ["exr", "png"] {
                 let p = out.join(m).join(format!("{f:04}.{ext}"));
@@ -84,6 +84,7 @@ fn capture_writes_frames_timings_and_page_for_every_denoiser() {
         "accum",
         "ours.update",
         "ours.spatial",
+        "svgf.atrous4",
     ] {
         assert!(passes.contains(&want), "no timing for {want}: {passes:?}");
     }

@@ -111,7 +111,7 @@ impl Harness {
     fn new(name: &str) -> Self {
         let ctx = context();
         let graph = RenderGraph::new(&ctx).expect("graph");
-        let denoiser = denoise::create(&ctx, name).expect("denoiser");
+        let denoiser = denoise::create(&ctx, name, Default::default()).expect("denoiser");
         Self {
             ctx,
             graph,
@@ -181,6 +181,15 @@ impl Harness {
         u.box_min = Vec4::new(-0.5, -0.5, -0.5, 1.0);
         u.box_max = Vec4::new(0.5, 0.5, 0.5, 1.0);
         u.dims = IVec4::new(DIMS, DIMS, DIMS, 8);
+        // The scene's positions are (x/W, y/H, −z): a camera that projects them back onto
+        // their pixel centres, so the reprojection round trip holds for a still camera.
+        u.view_proj = glam::Mat4::from_cols(
+            Vec4::new(2.0, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, 2.0, 0.0, 0.0),
+            Vec4::ZERO,
+            Vec4::new(1.0 / W as f32 - 1.0, 1.0 / H as f32 - 1.0, 0.0, 1.0),
+        );
+        u.prev_view_proj = u.view_proj;
         g.buffer_mut(ubo)
             .write(bytemuck::bytes_of(&u))
             .expect("write uniforms");
@@ -202,11 +211,11 @@ impl Harness {
             uniforms: ubo,
             noisy: noisy_img,
             moments: moments_img,
-            features: FeatureImages {
+            features: Some(FeatureImages {
                 position: feature_position,
                 normal: normal_img,
                 albedo: albedo_img,
-            },
+            }),
             first_hit,
             motion: motion_img,
             size: Extent {

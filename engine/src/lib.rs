@@ -8,6 +8,7 @@ pub mod denoise;
 pub mod error;
 pub mod gpu;
 pub mod graph;
+pub mod image_io;
 pub mod metrics;
 pub mod passes;
 pub mod renderer;

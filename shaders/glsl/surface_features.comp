@@ -3,11 +3,20 @@
 // centre's ray front to back, compositing opacity, and stop where accumulated opacity
 // crosses a threshold. There: world position, linear depth, gradient normal and TF albedo,
 // with a validity flag (0 where the threshold is never reached).
+// Where the threshold is not reached but the ray still meets a visible amount of medium
+// (a semi-transparent layer), the position is the EXPECTED first real collision: the mean
+// of the first-collision depth distribution μ(t)T(t), from the same compositing weights.
+// It is what the paper's per-sample first collisions average to, without their noise, so
+// reprojection through semi-transparent layers gets a stable depth. Normal and albedo stay
+// invalid there (edge-stopping only trusts threshold surfaces).
 #include "common.glsl"
 #include "frame.glsl"
 #include "volume.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+
+// Accumulated opacity below which a ray counts as having met nothing.
+const float MIN_VISIBLE_OPACITY = 0.05;
 
 layout(binding = 7, rgba32f) uniform writeonly image2D feature_position;  // xyz, w valid
 layout(binding = 8, rgba32f) uniform writeonly image2D feature_normal;    // xyz, w depth
@@ -30,27 +39,56 @@ void main() {
     vec2 span = intersect_box(o, d);
     float voxel = min(box_size().x / float(frame.dims.x),
                       min(box_size().y / float(frame.dims.y), box_size().z / float(frame.dims.z)));
-    float step_len = voxel * pc.step_voxels;
+    float base_step = voxel * pc.step_voxels;
     float alpha = 0.0;
     float threshold = frame.params.z;
     vec4 pos = vec4(0.0);
     vec4 nrm = vec4(0.0, 0.0, 0.0, 0.0);
     vec4 alb = vec4(0.0);
     if (span.x < span.y) {
-        for (float t = span.x; t < span.y; t += step_len) {
-            vec3 p = o + d * t;
-            float a = 1.0 - exp(-extinction_at(p) * step_len);
-            alpha += (1.0 - alpha) * a;
-            if (alpha >= threshold) {
-                float density = density_at(p);
-                vec3 g = density_gradient(p);
-                vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
-                if (dot(n, d) > 0.0) n = -n;
-                pos = vec4(p, 1.0);
-                nrm = vec4(n, t);
-                alb = vec4(tf_albedo_opacity(density).rgb, 1.0);
-                break;
+        // March the bricks the majorant grid says hold anything; skip empty ones whole.
+        GridWalk w = grid_walk_begin(o, d, span.x);
+        float t = span.x;
+        float prev_alpha = 0.0;
+        float mean_t = 0.0;  // Σ t · (contribution of the step to the accumulated opacity)
+        bool found = false;
+        for (int guard = 0; guard < 4096 && !found; ++guard) {
+            float cell_exit = min(grid_walk_exit(w), span.y);
+            float m = grid_majorant(w);
+            if (m > 0.0) {
+                // Steps short enough that one step's opacity stays below ~0.2 in this
+                // brick (fine where it is dense, up to 4× longer where it is faint).
+                float step_len = clamp(0.2 / m, base_step, 4.0 * base_step);
+                for (; t < cell_exit; t += step_len) {
+                    vec3 p = o + d * t;
+                    float a = 1.0 - exp(-extinction_at(p) * step_len);
+                    prev_alpha = alpha;
+                    alpha += (1.0 - alpha) * a;
+                    mean_t += t * (alpha - prev_alpha);
+                    if (alpha >= threshold) {
+                        // Interpolate the crossing inside the last step, so depth and
+                        // position do not terrace at the step length.
+                        float f = (threshold - prev_alpha) / max(alpha - prev_alpha, 1e-6);
+                        float th = t - step_len * (1.0 - clamp(f, 0.0, 1.0));
+                        vec3 ph = o + d * th;
+                        float density = density_at(ph);
+                        vec3 g = density_gradient(ph);
+                        vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
+                        if (dot(n, d) > 0.0) n = -n;
+                        pos = vec4(ph, 1.0);
+                        nrm = vec4(n, th);
+                        alb = vec4(tf_albedo_opacity(density).rgb, 1.0);
+                        found = true;
+                        break;
+                    }
+                }
+            } else {
+                t = cell_exit;
             }
+            if (found || t >= span.y || !grid_walk_advance(w)) break;
+        }
+        if (!found && alpha >= MIN_VISIBLE_OPACITY) {
+            pos = vec4(o + d * (mean_t / alpha), 1.0);
         }
     }
     imageStore(feature_position, ivec2(pixel), pos);

@@ -9,9 +9,9 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 0, rgba32f) uniform readonly image2D noisy;
-layout(binding = 1) uniform sampler2D history_prev;
-layout(binding = 2, rgba32f) uniform writeonly image2D history_cur;
+layout(binding = 1, rgba32f) uniform readonly image2D noisy;
+layout(binding = 2) uniform sampler2D history_prev;
+layout(binding = 3, rgba32f) uniform writeonly image2D history_cur;
 
 layout(push_constant) uniform TaaPush {
     vec4 camera;       // xyz camera position

@@ -10,21 +10,21 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 0, rgba32f) uniform readonly image2D noisy;
-layout(binding = 1) uniform sampler2D z_prev;
-layout(binding = 2) uniform sampler2D beta_r_prev;
-layout(binding = 3) uniform sampler2D beta_g_prev;
-layout(binding = 4) uniform sampler2D beta_b_prev;
-layout(binding = 5) uniform sampler2D p0_prev;
-layout(binding = 6) uniform sampler2D p1_prev;
-layout(binding = 7) uniform sampler2D p2_prev;
-layout(binding = 8, rgba32f) uniform writeonly image2D z_cur;
-layout(binding = 9, rgba32f) uniform writeonly image2D beta_r_cur;
-layout(binding = 10, rgba32f) uniform writeonly image2D beta_g_cur;
-layout(binding = 11, rgba32f) uniform writeonly image2D beta_b_cur;
-layout(binding = 12, rgba32f) uniform writeonly image2D p0_cur;
-layout(binding = 13, rgba32f) uniform writeonly image2D p1_cur;
-layout(binding = 14, rgba32f) uniform writeonly image2D p2_cur;
+layout(binding = 1, rgba32f) uniform readonly image2D noisy;
+layout(binding = 2) uniform sampler2D z_prev;
+layout(binding = 3) uniform sampler2D beta_r_prev;
+layout(binding = 4) uniform sampler2D beta_g_prev;
+layout(binding = 5) uniform sampler2D beta_b_prev;
+layout(binding = 6) uniform sampler2D p0_prev;
+layout(binding = 7) uniform sampler2D p1_prev;
+layout(binding = 8) uniform sampler2D p2_prev;
+layout(binding = 9, rgba32f) uniform writeonly image2D z_cur;
+layout(binding = 10, rgba32f) uniform writeonly image2D beta_r_cur;
+layout(binding = 11, rgba32f) uniform writeonly image2D beta_g_cur;
+layout(binding = 12, rgba32f) uniform writeonly image2D beta_b_cur;
+layout(binding = 13, rgba32f) uniform writeonly image2D p0_cur;
+layout(binding = 14, rgba32f) uniform writeonly image2D p1_cur;
+layout(binding = 15, rgba32f) uniform writeonly image2D p2_cur;
 
 layout(push_constant) uniform WrlsUpdatePush {
     vec4 camera;          // xyz camera position
@@ -105,7 +105,15 @@ void main() {
         if (noise_level < 0.0) noise_level = r2;
         bool far = r2 > pc.change_ratio * (noise_level + 1e-6);
         streak = far ? streak + 1.0 : 0.0;
-        if (streak >= 2.0) lambda = pc.lambda_min;
+        // A change is a residual far above the noise level for 2–4 frames in a row: forget
+        // fast while it lasts. A spike is one frame (its weight w handles it); a residual
+        // that stays high longer is the new scene's noise level, adopted as such, so a
+        // noisier state after the change does not keep the model forgetting.
+        if (streak >= 2.0 && streak <= 4.0) lambda = pc.lambda_min;
+        if (streak > 4.0) {
+            noise_level = r2;
+            streak = 0.0;
+        }
         // Spikes barely move the noise level; ordinary residuals track it.
         noise_level = mix(noise_level, r2, far ? 0.02 : 0.1);
     }

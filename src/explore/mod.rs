@@ -5,7 +5,7 @@
 //! The loop, once per frame ([`Explorer::frame`]): scripted commands due → the UI (egui)
 //! edits the [`ui::Model`] → model changes go to the renderer (denoisers, settings; a
 //! pipeline-specialising change rebuilds it) → acquire a swapchain image → the frame's
-//! inputs from the camera, lights and TF through `setup::frame_inputs` (the same path
+//! inputs from the camera, lights and TF through `scene_setup::inputs_for` (the same path
 //! `dvr capture` takes) → `Renderer::frame` with a present target → present → handle
 //! the results of the frame that finished (timings, screenshots, recorded frames).
 //!
@@ -19,15 +19,15 @@ mod record;
 mod tf_editor;
 mod ui;
 
-use crate::output::{to_rgb, write_exr, write_png};
-use crate::setup::{self, frame_inputs, Setup};
-use crate::SceneArgs;
+use crate::setup;
 use anyhow::{bail, Context, Result};
 use ash::vk;
 use camera::OrbitCamera;
 use dvr_engine::gpu::{ContextOptions, GpuContext, Swapchain};
+use dvr_engine::image_io::{to_rgb, write_exr, write_png, PNG_EXPOSURE};
 use dvr_engine::passes::present::PresentLayout;
 use dvr_engine::passes::Extent;
+use dvr_engine::renderer::scene_setup::{self, inputs_for, load_volume, SceneSetup};
 use dvr_engine::renderer::{
     FrameRequest, FrameResult, PresentTarget, RenderSettings, Renderer, Screenshot,
 };
@@ -53,6 +53,8 @@ pub const NO_DISPLAY: &str =
 
 /// Frames left out of the frame-rate summary (pipeline compilation on first use).
 const WARMUP_FRAMES: usize = 5;
+/// Bins of the density histogram behind the transfer-function editor.
+const HISTOGRAM_BINS: usize = 128;
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct ExploreArgs {
@@ -137,17 +139,17 @@ pub fn run(args: ExploreArgs) -> Result<()> {
             raw: None,
         };
     }
-    let scene_args = SceneArgs {
-        scene: args.scene.clone(),
-        frames: None,
-        size: args.size,
-        spp: args.spp,
-        volume_size: args.volume_size,
+    let volume = load_volume(&scene, args.volume_size)?;
+    let histogram = volume.histogram(HISTOGRAM_BINS);
+    let size = Extent {
+        width: args.size.0,
+        height: args.size.1,
     };
-    let setup = Setup::from_scene(scene, &scene_args)?;
+    let setup = SceneSetup::with_volume(scene, &volume, size, args.spp)?;
+    drop(volume);
     let event_loop = EventLoop::new().map_err(|e| anyhow::anyhow!("{NO_DISPLAY} ({e})"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
-    let mut app = Explorer::new(args, setup, script, &names)?;
+    let mut app = Explorer::new(args, setup, &histogram, script, &names)?;
     event_loop
         .run_app(&mut app)
         .context("the window's event loop failed")?;
@@ -174,7 +176,7 @@ impl Drop for Gfx {
 
 struct Explorer {
     args: ExploreArgs,
-    setup: Setup,
+    setup: SceneSetup,
     script: Script,
     model: Model,
     /// The model the renderer currently reflects.
@@ -210,7 +212,13 @@ struct Explorer {
 }
 
 impl Explorer {
-    fn new(args: ExploreArgs, setup: Setup, script: Script, names: &[String]) -> Result<Self> {
+    fn new(
+        args: ExploreArgs,
+        setup: SceneSetup,
+        histogram: &[u32],
+        script: Script,
+        names: &[String],
+    ) -> Result<Self> {
         let state = setup.scene.frame_state(0);
         let camera = OrbitCamera::from_spec(&setup.scene.camera_at(0));
         let model = Model {
@@ -221,13 +229,13 @@ impl Explorer {
                 r.spp = setup.settings.spp;
                 r
             },
-            exposure: crate::output::PNG_EXPOSURE,
+            exposure: PNG_EXPOSURE,
             vsync: !args.no_vsync,
             left: names[0].clone(),
             right: names.get(1).cloned(),
             split: 0.5,
         };
-        let mut ui = UiState::new(&setup.histogram);
+        let mut ui = UiState::new(histogram);
         let recorder = match &args.record {
             Some(dir) => {
                 ui.recording = true;
@@ -280,7 +288,7 @@ impl Explorer {
         let ppp = self.egui_ctx.pixels_per_point();
         let (w, h) = self.args.size;
         let attributes = Window::default_attributes()
-            .with_title(format!("dvr explore — {}", self.setup.name))
+            .with_title(format!("dvr explore — {}", self.setup.scene.name))
             .with_inner_size(PhysicalSize::new(w + (PANEL_WIDTH * ppp).round() as u32, h));
         let window = Arc::new(
             event_loop
@@ -319,7 +327,7 @@ impl Explorer {
         let overlay = EguiOverlay::new(&ctx, swapchain.format)?;
         let renderer = self
             .setup
-            .renderer_on(Arc::clone(&ctx), &self.denoiser_list())?;
+            .renderer_shared(Arc::clone(&ctx), &self.denoiser_list())?;
         self.ui.stats.device = ctx.info.name.clone();
         self.ui.stats.present_mode = format!("{:?}", swapchain.present_mode);
         let max_texture_side = 4096;
@@ -355,9 +363,25 @@ impl Explorer {
         v
     }
 
-    /// The renderer settings for the model (size and seed from the current ones).
+    /// The renderer settings for the model: what a scene with the model's render
+    /// settings and lights asks for (`scene_setup::render_settings`, the one mapping),
+    /// over the current size, seed and motion source.
     fn render_settings(&self, current: &RenderSettings) -> RenderSettings {
-        setup::render_settings(&self.model.render, &self.model.lights, current.clone())
+        let scene = Scene {
+            render: self.model.render,
+            lights: self.model.lights.clone(),
+            ..self.setup.scene.clone()
+        };
+        let s = scene_setup::render_settings(&scene, current.size, self.model.render.spp);
+        RenderSettings {
+            spp: s.spp,
+            max_bounces: s.max_bounces,
+            rr_depth: s.rr_depth,
+            features: s.features,
+            hg_g: s.hg_g,
+            step_voxels: s.step_voxels,
+            ..current.clone()
+        }
     }
 
     /// Brings the renderer and swapchain in line with the model.
@@ -388,7 +412,7 @@ impl Explorer {
             gfx.renderer = None;
             self.setup.settings = settings;
             let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
-            gfx.renderer = Some(self.setup.renderer_on(Arc::clone(&gfx.ctx), &names)?);
+            gfx.renderer = Some(self.setup.renderer_shared(Arc::clone(&gfx.ctx), &names)?);
         } else {
             if renderer.denoiser_names() != denoisers {
                 let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
@@ -525,7 +549,7 @@ impl Explorer {
         // Render and present.
         let (vw, vh) = self.view_size();
         let spec = self.camera.spec();
-        let inputs = frame_inputs(
+        let inputs = inputs_for(
             &spec.camera(),
             vw as f32 / vh as f32,
             &self.model.lights,

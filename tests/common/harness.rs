@@ -9,6 +9,9 @@ use dvr_engine::graph::{Frame, History, ImageHandle, RenderGraph};
 use dvr_engine::passes::surface_features::FeatureImages;
 use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::add_upload;
+use dvr_engine::renderer::uniforms::FrameUniforms;
+use dvr_engine::renderer::CameraMatrices;
+use glam::Vec3;
 use gpu_allocator::MemoryLocation;
 
 pub struct Harness {
@@ -24,7 +27,7 @@ impl Harness {
     pub fn new(name: &str, width: u32, height: u32) -> Self {
         let ctx = super::context();
         let graph = RenderGraph::new(&ctx).expect("graph");
-        let denoiser = denoise::create(&ctx, name).expect("denoiser");
+        let denoiser = denoise::create(&ctx, name, Default::default()).expect("denoiser");
         Self {
             ctx,
             graph,
@@ -60,17 +63,34 @@ impl Harness {
         let n = (w * h) as usize;
         assert_eq!(noisy.len(), n);
         let desc = ImageDesc::d2(w, h, vk::Format::R32G32B32A32_SFLOAT);
-        // A flat surface facing the camera at z = 0, one unit away.
-        let positions: Vec<[f32; 4]> = (0..n)
+        // A flat surface at z = 0 seen by a camera one unit away: each pixel's world
+        // position is where its centre ray meets the plane, so reprojection round trips
+        // land exactly on the pixel.
+        let camera = CameraMatrices::look_at(
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            60f32.to_radians(),
+            w as f32 / h as f32,
+        );
+        let view_proj = camera.proj * camera.view;
+        let inv = view_proj.inverse();
+        let positions: Vec<[f32; 4]> = (0..n as u32)
             .map(|i| {
-                [
-                    (i as u32 % w) as f32 / w as f32 - 0.5,
-                    (i as u32 / w) as f32 / h as f32 - 0.5,
-                    0.0,
-                    1.0,
-                ]
+                let ndc_x = ((i % w) as f32 + 0.5) / w as f32 * 2.0 - 1.0;
+                let ndc_y = ((i / w) as f32 + 0.5) / h as f32 * 2.0 - 1.0;
+                let near = inv.project_point3(Vec3::new(ndc_x, ndc_y, 0.0));
+                let far = inv.project_point3(Vec3::new(ndc_x, ndc_y, 1.0));
+                let t = near.z / (near.z - far.z);
+                let p = near + (far - near) * t;
+                [p.x, p.y, p.z, 1.0]
             })
             .collect();
+        let mut frame_uniforms: FrameUniforms = bytemuck::Zeroable::zeroed();
+        frame_uniforms.view_proj = view_proj;
+        frame_uniforms.inv_view_proj = inv;
+        frame_uniforms.prev_view_proj = view_proj;
+        frame_uniforms.camera_pos = camera.position.extend(1.0);
         let normals = vec![[0.0, 0.0, 1.0, 1.0]; n];
         let albedo = vec![[0.8, 0.8, 0.8, 1.0]; n];
         let zeros = vec![[0.0f32; 4]; n];
@@ -90,8 +110,16 @@ impl Harness {
         let albedo_img = g.image(ctx, "h.albedo", desc).expect("image");
         let motion_img = g.image(ctx, "h.motion", desc).expect("image");
         let uniforms = g
-            .buffer(ctx, "h.uniforms", 1024, MemoryLocation::CpuToGpu)
+            .buffer(
+                ctx,
+                "h.uniforms",
+                std::mem::size_of::<FrameUniforms>() as u64,
+                MemoryLocation::CpuToGpu,
+            )
             .expect("buffer");
+        g.buffer_mut(uniforms)
+            .write(bytemuck::bytes_of(&frame_uniforms))
+            .expect("uniforms");
         self.upload(&mut f, "upload_noisy", noisy_img, noisy);
         self.upload(&mut f, "upload_moments", moments_img, &moments);
         self.upload(&mut f, "upload_normal", normal_img, &normals);
@@ -103,11 +131,11 @@ impl Harness {
             uniforms,
             noisy: noisy_img,
             moments: moments_img,
-            features: FeatureImages {
+            features: Some(FeatureImages {
                 position: feature_position,
                 normal: normal_img,
                 albedo: albedo_img,
-            },
+            }),
             first_hit,
             motion: motion_img,
             size: Extent {

@@ -20,6 +20,32 @@ use crate::graph::{BufferHandle, Frame, History, ImageHandle, RenderGraph};
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::Extent;
 
+/// Disocclusion tolerance of the shared reprojection (include/reproject.glsl): how far,
+/// in pixels, last frame's surface may land from this pixel when projected back.
+pub const REPROJECTION_TOLERANCE_PX: f32 = 1.5;
+
+/// Which per-pixel world position drives motion vectors and the disocclusion test.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MotionSource {
+    /// The closest first real collision among the frame's samples (the paper's choice).
+    #[default]
+    FirstHit,
+    /// The deterministic surface features: the opacity-threshold position, or the expected
+    /// first collision through semi-transparent layers.
+    Features,
+}
+
+impl MotionSource {
+    /// The value of the shaders' MOTION_SOURCE specialisation constant.
+    pub fn spec(self) -> i32 {
+        match self {
+            MotionSource::FirstHit => 0,
+            MotionSource::Features => 1,
+        }
+    }
+}
+
 /// What changed since the previous frame (drives resets of history-based methods).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Changes {
@@ -42,7 +68,9 @@ pub struct DenoiseInputs {
     pub noisy: ImageHandle,
     /// Luminance moments (x mean, y second moment).
     pub moments: ImageHandle,
-    pub features: FeatureImages,
+    /// Deterministic surface features; rendered only when a denoiser of this frame
+    /// uses them ([`Denoiser::uses_surface_features`]).
+    pub features: Option<FeatureImages>,
     /// Closest first real collision per pixel, this frame's and last frame's.
     pub first_hit: History,
     /// Motion to the previous frame in pixels: xy from the first collision, zw from features.
@@ -52,6 +80,28 @@ pub struct DenoiseInputs {
     pub camera: glam::Vec3,
     pub spp: u32,
     pub changes: Changes,
+}
+
+impl DenoiseInputs {
+    /// The surface features, or an error naming the denoiser that forgot to ask for them.
+    pub fn features(&self, denoiser: &str) -> Result<FeatureImages> {
+        self.features.ok_or_else(|| EngineError::Pass {
+            pass: denoiser.to_string(),
+            problem: "surface features were not rendered: the denoiser must return true \
+                      from uses_surface_features"
+                .into(),
+        })
+    }
+
+    /// The world positions reprojection tests against, for a motion source: 0 = the
+    /// closest first real collision (the paper's), 1 = the surface features.
+    pub fn positions(&self, denoiser: &str, motion_source: i32) -> Result<History> {
+        if motion_source == 0 {
+            Ok(self.first_hit)
+        } else {
+            Ok(self.features(denoiser)?.position)
+        }
+    }
 }
 
 pub trait Denoiser {
@@ -66,6 +116,11 @@ pub trait Denoiser {
         input: &DenoiseInputs,
     ) -> Result<ImageHandle>;
     fn destroy(&mut self, ctx: &GpuContext);
+    /// Whether the frame must render the surface-features pass for this denoiser (it
+    /// costs about as much as the path trace on lavapipe, so it runs only when used).
+    fn uses_surface_features(&self) -> bool {
+        false
+    }
 }
 
 /// Names accepted by `--denoiser`.
@@ -83,18 +138,19 @@ pub const NAMES: &[&str] = &[
 ];
 
 /// Builds a denoiser by name.
-pub fn create(ctx: &GpuContext, name: &str) -> Result<Box<dyn Denoiser>> {
+pub fn create(ctx: &GpuContext, name: &str, motion: MotionSource) -> Result<Box<dyn Denoiser>> {
+    let m = motion.spec();
     Ok(match name {
         "none" => Box::new(Passthrough),
         "accum" => Box::new(Accum::new(ctx)?),
-        "taa" => Box::new(Taa::new(ctx, 0)?),
-        "svgf" => Box::new(Svgf::new(ctx, 0)?),
+        "taa" => Box::new(Taa::new(ctx, m)?),
+        "svgf" => Box::new(Svgf::new(ctx, m)?),
         n if WrlsVariant::from_name(n).is_some() => {
             let variant = WrlsVariant::from_name(n).ok_or_else(|| EngineError::Pass {
                 pass: "denoise".into(),
                 problem: format!("unknown wRLS variant {n:?}"),
             })?;
-            Box::new(Wrls::new(ctx, n, variant, 0)?)
+            Box::new(Wrls::new(ctx, n, variant, m)?)
         }
         other => {
             return Err(EngineError::Pass {

@@ -55,7 +55,7 @@ pub struct SvgfParams {
     /// Added to the albedo before demodulating: a black albedo channel amplifies the
     /// colour by at most 1/eps before filtering (and is multiplied back exactly).
     pub demod_eps: f32,
-    /// Disocclusion tolerance, relative to the distance from the camera (as `ours`).
+    /// Disocclusion tolerance in pixels (see [`super::REPROJECTION_TOLERANCE_PX`]).
     pub tolerance: f32,
 }
 
@@ -70,7 +70,7 @@ impl Default for SvgfParams {
             sigma_l: 4.0,
             luminance_eps: 1e-6,
             demod_eps: 0.01,
-            tolerance: 0.05,
+            tolerance: super::REPROJECTION_TOLERANCE_PX,
         }
     }
 }
@@ -105,6 +105,10 @@ impl Svgf {
 }
 
 impl Denoiser for Svgf {
+    fn uses_surface_features(&self) -> bool {
+        true // edge-stopping on depth, normal; albedo demodulation
+    }
+
     fn name(&self) -> &str {
         "svgf"
     }
@@ -124,16 +128,13 @@ impl Denoiser for Svgf {
         let ping = graph.image(ctx, "svgf.ping", desc)?;
         let pong = graph.image(ctx, "svgf.pong", desc)?;
         let out = graph.image(ctx, "svgf.out", desc)?;
-        let (pos_cur, pos_prev) = if self.motion_source == 0 {
-            (input.first_hit.cur, input.first_hit.prev)
-        } else {
-            (input.features.position.cur, input.features.position.prev)
-        };
-        let valid =
-            color.valid && moments.valid && input.first_hit.valid && input.features.position.valid;
+        let positions = input.positions(self.name(), self.motion_source)?;
+        let (pos_cur, pos_prev) = (positions.cur, positions.prev);
+        let valid = color.valid && moments.valid && positions.valid;
         let p = self.params;
         let (noisy, motion) = (input.noisy, input.motion);
-        let (albedo, normal) = (input.features.albedo, input.features.normal);
+        let features = input.features(self.name())?;
+        let (albedo, normal) = (features.albedo, features.normal);
         let uniforms = input.uniforms;
 
         let push = SvgfTemporalPush {
@@ -335,7 +336,7 @@ pub mod edge {
             sigma_l: 4.0,
             luminance_eps: 1e-6,
             demod_eps: 0.01,
-            tolerance: 0.05,
+            tolerance: crate::denoise::REPROJECTION_TOLERANCE_PX,
         };
 
         #[test]

@@ -18,7 +18,7 @@ pub struct TaaParams {
     pub alpha: f32,
     /// Half-size of the clip box in standard deviations of the neighbourhood.
     pub gamma: f32,
-    /// Disocclusion tolerance, relative to the distance from the camera (as `ours`).
+    /// Disocclusion tolerance in pixels (see [`super::REPROJECTION_TOLERANCE_PX`]).
     pub tolerance: f32,
 }
 
@@ -27,7 +27,7 @@ impl Default for TaaParams {
         Self {
             alpha: 0.1,
             gamma: 1.0,
-            tolerance: 0.05,
+            tolerance: super::REPROJECTION_TOLERANCE_PX,
         }
     }
 }
@@ -57,6 +57,10 @@ impl Taa {
 }
 
 impl Denoiser for Taa {
+    fn uses_surface_features(&self) -> bool {
+        self.motion_source == 1
+    }
+
     fn name(&self) -> &str {
         "taa"
     }
@@ -71,13 +75,11 @@ impl Denoiser for Taa {
         let size = input.size;
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
         let color = graph.history(ctx, Self::HISTORY, desc)?;
-        let (pos_cur, pos_prev) = if self.motion_source == 0 {
-            (input.first_hit.cur, input.first_hit.prev)
-        } else {
-            (input.features.position.cur, input.features.position.prev)
-        };
-        let valid = color.valid && input.first_hit.valid && input.features.position.valid;
+        let positions = input.positions(self.name(), self.motion_source)?;
+        let (pos_cur, pos_prev) = (positions.cur, positions.prev);
+        let valid = color.valid && positions.valid;
         let p = self.params;
+        let uniforms = input.uniforms;
         let push = TaaPush {
             camera: input.camera.extend(1.0),
             width: size.width,
@@ -94,7 +96,8 @@ impl Denoiser for Taa {
         frame.add_pass(
             "taa",
             |b| {
-                b.read(noisy)
+                b.uniform(uniforms)
+                    .read(noisy)
                     .read(motion)
                     .read(pos_cur)
                     .sampled(pos_prev)
@@ -103,6 +106,7 @@ impl Denoiser for Taa {
             },
             move |pc| {
                 let binds = [
+                    ("frame", Bind::Buffer(uniforms)),
                     ("noisy", Bind::Image(noisy)),
                     ("motion", Bind::Image(motion)),
                     ("position_cur", Bind::Image(pos_cur)),

@@ -18,7 +18,7 @@ pub struct WrlsParams {
     pub h: f32,
     /// Initial P = delta · I for a new model.
     pub delta: f32,
-    /// Disocclusion tolerance, relative to the distance from the camera.
+    /// Disocclusion tolerance in pixels (see [`super::REPROJECTION_TOLERANCE_PX`]).
     pub tolerance: f32,
     pub sigma_spatial: f32,
     pub sigma_range: f32,
@@ -35,7 +35,7 @@ impl Default for WrlsParams {
             alpha: 0.75,
             h: 0.75,
             delta: 100.0,
-            tolerance: 0.05,
+            tolerance: super::REPROJECTION_TOLERANCE_PX,
             sigma_spatial: 2.0,
             sigma_range: 0.5,
             lambda_min: 0.5,
@@ -126,6 +126,10 @@ impl Wrls {
 }
 
 impl Denoiser for Wrls {
+    fn uses_surface_features(&self) -> bool {
+        self.motion_source == 1
+    }
+
     fn name(&self) -> &str {
         &self.name
     }
@@ -152,13 +156,11 @@ impl Denoiser for Wrls {
             graph.history(ctx, &format!("{n}.p2"), desc)?,
         ];
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
-        let (pos_cur, pos_prev) = if self.motion_source == 0 {
-            (input.first_hit.cur, input.first_hit.prev)
-        } else {
-            (input.features.position.cur, input.features.position.prev)
-        };
-        let valid = z.valid && input.first_hit.valid && input.features.position.valid;
+        let positions = input.positions(self.name(), self.motion_source)?;
+        let (pos_cur, pos_prev) = (positions.cur, positions.prev);
+        let valid = z.valid && positions.valid;
         let p = self.params;
+        let uniforms = input.uniforms;
         let push = WrlsUpdatePush {
             camera: input.camera.extend(1.0),
             width: size.width,
@@ -179,7 +181,8 @@ impl Denoiser for Wrls {
         frame.add_pass(
             format!("{n}.update"),
             |b| {
-                b.read(noisy)
+                b.uniform(uniforms)
+                    .read(noisy)
                     .read(motion)
                     .read(pos_cur)
                     .sampled(pos_prev)
@@ -194,6 +197,7 @@ impl Denoiser for Wrls {
             },
             move |pc| {
                 let binds = [
+                    ("frame", Bind::Buffer(uniforms)),
                     ("noisy", Bind::Image(noisy)),
                     ("motion", Bind::Image(motion)),
                     ("position_cur", Bind::Image(pos_cur)),

@@ -105,30 +105,8 @@ impl GpuImage {
         let d = &ctx.device;
         let image = unsafe { d.create_image(&info, None) }.vk("vkCreateImage")?;
         let requirements = unsafe { d.get_image_memory_requirements(image) };
-        let allocation = ctx
-            .allocator
-            .lock()
-            .map_err(|_| EngineError::Resource {
-                resource: name.into(),
-                problem: "allocator lock poisoned".into(),
-            })?
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            });
-        let allocation = match allocation {
-            Ok(a) => a,
-            Err(source) => {
-                unsafe { d.destroy_image(image, None) };
-                return Err(EngineError::Alloc {
-                    what: format!("image {name:?}"),
-                    source,
-                });
-            }
-        };
+        let allocation = allocate(ctx, name, requirements, MemoryLocation::GpuOnly, false)
+            .inspect_err(|_| unsafe { d.destroy_image(image, None) })?;
         unsafe { d.bind_image_memory(image, allocation.memory(), allocation.offset()) }
             .vk("vkBindImageMemory")?;
         let view_info = vk::ImageViewCreateInfo::default()
@@ -209,30 +187,8 @@ impl GpuBuffer {
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         let buffer = unsafe { d.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
         let requirements = unsafe { d.get_buffer_memory_requirements(buffer) };
-        let allocation = ctx
-            .allocator
-            .lock()
-            .map_err(|_| EngineError::Resource {
-                resource: name.into(),
-                problem: "allocator lock poisoned".into(),
-            })?
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            });
-        let allocation = match allocation {
-            Ok(a) => a,
-            Err(source) => {
-                unsafe { d.destroy_buffer(buffer, None) };
-                return Err(EngineError::Alloc {
-                    what: format!("buffer {name:?} ({size} bytes)"),
-                    source,
-                });
-            }
-        };
+        let allocation = allocate(ctx, name, requirements, location, true)
+            .inspect_err(|_| unsafe { d.destroy_buffer(buffer, None) })?;
         unsafe { d.bind_buffer_memory(buffer, allocation.memory(), allocation.offset()) }
             .vk("vkBindBufferMemory")?;
         set_name(ctx, buffer, name);
@@ -281,6 +237,33 @@ impl GpuBuffer {
             let _ = alloc.free(a);
         }
     }
+}
+
+/// Allocates memory for an image (`linear` false) or a buffer, naming the resource in
+/// the error.
+fn allocate(
+    ctx: &GpuContext,
+    name: &str,
+    requirements: vk::MemoryRequirements,
+    location: MemoryLocation,
+    linear: bool,
+) -> Result<Allocation> {
+    let mut allocator = ctx.allocator.lock().map_err(|_| EngineError::Resource {
+        resource: name.into(),
+        problem: "allocator lock poisoned".into(),
+    })?;
+    allocator
+        .allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        })
+        .map_err(|source| EngineError::Alloc {
+            what: format!("{name:?} ({} bytes)", requirements.size),
+            source,
+        })
 }
 
 /// Names an object for validation messages and GPU captures.

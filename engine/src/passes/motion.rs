@@ -27,9 +27,11 @@ impl Motion {
         frame: &mut Frame<'f>,
         uniforms: BufferHandle,
         first_hit: ImageHandle,
-        feature_position: ImageHandle,
+        feature_position: Option<ImageHandle>,
         size: Extent,
     ) -> Result<ImageHandle> {
+        // Without surface features this frame, zw repeats the first-collision motion.
+        let feature_position = feature_position.unwrap_or(first_hit);
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
         let motion = graph.image(ctx, "motion", desc)?;
         let push = MotionPush {

@@ -8,28 +8,8 @@ use crate::graph::{Bind, Frame, History, ImageHandle, RenderGraph};
 use crate::renderer::uniforms::PathTracePush;
 use ash::vk;
 
-/// Free-path estimator.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Estimator {
-    /// Delta tracking with ratio-tracked shadow rays over the majorant grid (unbiased).
-    #[default]
-    Delta,
-    /// Jittered Riemann-sum ray marching (Exposure Render's choice; biased by the step).
-    RayMarch,
-}
-
-/// Scattering model.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Phase {
-    #[default]
-    Isotropic,
-    /// Henyey–Greenstein with the scene's g.
-    Hg,
-    /// Exposure Render's gradient-based BRDF/phase hybrid.
-    Hybrid,
-}
+// The estimator and phase function are scene settings; one definition, in `scene`.
+pub use crate::scene::{Estimator, Phase};
 
 /// What the pipeline is specialised for (what the scene uses).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

@@ -5,6 +5,7 @@
 
 pub mod present;
 pub mod scene_gpu;
+pub mod scene_setup;
 pub mod uniforms;
 
 use crate::denoise::{self, Changes, DenoiseInputs, Denoiser};
@@ -55,6 +56,8 @@ pub struct RenderSettings {
     /// Extinction per unit opacity (1/world unit).
     pub density_scale: f32,
     pub seed: u32,
+    /// What the temporal denoisers reproject with.
+    pub motion_source: denoise::MotionSource,
 }
 
 impl Default for RenderSettings {
@@ -74,6 +77,7 @@ impl Default for RenderSettings {
             filter_sigma: 0.5,
             density_scale: 100.0,
             seed: 1,
+            motion_source: denoise::MotionSource::FirstHit,
         }
     }
 }
@@ -233,7 +237,7 @@ impl Renderer {
         };
         let denoisers = denoisers
             .iter()
-            .map(|n| denoise::create(&ctx, n))
+            .map(|n| denoise::create(&ctx, n, settings.motion_source))
             .collect::<Result<Vec<_>>>()?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
@@ -318,7 +322,7 @@ impl Renderer {
         let done = self.flush()?;
         let new = names
             .iter()
-            .map(|n| denoise::create(&self.ctx, n))
+            .map(|n| denoise::create(&self.ctx, n, self.settings.motion_source))
             .collect::<Result<Vec<_>>>()?;
         for d in &mut self.denoisers {
             d.destroy(&self.ctx);
@@ -354,7 +358,7 @@ impl Renderer {
                 self.volume_dims[0] as i32,
                 self.volume_dims[1] as i32,
                 self.volume_dims[2] as i32,
-                0,
+                self.bricks.brick as i32,
             ),
             counts: glam::IVec4::new(
                 inputs.lights.len().min(MAX_LIGHTS) as i32,
@@ -400,7 +404,11 @@ impl Renderer {
             (&self.ctx, &mut self.graph, &self.passes, self.settings.size);
 
         // features → path trace → motion → each denoiser on the same noisy frame.
-        let features = passes.features.add(ctx, graph, &mut frame, &scene, size)?;
+        let features = if self.denoisers.iter().any(|d| d.uses_surface_features()) {
+            Some(passes.features.add(ctx, graph, &mut frame, &scene, size)?)
+        } else {
+            None
+        };
         let noisy = passes.path_trace.add(
             ctx,
             graph,
@@ -417,7 +425,7 @@ impl Renderer {
             &mut frame,
             scene.uniforms,
             noisy.first_hit.cur,
-            features.position.cur,
+            features.map(|f| f.position.cur),
             size,
         )?;
         let input = DenoiseInputs {

@@ -36,6 +36,9 @@ impl VolumeFormat {
 /// Min/max normalised density per brick (a coarse grid over the volume).
 #[derive(Clone, Debug, PartialEq)]
 pub struct BrickRanges {
+    /// Brick edge in voxels; brick (i, j, k) covers voxels [i·brick, (i+1)·brick) etc.,
+    /// so the last brick along an axis may reach past the volume.
+    pub brick: u32,
     pub grid: [u32; 3],
     pub min: Vec<f32>,
     pub max: Vec<f32>,
@@ -77,6 +80,7 @@ impl VolumeUpload {
             bytes: v.data.as_bytes().to_vec(),
             world_size: extent.map(|e| e / longest),
             bricks: BrickRanges {
+                brick: grid.brick,
                 grid: grid.dims,
                 min: grid.min,
                 max: grid.max,
@@ -297,6 +301,7 @@ mod tests {
     fn majorant_bounds_every_interpolated_opacity_in_range() {
         let opacity: Vec<f32> = (0..256).map(|i| ((i as f32) * 0.37).sin().abs()).collect();
         let bricks = BrickRanges {
+            brick: 8,
             grid: [3, 1, 1],
             min: vec![0.0, 0.2, 0.9],
             max: vec![0.1, 0.55, 1.0],
@@ -318,6 +323,7 @@ mod tests {
         }
         // Tight for a constant range.
         let flat = BrickRanges {
+            brick: 8,
             grid: [1, 1, 1],
             min: vec![0.5],
             max: vec![0.5],

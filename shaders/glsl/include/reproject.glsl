@@ -6,6 +6,7 @@
 #define DVR_REPROJECT_GLSL
 
 #include "common.glsl"
+#include "frame.glsl"
 
 // Motion in pixels: xy from the closest first real collision, zw from the surface features.
 layout(binding = 20, rgba32f) uniform readonly image2D motion;
@@ -22,8 +23,21 @@ struct Reprojection {
     bool valid;  // on screen, same surface, history exists
 };
 
-// `tolerance` is the allowed world-space distance, relative to the distance from the
-// camera, between this surface and what was at the reprojected place last frame.
+vec2 to_pixel(mat4 view_proj, vec3 world, ivec2 size) {
+    vec4 clip = view_proj * vec4(world, 1.0);
+    return (clip.xy / max(clip.w, 1e-6) * 0.5 + 0.5) * vec2(size);
+}
+
+// Disocclusion by a screen-space round trip: what was at the reprojected place last
+// frame, projected with this frame's camera, must land within `tolerance` pixels of this
+// pixel. Unlike comparing world positions, this tolerates the stochastic depth of the
+// first real collision in semi-transparent media (with a still camera every surface maps
+// back onto itself; under motion a depth error only moves the round trip by its
+// parallax), and it also tests pixels whose ray missed this frame: a background pixel
+// where the object was last frame sends the object's point back to where the object is
+// now, far from here, so no colour is dragged into the background. Where last frame's
+// ray missed but this one hit, only a still pixel keeps its history (a semi-transparent
+// pixel whose first collision comes and goes), anything moving is a disocclusion.
 Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, float tolerance) {
     Reprojection r;
     vec4 m = imageLoad(motion, p);
@@ -34,11 +48,11 @@ Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, flo
     if (r.valid) {
         vec4 cur = imageLoad(position_cur, p);
         vec4 prev = texelFetch(position_prev, ivec2(q), 0);
-        if ((cur.w > 0.0) != (prev.w > 0.0)) {
-            r.valid = false;
+        if (prev.w > 0.0) {
+            vec2 back = to_pixel(frame.view_proj, prev.xyz, size);
+            r.valid = length(back - (vec2(p) + 0.5)) <= tolerance;
         } else if (cur.w > 0.0) {
-            float dist = length(cur.xyz - camera);
-            r.valid = length(cur.xyz - prev.xyz) <= tolerance * max(dist, 1e-3);
+            r.valid = length(delta) <= tolerance;
         }
     }
     return r;

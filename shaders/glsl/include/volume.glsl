@@ -51,8 +51,9 @@ vec2 intersect_box(vec3 o, vec3 d) {
     return vec2(max(max(tmin.x, tmin.y), max(tmin.z, 0.0)), min(min(tmax.x, tmax.y), tmax.z));
 }
 
-// Majorant grid traversal (Amanatides–Woo). The grid covers the box; cell c spans
-// brick c of the volume.
+// Majorant grid traversal (Amanatides–Woo). Cell c is brick c of the volume: bricks are
+// a whole number of voxels, so when a dimension is not a multiple of the brick the grid
+// reaches past the box (the walk still ends at the box exit).
 struct GridWalk {
     ivec3 cell;
     ivec3 step_dir;
@@ -64,7 +65,7 @@ struct GridWalk {
 GridWalk grid_walk_begin(vec3 o, vec3 d, float t) {
     GridWalk w;
     w.grid = textureSize(majorant_grid, 0);
-    vec3 cell_size = box_size() / vec3(w.grid);
+    vec3 cell_size = box_size() / vec3(frame.dims.xyz) * float(frame.dims.w);
     vec3 p = o + d * t;
     vec3 g = (p - frame.box_min.xyz) / cell_size;
     w.cell = clamp(ivec3(floor(g)), ivec3(0), w.grid - 1);

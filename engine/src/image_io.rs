@@ -1,9 +1,20 @@
-//! Frame files: linear float EXR (what the metrics and references use) and tone-mapped
-//! sRGB PNG (what people look at), both through the one tone map in `metrics::tonemap`.
+//! Frame files: linear float EXR (what the metrics, references and environment maps
+//! use) and tone-mapped sRGB PNG (what people look at), through the one tone map in
+//! `metrics::tonemap`.
 
-use anyhow::{Context, Result};
-use dvr_engine::metrics::{tonemap_srgb, Rgb32Image};
-use std::path::Path;
+use crate::metrics::{tonemap_srgb, Rgb32Image};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum ImageIoError {
+    #[error("{}: {message}", path.display())]
+    Exr { path: PathBuf, message: String },
+    #[error("{}: {message}", path.display())]
+    Png { path: PathBuf, message: String },
+}
+
+pub type Result<T> = std::result::Result<T, ImageIoError>;
 
 /// Exposure applied before the tone map for PNGs.
 pub const PNG_EXPOSURE: f32 = 1.0;
@@ -22,7 +33,10 @@ pub fn write_exr(path: &Path, img: &Rgb32Image) -> Result<()> {
         let p = img.data[y * w + x];
         (p[0], p[1], p[2])
     })
-    .with_context(|| format!("writing {}", path.display()))
+    .map_err(|e| ImageIoError::Exr {
+        path: path.to_path_buf(),
+        message: format!("cannot write EXR: {e}"),
+    })
 }
 
 pub fn read_exr(path: &Path) -> Result<Rgb32Image> {
@@ -37,7 +51,10 @@ pub fn read_exr(path: &Path) -> Result<Rgb32Image> {
             data[pos.y() * *w + pos.x()] = [r, g, b];
         },
     )
-    .with_context(|| format!("reading {}", path.display()))?;
+    .map_err(|e| ImageIoError::Exr {
+        path: path.to_path_buf(),
+        message: format!("cannot read EXR: {e}"),
+    })?;
     let size = image.layer_data.size;
     Ok(Rgb32Image {
         width: size.width() as u32,
@@ -55,5 +72,8 @@ pub fn write_png(path: &Path, img: &Rgb32Image) -> Result<()> {
         img.height,
         image::ExtendedColorType::Rgb8,
     )
-    .with_context(|| format!("writing {}", path.display()))
+    .map_err(|e| ImageIoError::Png {
+        path: path.to_path_buf(),
+        message: format!("cannot write PNG: {e}"),
+    })
 }

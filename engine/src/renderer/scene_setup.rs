@@ -1,0 +1,234 @@
+//! From a scene (engine/src/scene) to what the renderer takes: the volume as a texture
+//! upload with its brick ranges, the render settings the scene asks for (what the path
+//! tracer is specialised for), the environment map, and per frame the camera, the lights
+//! as GPU structs and the transfer function as LUTs. The CLI, the explorer and the tests
+//! all go through here.
+
+use super::scene_gpu::{EnvironmentUpload, LutUpload, VolumeUpload};
+use super::uniforms::{self, GpuLight};
+use super::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
+use crate::error::Result as EngineResult;
+use crate::gpu::GpuContext;
+use crate::image_io::ImageIoError;
+use crate::passes::path_trace::PathTraceFeatures;
+use crate::passes::Extent;
+use crate::scene::{self, Camera, EnvSource, Light, Scene, VolumeSource};
+use crate::transfer::{TfLut, LUT_SIZE};
+use crate::volume::{RawFormat, RawParams, Volume, VolumeError};
+use glam::{Vec3, Vec4};
+use std::sync::Arc;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum SetupError {
+    #[error(transparent)]
+    Volume(#[from] VolumeError),
+    #[error("environment map: {0}")]
+    Environment(#[from] ImageIoError),
+    #[error("scene {scene}: {problem}")]
+    Invalid { scene: String, problem: String },
+}
+
+/// A scene made ready for rendering.
+pub struct SceneSetup {
+    pub scene: Scene,
+    pub settings: RenderSettings,
+    pub volume: VolumeUpload,
+    pub environment: Option<EnvironmentUpload>,
+    lut_a: TfLut,
+    lut_b: Option<TfLut>,
+}
+
+impl SceneSetup {
+    /// `spp` overrides the scene's samples per frame; `volume_size` is the edge of
+    /// procedural volumes when the scene does not give one.
+    pub fn new(
+        scene: Scene,
+        size: Extent,
+        spp: Option<u32>,
+        volume_size: u32,
+    ) -> Result<Self, SetupError> {
+        let volume = load_volume(&scene, volume_size)?;
+        Self::with_volume(scene, &volume, size, spp)
+    }
+
+    /// [`SceneSetup::new`] with the volume already loaded (the explorer also draws its
+    /// histogram).
+    pub fn with_volume(
+        scene: Scene,
+        volume: &Volume,
+        size: Extent,
+        spp: Option<u32>,
+    ) -> Result<Self, SetupError> {
+        let settings = render_settings(&scene, size, spp.unwrap_or(scene.render.spp));
+        let environment = load_environment(&scene.lights)?;
+        let lut_a = scene.tf_a.lut();
+        let lut_b = scene.tf_b.as_ref().map(|b| b.lut());
+        Ok(Self {
+            volume: VolumeUpload::from_volume(volume),
+            settings,
+            environment,
+            scene,
+            lut_a,
+            lut_b,
+        })
+    }
+
+    pub fn renderer(&self, ctx: GpuContext, denoisers: &[&str]) -> EngineResult<Renderer> {
+        Renderer::new(
+            ctx,
+            self.settings.clone(),
+            &self.volume,
+            self.environment.as_ref(),
+            denoisers,
+            LUT_SIZE as u32,
+        )
+    }
+
+    /// A renderer on a context the caller keeps a handle to (the explorer's, which
+    /// also owns the window's swapchain).
+    pub fn renderer_shared(
+        &self,
+        ctx: Arc<GpuContext>,
+        denoisers: &[&str],
+    ) -> EngineResult<Renderer> {
+        Renderer::new_shared(
+            ctx,
+            self.settings.clone(),
+            &self.volume,
+            self.environment.as_ref(),
+            denoisers,
+            LUT_SIZE as u32,
+        )
+    }
+
+    /// The renderer's inputs for animation frame `f`.
+    pub fn frame_inputs(&self, f: u32) -> FrameInputs {
+        let state = self.scene.frame_state(f);
+        let size = self.settings.size;
+        let aspect = size.width as f32 / size.height.max(1) as f32;
+        let blended;
+        let lut = match &self.lut_b {
+            Some(b) if state.tf_blend > 0.0 => {
+                blended = TfLut::lerp(&self.lut_a, b, state.tf_blend);
+                &blended
+            }
+            _ => &self.lut_a,
+        };
+        inputs_for(&state.camera, aspect, &state.lights, lut)
+    }
+}
+
+/// The renderer's inputs for a camera, lights and a TF: the one place scene state
+/// becomes [`FrameInputs`] (a scene's frames and the explorer's edits alike).
+pub fn inputs_for(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -> FrameInputs {
+    let c = camera;
+    FrameInputs {
+        camera: CameraMatrices::look_at(c.position, c.target, c.up, c.fov_y, aspect),
+        lights: lights.iter().map(gpu_light).collect(),
+        lut: LutUpload::from(lut),
+    }
+}
+
+/// The scene's volume: a built-in dataset or a file.
+pub fn load_volume(scene: &Scene, volume_size: u32) -> Result<Volume, VolumeError> {
+    match &scene.volume.source {
+        VolumeSource::Builtin { dataset, size } => {
+            Volume::builtin(dataset.name(), size.unwrap_or(volume_size))
+        }
+        VolumeSource::File { path, raw } => {
+            let params = raw.as_ref().map(|r| RawParams {
+                dims: r.dims,
+                format: match r.format {
+                    scene::RawFormat::U8 => RawFormat::U8,
+                    scene::RawFormat::U16 => RawFormat::U16,
+                    scene::RawFormat::F32 => RawFormat::F32,
+                },
+                spacing: r.spacing.map(|s| s as f32),
+            });
+            Volume::load(path, params.as_ref())
+        }
+    }
+}
+
+/// The render settings a scene asks for, at `size` and `spp` samples per frame.
+pub fn render_settings(scene: &Scene, size: Extent, spp: u32) -> RenderSettings {
+    let r = &scene.render;
+    RenderSettings {
+        size,
+        spp,
+        max_bounces: r.max_bounces,
+        rr_depth: r.russian_roulette_depth,
+        features: PathTraceFeatures {
+            estimator: r.estimator,
+            phase: r.phase,
+            emission: r.emission,
+            environment_map: scene.lights.iter().any(
+                |l| matches!(l, Light::Environment(e) if matches!(e.source, EnvSource::Map { .. })),
+            ),
+        },
+        hg_g: r.hg_g as f32,
+        step_voxels: r.step_size as f32,
+        density_scale: scene.volume.density_scale as f32,
+        ..Default::default()
+    }
+}
+
+fn v3(d: glam::DVec3) -> Vec3 {
+    d.as_vec3()
+}
+
+/// A scene light as the path tracer's uniform struct (layout in include/frame.glsl).
+pub fn gpu_light(l: &Light) -> GpuLight {
+    match l {
+        Light::Point(p) => GpuLight {
+            position_kind: v3(p.position).extend(uniforms::LIGHT_POINT),
+            radiance: (v3(p.colour) * p.intensity as f32).extend(0.0),
+            ..Default::default()
+        },
+        Light::Area(a) => {
+            let (u, v) = a.half_axes();
+            GpuLight {
+                position_kind: v3(a.position).extend(uniforms::LIGHT_AREA),
+                radiance: (v3(a.colour) * a.intensity as f32).extend(0.0),
+                u_axis: v3(u).extend(0.0),
+                v_axis: v3(v).extend(0.0),
+            }
+        }
+        Light::Environment(e) => {
+            let k = e.intensity as f32;
+            let (top, bottom, mode) = match &e.source {
+                EnvSource::Constant { colour } => {
+                    (v3(*colour) * k, Vec3::ZERO, uniforms::ENV_CONSTANT)
+                }
+                EnvSource::Gradient { top, bottom } => {
+                    (v3(*top) * k, v3(*bottom) * k, uniforms::ENV_GRADIENT)
+                }
+                EnvSource::Map { .. } => (Vec3::ZERO, Vec3::ZERO, uniforms::ENV_MAP),
+            };
+            GpuLight {
+                position_kind: Vec4::new(0.0, 0.0, 0.0, uniforms::LIGHT_ENV),
+                radiance: top.extend(mode),
+                u_axis: bottom.extend(k),
+                v_axis: Vec4::ZERO,
+            }
+        }
+    }
+}
+
+/// The environment map of the scene's environment light, if it uses one.
+pub fn load_environment(lights: &[Light]) -> Result<Option<EnvironmentUpload>, ImageIoError> {
+    for l in lights {
+        if let Light::Environment(e) = l {
+            if let EnvSource::Map { path } = &e.source {
+                let img = crate::image_io::read_exr(path)?;
+                return Ok(Some(EnvironmentUpload {
+                    width: img.width,
+                    height: img.height,
+                    rgba: img.data.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect(),
+                }));
+            }
+        }
+    }
+    Ok(None)
+}

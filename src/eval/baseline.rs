@@ -1,0 +1,142 @@
+//! The speed-vs-accuracy baseline: plain accumulation of n spp (n = 1, 2, 4, …) on a
+//! few frames of a scene, scored against the reference. Its GPU time is the measured
+//! path-trace time per sample of the evaluated frames times n, so it sits on the same
+//! axis as the denoisers (which pay path tracing at `--spp` plus their own passes).
+
+use super::progress::Progress;
+use super::reference::ReferenceCache;
+use super::score::{score, FrameReference};
+use crate::setup::Setup;
+use anyhow::Result;
+use dvr_engine::image_io::to_rgb;
+use dvr_engine::renderer::Renderer;
+
+/// Largest sample count of the baseline curve.
+pub const MAX_SPP: u32 = 256;
+
+/// Samples per submission while accumulating.
+const BATCH: u32 = 32;
+
+/// Seed offset of the baseline's sample stream, so it is independent of the
+/// references' (which would otherwise share its first n samples and flatter it).
+const SEED_OFFSET: u32 = 0x5eed_0b11;
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct BaselinePoint {
+    pub frame: u32,
+    pub spp: u32,
+    pub gpu_ms: f64,
+    pub psnr: f64,
+}
+
+/// Sample counts of the curve: powers of two up to min([`MAX_SPP`], ref_spp / 2), so
+/// the baseline always has at most half the reference's samples.
+pub fn levels(ref_spp: u32) -> Vec<u32> {
+    let top = MAX_SPP.min(ref_spp / 2);
+    std::iter::successors(Some(1u32), |n| n.checked_mul(2))
+        .take_while(|&n| n <= top)
+        .collect()
+}
+
+/// Frames the baseline is measured on: the first and the middle one (the cost stays
+/// bounded whatever the animation length).
+pub fn frames(frames: u32) -> Vec<u32> {
+    let mut f = vec![0, frames / 2];
+    f.dedup();
+    f
+}
+
+/// Work units of the baseline of one scene (see [`Progress`]).
+pub fn units(frame_count: u32, ref_spp: u32) -> f64 {
+    let per_frame: u32 = levels(ref_spp).iter().sum();
+    (frames(frame_count).len() as u32 * per_frame) as f64
+}
+
+/// Measures the curve with `renderer` (after the evaluated frames: it changes the
+/// renderer's seed).
+pub fn measure(
+    renderer: &mut Renderer,
+    setup: &Setup,
+    references: &ReferenceCache,
+    path_trace_ms_per_spp: f64,
+    ref_spp: u32,
+    progress: &mut Progress,
+    label: &str,
+) -> Result<Vec<BaselinePoint>> {
+    renderer.settings.seed = renderer.settings.seed.wrapping_add(SEED_OFFSET);
+    let mut points = Vec::new();
+    for f in frames(setup.frames) {
+        let reference = FrameReference::new(&references.load(f)?);
+        for n in levels(ref_spp) {
+            let pixels = renderer.reference(&setup.inputs(f), n, BATCH)?;
+            let s = score(
+                &reference,
+                &to_rgb(setup.width(), setup.height(), &pixels),
+                None,
+            );
+            points.push(BaselinePoint {
+                frame: f,
+                spp: n,
+                gpu_ms: path_trace_ms_per_spp * f64::from(n),
+                psnr: s.psnr,
+            });
+            progress.advance(
+                f64::from(n),
+                &format!("{label} | baseline frame {f}, {n} spp"),
+            );
+        }
+    }
+    Ok(points)
+}
+
+/// The curve averaged over the measured frames: (spp, mean GPU ms, mean PSNR).
+pub fn mean_curve(points: &[BaselinePoint]) -> Vec<(u32, f64, f64)> {
+    let mut spps: Vec<u32> = points.iter().map(|p| p.spp).collect();
+    spps.sort_unstable();
+    spps.dedup();
+    spps.into_iter()
+        .map(|n| {
+            let at: Vec<&BaselinePoint> = points.iter().filter(|p| p.spp == n).collect();
+            let k = at.len() as f64;
+            (
+                n,
+                at.iter().map(|p| p.gpu_ms).sum::<f64>() / k,
+                at.iter().map(|p| p.psnr).sum::<f64>() / k,
+            )
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn levels_stop_at_half_the_reference_and_256() {
+        assert_eq!(levels(16), vec![1, 2, 4, 8]);
+        assert_eq!(levels(17), vec![1, 2, 4, 8]);
+        assert_eq!(levels(1), Vec::<u32>::new());
+        assert_eq!(levels(4096).last(), Some(&256));
+        assert_eq!(levels(4096).len(), 9);
+    }
+
+    #[test]
+    fn first_and_middle_frame() {
+        assert_eq!(frames(16), vec![0, 8]);
+        assert_eq!(frames(3), vec![0, 1]);
+        assert_eq!(frames(1), vec![0]);
+        assert_eq!(units(16, 16), 2.0 * 15.0);
+    }
+
+    #[test]
+    fn mean_curve_averages_frames() {
+        let p = |frame, spp, gpu_ms, psnr| BaselinePoint {
+            frame,
+            spp,
+            gpu_ms,
+            psnr,
+        };
+        let c = mean_curve(&[p(0, 1, 1.0, 20.0), p(8, 1, 1.0, 22.0), p(0, 2, 2.0, 25.0)]);
+        assert_eq!(c, vec![(1, 1.0, 21.0), (2, 2.0, 25.0)]);
+    }
+}

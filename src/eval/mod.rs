@@ -1,0 +1,169 @@
+//! `dvr eval`: every listed denoiser on scripted animations against high-sample
+//! references, in one run.
+//!
+//! For each scene: references at `--ref-spp` per frame (cached under
+//! `DIR/<scene>/reference/`, reused when the settings match), then one renderer with all
+//! denoisers renders each noisy frame once and feeds it to every method; each method's
+//! HDR output is tone-mapped with [`tonemap_srgb`](dvr_engine::metrics::tonemap_srgb)
+//! (exposure [`EXPOSURE`]) and scored against the tone-mapped reference (PSNR, SSIM,
+//! FLIP, temporal error), and its GPU time is the shared passes plus its own. A plain
+//! accumulation baseline at 1, 2, 4, … spp on a few frames gives the speed-vs-accuracy
+//! curve. Outputs (see the README's "Evaluation" section):
+//!
+//! ```text
+//! DIR/metrics.csv                 scene,method,frame,psnr,ssim,flip,temporal_error,gpu_ms
+//! DIR/summary.csv                 per scene and method: means and frames to recover
+//! DIR/baseline.csv                accumulation baseline: scene,frame,spp,gpu_ms,psnr
+//! DIR/index.html                  the results page (works from file://)
+//! DIR/plots/speed_accuracy.{svg,png}        all scenes
+//! DIR/<scene>/plots/*.{svg,png}             metric vs frame, speed vs accuracy
+//! DIR/<scene>/reference/NNNN.{exr,png}      + reference.json (the cache key)
+//! DIR/<scene>/<method>/NNNN.png, flip_NNNN.png   (+ NNNN.exr for `none`, the noisy input)
+//! DIR/<scene>/timings.json        per-frame, per-pass GPU timings
+//! ```
+//!
+//! One file per responsibility: [`scenes`] (which scenes, folder names, the event frame),
+//! [`reference`] (the cache), [`run`] (the frame loop), [`score`] (metrics of one frame),
+//! [`baseline`], [`csv`], [`plots`], [`html`], [`progress`].
+
+mod baseline;
+mod csv;
+mod html;
+mod images;
+mod plots;
+mod progress;
+mod reference;
+mod run;
+mod scenes;
+mod score;
+
+use anyhow::{bail, Context, Result};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Exposure of the tone map every metric and PNG of an eval uses.
+pub const EXPOSURE: f32 = 1.0;
+
+/// A method's PSNR must come back within this many dB of its level before a sudden
+/// change for the change to count as recovered from.
+pub const RECOVERY_TOLERANCE_DB: f64 = 1.0;
+
+/// Frames left out of the mean GPU time: the first dispatches include driver
+/// compilation (see [`crate::profile::WARMUP_FRAMES`]).
+pub const GPU_WARMUP_FRAMES: usize = crate::profile::WARMUP_FRAMES;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct EvalArgs {
+    /// `suite` (every built-in scene but the stress ones), `stress` (the tf-jump,
+    /// light-jump and fast-orbit scenes), or a comma-separated list of built-in scene
+    /// names and scene files.
+    #[arg(long, default_value = "suite")]
+    pub scene: String,
+    /// Frames of each animation (default: each scene's own length).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Samples per pixel per frame of the noisy input (default: the scene's, 2 for
+    /// built-ins).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Samples per pixel of the references.
+    #[arg(long = "ref-spp", default_value_t = 1024)]
+    pub ref_spp: u32,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "256x256", value_parser = crate::setup::parse_size)]
+    pub size: (u32, u32),
+    /// Comma-separated denoisers, all fed the same noisy frames.
+    #[arg(long, default_value = "none,accum,ours", value_delimiter = ',')]
+    pub denoiser: Vec<String>,
+    /// Output folder (references in it are reused when their settings match).
+    #[arg(long, default_value = "out/eval")]
+    pub out: PathBuf,
+    /// Edge length of procedural volumes (phantom, cloud).
+    #[arg(long, default_value_t = 128)]
+    pub volume_size: u32,
+    /// Position the temporal denoisers reproject with: `first-hit` or `features` (as
+    /// for `dvr capture`; references do not depend on it).
+    #[arg(long, default_value = "first-hit", value_parser = crate::setup::parse_motion)]
+    pub motion: dvr_engine::denoise::MotionSource,
+}
+
+pub fn eval(args: &EvalArgs) -> Result<()> {
+    let started = Instant::now();
+    if args.ref_spp == 0 {
+        bail!("--ref-spp must be at least 1");
+    }
+    let mut methods: Vec<String> = Vec::new();
+    for d in &args.denoiser {
+        let d = d.trim();
+        if d.is_empty() || methods.iter().any(|m| m == d) {
+            continue;
+        }
+        if !dvr_engine::denoise::NAMES.contains(&d) {
+            bail!(
+                "unknown denoiser {d:?}; available: {}",
+                dvr_engine::denoise::NAMES.join(", ")
+            );
+        }
+        methods.push(d.to_string());
+    }
+    if methods.is_empty() {
+        bail!("--denoiser names no method");
+    }
+    // Fail before hours of rendering, not after: the plots need a font.
+    plots::init_font()?;
+    let names = scenes::select(&args.scene)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let plan = run::Plan::new(args, &names, &methods)?;
+    let mut progress = progress::Progress::new(plan.total_units());
+    let mut results = Vec::new();
+    let mut device = String::new();
+    for (i, scene) in plan.scenes.iter().enumerate() {
+        let label = format!("[{}/{}] {}", i + 1, plan.scenes.len(), scene.name);
+        let r = run::evaluate_scene(args, &methods, scene, &label, &mut progress)
+            .with_context(|| format!("evaluating {}", scene.name))?;
+        device.clone_from(&r.device);
+        plots::scene_plots(&args.out, &r)?;
+        results.push(r);
+        // Everything is rewritten after each scene, so an interrupted eval leaves a
+        // consistent report of the scenes it finished.
+        write_reports(args, &methods, &results, &device, started)?;
+    }
+    progress.finish();
+    let overall = csv::overall_summary(&results, &methods);
+    print!("{}", csv::summary_table(&results, &overall));
+    println!(
+        "eval: {} scene(s) × {} method(s) in {:.1} s; open {}",
+        results.len(),
+        methods.len(),
+        started.elapsed().as_secs_f64(),
+        args.out.join("index.html").display()
+    );
+    Ok(())
+}
+
+fn write_reports(
+    args: &EvalArgs,
+    methods: &[String],
+    results: &[run::SceneResult],
+    device: &str,
+    started: Instant,
+) -> Result<()> {
+    let out = &args.out;
+    csv::write_metrics(&out.join("metrics.csv"), results)?;
+    csv::write_summary(&out.join("summary.csv"), results)?;
+    csv::write_baseline(&out.join("baseline.csv"), results)?;
+    let overall = csv::overall_summary(results, methods);
+    plots::overall_plot(out, results, &overall)?;
+    html::write_page(
+        &out.join("index.html"),
+        &html::PageInfo {
+            args,
+            methods,
+            device,
+            seconds: started.elapsed().as_secs_f64(),
+        },
+        results,
+        &overall,
+    )
+}

@@ -1,0 +1,127 @@
+//! Which scenes an eval runs, the folder each one's files go to, and where a scene's
+//! sudden change happens.
+
+use anyhow::{bail, Result};
+use dvr_engine::renderer::FrameInputs;
+use dvr_engine::scene::Scene;
+
+/// Animations that make methods fail on purpose; `--scene stress` runs these and
+/// `--scene suite` leaves them out.
+pub const STRESS_ANIMATIONS: [&str; 3] = ["tf-jump", "light-jump", "fast-orbit"];
+
+/// Animations with one sudden change, after which frames to recover are measured.
+pub const SUDDEN_ANIMATIONS: [&str; 2] = ["tf-jump", "light-jump"];
+
+fn animation(name: &str) -> &str {
+    name.rsplit('/').next().unwrap_or(name)
+}
+
+/// The scene names (or files) `--scene` selects, in order, without duplicates.
+pub fn select(spec: &str) -> Result<Vec<String>> {
+    let builtin = Scene::builtin_names();
+    let is_stress = |n: &String| STRESS_ANIMATIONS.contains(&animation(n));
+    let mut out: Vec<String> = Vec::new();
+    for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let add: Vec<String> = match item {
+            "suite" => builtin.iter().filter(|n| !is_stress(n)).cloned().collect(),
+            "stress" => builtin.iter().filter(|n| is_stress(n)).cloned().collect(),
+            other => vec![other.to_string()],
+        };
+        for n in add {
+            if !out.contains(&n) {
+                out.push(n);
+            }
+        }
+    }
+    if out.is_empty() {
+        bail!("--scene selects no scene (use suite, stress, or names from `dvr scenes`)");
+    }
+    Ok(out)
+}
+
+/// The folder name of a scene inside the eval folder: its name with `/` (and anything
+/// else that is awkward in a path or URL) replaced by `_`, e.g. `cloud/orbit` →
+/// `cloud_orbit`.
+pub fn dir_name(scene: &str) -> String {
+    let s: String = scene
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let s = s.trim_matches('.').to_string();
+    if s.is_empty() {
+        "scene".to_string()
+    } else {
+        s
+    }
+}
+
+/// True for scenes with one sudden change (a TF or light jump).
+pub fn has_sudden_change(scene: &str) -> bool {
+    SUDDEN_ANIMATIONS.contains(&animation(scene))
+}
+
+/// The frame at which a sudden change takes effect: the first frame whose lights or
+/// transfer function differ from the frame before (the built-in jumps happen at the
+/// middle frame; this finds it whatever `--frames` rescaled it to). Falls back to the
+/// middle frame when nothing changes.
+pub fn event_frame(frames: u32, inputs: impl Fn(u32) -> FrameInputs) -> u32 {
+    let mut prev = inputs(0);
+    for f in 1..frames {
+        let cur = inputs(f);
+        if cur.lights != prev.lights || cur.lut != prev.lut {
+            return f;
+        }
+        prev = cur;
+    }
+    frames / 2
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn suite_and_stress_split_the_builtins() {
+        let all = Scene::builtin_names();
+        let suite = select("suite").unwrap();
+        let stress = select("stress").unwrap();
+        assert_eq!(suite.len() + stress.len(), all.len());
+        assert!(stress
+            .iter()
+            .all(|n| STRESS_ANIMATIONS.contains(&animation(n))));
+        assert!(suite
+            .iter()
+            .all(|n| !STRESS_ANIMATIONS.contains(&animation(n))));
+        assert!(stress.contains(&"cloud/tf-jump".to_string()));
+        assert!(suite.contains(&"cloud/orbit".to_string()));
+    }
+
+    #[test]
+    fn lists_keep_order_and_drop_duplicates() {
+        let s = select("cloud/orbit, phantom/tf-jump,cloud/orbit").unwrap();
+        assert_eq!(s, vec!["cloud/orbit", "phantom/tf-jump"]);
+        assert!(select(" , ").is_err());
+    }
+
+    #[test]
+    fn folder_names() {
+        assert_eq!(dir_name("cloud/orbit"), "cloud_orbit");
+        assert_eq!(dir_name("mri/tf-jump"), "mri_tf-jump");
+        assert_eq!(dir_name("../x y"), "_x_y");
+        assert_eq!(dir_name(".."), "scene");
+    }
+
+    #[test]
+    fn sudden_changes() {
+        assert!(has_sudden_change("mri/tf-jump"));
+        assert!(has_sudden_change("cloud/light-jump"));
+        assert!(!has_sudden_change("cloud/fast-orbit"));
+        assert!(!has_sudden_change("cloud/orbit"));
+    }
+}
