@@ -748,8 +748,7 @@ impl Explorer {
             if !passes.is_empty() {
                 let span = self.gpu_spans.iter().sum::<f64>() / self.gpu_spans.len().max(1) as f64;
                 println!(
-                    "explore: GPU frame span {span:.1} ms; per pass (on lavapipe one pass \
-                     late once the UI has drawn, see ui::gpu_span_ms): {}",
+                    "explore: GPU frame span {span:.1} ms; ms per pass: {}",
                     passes.join(", ")
                 );
             }

@@ -50,11 +50,8 @@ pub struct Stats {
     pub history: VecDeque<(f32, f32)>,
 }
 
-/// The GPU time from the first pass's start to the last pass's end. Unlike the sum of
-/// per-pass times it stays right on lavapipe, where (llvmpipe bins a timestamp with the
-/// framebuffer bound by the UI's graphics pass and records it at the next flush) each
-/// timestamp lands one pass late, so compute passes read ~0 ms and their time falls in
-/// the gaps between passes.
+/// The GPU time from the first pass's start to the last pass's end (the sum of the
+/// per-pass times leaves out the barriers between passes).
 pub fn gpu_span_ms(timings: &[PassTiming]) -> f64 {
     timings
         .iter()
@@ -483,15 +480,6 @@ fn timing(ui: &mut egui::Ui, stats: &Stats) {
         "GPU frame span {:.2} ms (sum of passes {total:.2} ms)",
         gpu_span_ms(&stats.timings)
     ));
-    if stats.device.contains("llvmpipe") {
-        ui.label(
-            RichText::new(
-                "lavapipe records timestamps one pass late once the UI has drawn: \
-                 trust the span; `dvr profile` gives per-pass times",
-            )
-            .small(),
-        );
-    }
     // Frame-time graph: CPU frame interval (orange) and GPU total (blue).
     let (rect, _) = ui.allocate_exact_size(egui::vec2(width, 60.0), egui::Sense::hover());
     let p = ui.painter();
