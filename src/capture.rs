@@ -39,7 +39,6 @@ pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()>
     let request = FrameRequest {
         readback: true,
         reset: false,
-        ..Default::default()
     };
     for f in 0..setup.frames {
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {

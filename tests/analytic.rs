@@ -93,7 +93,6 @@ fn identical_seeds_give_identical_images() {
             &dvr_engine::renderer::FrameRequest {
                 readback: true,
                 reset: false,
-                ..Default::default()
             },
         )
         .expect("frame");

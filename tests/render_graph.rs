@@ -152,3 +152,38 @@ fn new_images_start_at_zero() {
     graph.destroy(&ctx);
     assert_validation_clean();
 }
+
+#[test]
+fn a_volume_too_large_for_the_device_is_refused_before_allocation() {
+    use dvr_engine::renderer::scene_gpu::{
+        check_volume_fits, BrickRanges, VolumeFormat, VolumeUpload,
+    };
+    let ctx = context();
+    // Only the header matters: the limits are checked before the bytes.
+    let huge = VolumeUpload {
+        name: "huge".into(),
+        dims: [4096, 4096, 4096],
+        format: VolumeFormat::R16,
+        bytes: Vec::new(),
+        world_size: [1.0; 3],
+        bricks: BrickRanges {
+            brick: 8,
+            grid: [1, 1, 1],
+            min: vec![0.0],
+            max: vec![1.0],
+        },
+    };
+    let err = check_volume_fits(&ctx, &huge)
+        .expect_err("256 GiB cannot fit")
+        .to_string();
+    assert!(
+        err.contains("huge") && err.contains(&ctx.info.name),
+        "message: {err}"
+    );
+    let mut too_tall = huge.clone();
+    too_tall.dims = [8, 8, ctx.info.max_image_dimension_3d + 1];
+    let err = check_volume_fits(&ctx, &too_tall)
+        .expect_err("dimension limit")
+        .to_string();
+    assert!(err.contains("dimension"), "message: {err}");
+}

@@ -1,7 +1,11 @@
 #version 460
 // The paper's denoiser, spatial part: pixel i's colour blends the predictions of the 25
 // linear models in its 5×5 window, each applied to i's own predictor p_i, with bilateral
-// weights (pixel distance and temporal-feature difference).
+// weights: pixel distance, and for the paper's variant the temporal-feature difference.
+// `ours` weighs a neighbour by how far its prediction lies from pixel i's own, in units of
+// the two predictions' standard errors (residual noise level × P00, what RLS knows of its
+// own uncertainty): young models blend widely, converged ones only with neighbours that
+// agree, so the filter never blurs what the per-pixel models have resolved.
 #include "common.glsl"
 #include "wrls.glsl"
 
@@ -13,19 +17,33 @@ layout(binding = 2, rgba32f) uniform readonly image2D beta_g;
 layout(binding = 3, rgba32f) uniform readonly image2D beta_b;
 layout(binding = 4, rgba32f) uniform readonly image2D noisy;
 layout(binding = 5, rgba32f) uniform writeonly image2D denoised;
+layout(binding = 6, rgba32f) uniform readonly image2D p0;  // x: P00
+layout(binding = 7, rgba32f) uniform readonly image2D p2;  // z: residual noise level
 
 layout(push_constant) uniform WrlsSpatialPush {
     uint width;
     uint height;
     float sigma_spatial;  // pixels
-    float sigma_range;    // relative feature difference
+    float sigma_range;    // relative feature difference (paper's variant)
+    float kappa;          // standard errors a neighbour's prediction may differ by (ours)
+    float pad0;
+    float pad1;
+    float pad2;
 } pc;
+
+// Variance of a model's constant term: residual noise per channel × P00.
+float prediction_variance(ivec2 j) {
+    return max(imageLoad(p2, j).z, 0.0) / 3.0 * max(imageLoad(p0, j).x, 0.0);
+}
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
     if (p.x >= size.x || p.y >= size.y) return;
     vec3 zi = imageLoad(z, p).rgb;
+    vec3 own = vec3(dot(predictor(zi), imageLoad(beta_r, p)), dot(predictor(zi), imageLoad(beta_g, p)),
+                    dot(predictor(zi), imageLoad(beta_b, p)));
+    float var_i = prediction_variance(p);
     vec4 xi = predictor(zi);
     float norm_i = dot(zi, zi) + 1e-4;
     vec3 sum = vec3(0.0);
@@ -35,11 +53,19 @@ void main() {
             ivec2 j = p + ivec2(dx, dy);
             if (any(lessThan(j, ivec2(0))) || any(greaterThanEqual(j, size))) continue;
             vec3 zj = imageLoad(z, j).rgb;
-            vec3 dz = zi - zj;
-            float w = exp(-float(dx * dx + dy * dy) / (2.0 * pc.sigma_spatial * pc.sigma_spatial)
-                          - dot(dz, dz) / (pc.sigma_range * pc.sigma_range * norm_i));
             vec3 pred = vec3(dot(xi, imageLoad(beta_r, j)), dot(xi, imageLoad(beta_g, j)),
                              dot(xi, imageLoad(beta_b, j)));
+            float range;
+            if (PAPER_PREDICTOR) {
+                vec3 dz = zi - zj;
+                range = dot(dz, dz) / (pc.sigma_range * pc.sigma_range * norm_i);
+            } else {
+                vec3 dp = pred - own;
+                float var = var_i + prediction_variance(j) + 1e-8;
+                range = dot(dp, dp) / 3.0 / (pc.kappa * pc.kappa * var);
+            }
+            float w = exp(-float(dx * dx + dy * dy) / (2.0 * pc.sigma_spatial * pc.sigma_spatial)
+                          - range);
             sum += w * pred;
             wsum += w;
         }

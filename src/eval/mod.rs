@@ -83,7 +83,7 @@ pub struct EvalArgs {
     pub volume_size: u32,
     /// Position the temporal denoisers reproject with: `first-hit` or `features` (as
     /// for `dvr capture`; references do not depend on it).
-    #[arg(long, default_value = "first-hit", value_parser = crate::setup::parse_motion)]
+    #[arg(long, default_value = "features", value_parser = crate::setup::parse_motion)]
     pub motion: dvr_engine::denoise::MotionSource,
 }
 

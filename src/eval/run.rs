@@ -294,7 +294,6 @@ pub fn evaluate_scene(
     let request = FrameRequest {
         readback: true,
         reset: false,
-        ..Default::default()
     };
     let frame_units = f64::from(setup.settings.spp) + methods.len() as f64;
     let status = |f: u32| {

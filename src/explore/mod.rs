@@ -6,7 +6,7 @@
 //! edits the [`ui::Model`] → model changes go to the renderer (denoisers, settings; a
 //! pipeline-specialising change rebuilds it) → acquire a swapchain image → the frame's
 //! inputs from the camera, lights and TF through `scene_setup::inputs_for` (the same path
-//! `dvr capture` takes) → `Renderer::frame` with a present target → present → handle
+//! `dvr capture` takes) → `Renderer::frame_presented` → present → handle
 //! the results of the frame that finished (timings, screenshots, recorded frames).
 //!
 //! Mouse and keys: see [`input::SHORTCUTS`]; `--script` plays the same commands at given
@@ -23,6 +23,7 @@ use crate::setup;
 use anyhow::{bail, Context, Result};
 use ash::vk;
 use camera::OrbitCamera;
+use dvr_engine::denoise::MotionSource;
 use dvr_engine::gpu::{ContextOptions, GpuContext, Swapchain};
 use dvr_engine::image_io::{to_rgb, write_exr, write_png, PNG_EXPOSURE};
 use dvr_engine::passes::present::PresentLayout;
@@ -94,6 +95,10 @@ pub struct ExploreArgs {
     /// Edge length of procedural volumes (phantom, cloud).
     #[arg(long, default_value_t = 128)]
     pub volume_size: u32,
+    /// Where motion vectors come from: `features` (opacity-threshold surface) or
+    /// `first-hit` (closest first real collision), as for the other commands.
+    #[arg(long, default_value = setup::DEFAULT_MOTION, value_parser = setup::parse_motion)]
+    pub motion: MotionSource,
 }
 
 /// True when the environment names an X11 or Wayland display.
@@ -145,7 +150,8 @@ pub fn run(args: ExploreArgs) -> Result<()> {
         width: args.size.0,
         height: args.size.1,
     };
-    let setup = SceneSetup::with_volume(scene, &volume, size, args.spp)?;
+    let mut setup = SceneSetup::with_volume(scene, &volume, size, args.spp)?;
+    setup.settings.motion_source = args.motion;
     drop(volume);
     let event_loop = EventLoop::new().map_err(|e| anyhow::anyhow!("{NO_DISPLAY} ({e})"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
@@ -607,9 +613,8 @@ impl Explorer {
         let request = FrameRequest {
             readback: readback_hdr,
             reset,
-            present: Some(target),
         };
-        let result = renderer.frame(&inputs, &request)?;
+        let result = renderer.frame_presented(&inputs, &request, Some(&target))?;
         if !gfx.swapchain.present(&gfx.ctx, &image)? {
             self.resized = true;
         }
@@ -719,11 +724,18 @@ impl Explorer {
         if let Some(rec) = &self.recorder {
             if let Some(path) = rec.finish(&self.setup.scene, self.args.volume_size)? {
                 println!(
-                    "explore: recorded {} frames; replay with: dvr capture --scene {} --size {}x{}",
+                    "explore: recorded {} frames; replay with: dvr capture --scene {} --size {}x{} \
+                     --volume-size {} --motion {} --denoiser {}",
                     rec.frame_count(),
                     path.display(),
                     self.ui.stats.render_size.0,
-                    self.ui.stats.render_size.1
+                    self.ui.stats.render_size.1,
+                    self.args.volume_size,
+                    match self.args.motion {
+                        MotionSource::FirstHit => "first-hit",
+                        MotionSource::Features => "features",
+                    },
+                    self.model.left,
                 );
             }
         }

@@ -22,6 +22,9 @@ pub struct WrlsParams {
     pub tolerance: f32,
     pub sigma_spatial: f32,
     pub sigma_range: f32,
+    /// Standard errors by which a neighbour's prediction may differ from the pixel's own
+    /// and still be blended (ours' spatial weights).
+    pub kappa: f32,
     /// Forgetting factor while a change is detected (adaptive λ only).
     pub lambda_min: f32,
     /// Squared a-priori residual over its running noise level that counts as a change.
@@ -38,6 +41,7 @@ impl Default for WrlsParams {
             tolerance: super::REPROJECTION_TOLERANCE_PX,
             sigma_spatial: 2.0,
             sigma_range: 0.5,
+            kappa: 2.0,
             lambda_min: 0.5,
             change_ratio: 9.0,
         }
@@ -118,7 +122,7 @@ impl Wrls {
         Ok(Self {
             name: name.to_string(),
             update: ComputePipeline::new(ctx, "wrls_update", &spec)?,
-            spatial: ComputePipeline::new(ctx, "wrls_spatial", &spec[1..2])?,
+            spatial: ComputePipeline::new(ctx, "wrls_spatial", &[spec[1], spec[3]])?,
             params: WrlsParams::default(),
             motion_source,
         })
@@ -226,11 +230,19 @@ impl Denoiser for Wrls {
             height: size.height,
             sigma_spatial: p.sigma_spatial,
             sigma_range: p.sigma_range,
+            kappa: p.kappa,
+            pad0: 0.0,
+            pad1: 0.0,
+            pad2: 0.0,
         };
         frame.add_pass(
             format!("{n}.spatial"),
             |b| {
-                b.read(z.cur).read(noisy).write(out);
+                b.read(z.cur)
+                    .read(noisy)
+                    .read(pm[0].cur)
+                    .read(pm[2].cur)
+                    .write(out);
                 for h in &beta {
                     b.read(h.cur);
                 }
@@ -243,6 +255,8 @@ impl Denoiser for Wrls {
                     ("beta_b", Bind::Image(beta[2].cur)),
                     ("noisy", Bind::Image(noisy)),
                     ("denoised", Bind::Image(out)),
+                    ("p0", Bind::Image(pm[0].cur)),
+                    ("p2", Bind::Image(pm[2].cur)),
                 ];
                 let groups = self.spatial.groups_2d(size.width, size.height);
                 pc.dispatch(&self.spatial, &binds, &spush, groups)

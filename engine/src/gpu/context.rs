@@ -23,6 +23,8 @@ pub struct DeviceInfo {
     pub max_memory_allocation_size: u64,
     pub max_storage_buffer_range: u32,
     pub max_push_constants_size: u32,
+    /// Size of the largest device-local memory heap.
+    pub device_local_heap: u64,
     /// `shaderStorageImageWriteWithoutFormat` (enabled when present): the present pass
     /// writes swapchain images of whatever format the surface offers.
     pub storage_write_without_format: bool,
@@ -299,6 +301,7 @@ fn pick_device(
             max_memory_allocation_size: max_allocation(instance, p),
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             max_push_constants_size: props.limits.max_push_constants_size,
+            device_local_heap: largest_device_heap(instance, p),
             storage_write_without_format: unsafe { instance.get_physical_device_features(p) }
                 .shader_storage_image_write_without_format
                 == vk::TRUE,
@@ -322,6 +325,16 @@ fn pick_device(
             names.join(", ")
         ))
     })
+}
+
+fn largest_device_heap(instance: &ash::Instance, p: vk::PhysicalDevice) -> u64 {
+    let mem = unsafe { instance.get_physical_device_memory_properties(p) };
+    mem.memory_heaps_as_slice()
+        .iter()
+        .filter(|h| h.flags.contains(vk::MemoryHeapFlags::DEVICE_LOCAL))
+        .map(|h| h.size)
+        .max()
+        .unwrap_or(0)
 }
 
 fn max_allocation(instance: &ash::Instance, p: vk::PhysicalDevice) -> u64 {

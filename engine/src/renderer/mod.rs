@@ -130,13 +130,11 @@ pub struct FrameInputs {
 
 /// What one frame should produce.
 #[derive(Clone, Debug, Default)]
-pub struct FrameRequest<'a> {
+pub struct FrameRequest {
     /// Read the outputs of these methods back to the host ("noisy" is the raw radiance).
     pub readback: bool,
     /// Restart every history (a cut).
     pub reset: bool,
-    /// Present the frame to a window's swapchain image (see [`present`]).
-    pub present: Option<PresentTarget<'a>>,
 }
 
 /// Results of a completed frame.
@@ -385,9 +383,21 @@ impl Renderer {
         inputs: &FrameInputs,
         request: &FrameRequest,
     ) -> Result<Option<FrameResult>> {
+        self.frame_presented(inputs, request, None)
+    }
+
+    /// [`Renderer::frame`], ending on screen when `present` is given: the denoised frame
+    /// is tone-mapped into the acquired swapchain image, the overlay drawn on top, and
+    /// the submission waits for and signals the image's semaphores (see [`present`]).
+    pub fn frame_presented(
+        &mut self,
+        inputs: &FrameInputs,
+        request: &FrameRequest,
+        present: Option<&PresentTarget<'_>>,
+    ) -> Result<Option<FrameResult>> {
         let slot = (self.frame_index % SLOTS as u64) as usize;
         let completed = self.wait_slot(slot)?;
-        if request.present.is_some() && self.passes.present.is_none() {
+        if present.is_some() && self.passes.present.is_none() {
             self.passes.present = Some(Present::new(&self.ctx)?);
         }
         let changes = self.changes(inputs, request.reset);
@@ -453,9 +463,9 @@ impl Renderer {
         // On screen: tone map into the swapchain image, UI on top, hand it over.
         let mut screenshot = None;
         let mut semaphores = None;
-        if let (Some(target), Some(present)) = (&request.present, &passes.present) {
+        if let (Some(target), Some(pass)) = (present, &passes.present) {
             screenshot = present::add_present_passes(
-                ctx, graph, &mut frame, present, slot, target, &outputs, size,
+                ctx, graph, &mut frame, pass, slot, target, &outputs, size,
             )?;
             semaphores = Some((target.image.wait, target.image.signal));
         }

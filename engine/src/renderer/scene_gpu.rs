@@ -148,21 +148,13 @@ pub fn add_upload<'f>(
     Ok(())
 }
 
-/// Checks a volume against the device's limits before anything is allocated.
+/// Checks a volume against the device's limits before anything is allocated: each
+/// dimension within the 3D image limit, the texture within one allocation, and the
+/// texture plus its staging copy within the device-local heap (lavapipe: a 1024³ 8-bit
+/// volume fits its 2 GiB, a 1024³ 16-bit one does not).
 pub fn check_volume_fits(ctx: &GpuContext, v: &VolumeUpload) -> Result<()> {
     let texels: u64 = v.dims.iter().map(|&d| d as u64).product();
     let needed = texels * v.format.bytes() as u64;
-    if needed != v.bytes.len() as u64 {
-        return Err(EngineError::Resource {
-            resource: v.name.clone(),
-            problem: format!(
-                "{} bytes for {:?} voxels of {:?}",
-                v.bytes.len(),
-                v.dims,
-                v.format
-            ),
-        });
-    }
     if let Some(&d) = v
         .dims
         .iter()
@@ -175,13 +167,31 @@ pub fn check_volume_fits(ctx: &GpuContext, v: &VolumeUpload) -> Result<()> {
             device: ctx.info.name.clone(),
         });
     }
-    // The texture and its staging copy live at once; each must fit one allocation.
-    if needed > ctx.info.max_memory_allocation_size {
+    let heap = if ctx.info.device_local_heap > 0 {
+        ctx.info.device_local_heap
+    } else {
+        u64::MAX
+    };
+    if needed > ctx.info.max_memory_allocation_size || needed.saturating_mul(2) > heap {
         return Err(EngineError::TooLarge {
-            what: format!("volume {:?} ({:?} voxels, {:?})", v.name, v.dims, v.format),
-            needed,
-            limit: ctx.info.max_memory_allocation_size,
+            what: format!(
+                "volume {:?} ({:?} voxels, {:?}; the texture and its upload copy)",
+                v.name, v.dims, v.format
+            ),
+            needed: needed.saturating_mul(2),
+            limit: heap.min(ctx.info.max_memory_allocation_size.saturating_mul(2)),
             device: ctx.info.name.clone(),
+        });
+    }
+    if needed != v.bytes.len() as u64 {
+        return Err(EngineError::Resource {
+            resource: v.name.clone(),
+            problem: format!(
+                "{} bytes for {:?} voxels of {:?}",
+                v.bytes.len(),
+                v.dims,
+                v.format
+            ),
         });
     }
     Ok(())

@@ -101,6 +101,10 @@ pub struct WrlsSpatialPush {
     pub height: u32,
     pub sigma_spatial: f32,
     pub sigma_range: f32,
+    pub kappa: f32,
+    pub pad0: f32,
+    pub pad1: f32,
+    pub pad2: f32,
 }
 
 #[repr(C)]
@@ -285,7 +289,11 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 width,
                 height,
                 sigma_spatial,
-                sigma_range
+                sigma_range,
+                kappa,
+                pad0,
+                pad1,
+                pad2
             }),
         ),
         (
