@@ -1,10 +1,11 @@
 //! `dvr`: real-time Monte Carlo direct volume rendering with temporal denoising.
-//! Subcommands: capture (offscreen sequences), reference (high-sample references),
-//! eval (denoisers against references: metrics, plots, HTML), profile (per-pass GPU
-//! timing), scenes (the built-in scenes).
+//! Subcommands: explore (the interactive window), capture (offscreen sequences),
+//! reference (high-sample references), eval (denoisers against references: metrics,
+//! plots, HTML), profile (per-pass GPU timing), scenes (the built-in scenes).
 
 mod capture;
 mod eval;
+mod explore;
 mod profile;
 mod setup;
 
@@ -45,12 +46,15 @@ pub struct SceneArgs {
     /// surface, or the expected first collision through semi-transparent layers; measured
     /// 1.5–2 dB better for every temporal method) or `first-hit` (the closest first real
     /// collision among the frame's samples, the paper's choice).
-    #[arg(long, default_value = "features", value_parser = setup::parse_motion)]
+    #[arg(long, default_value = setup::DEFAULT_MOTION, value_parser = setup::parse_motion)]
     pub motion: dvr_engine::denoise::MotionSource,
 }
 
 #[derive(Subcommand)]
 enum Command {
+    /// Open a window: the path tracer and a denoiser live, with an orbit camera, a
+    /// transfer-function editor, light and render controls and per-pass GPU timing.
+    Explore(explore::ExploreArgs),
     /// Render an animation offscreen with one or more denoisers: EXR + PNG per frame,
     /// per-pass GPU timings and an HTML page.
     Capture {
@@ -129,6 +133,7 @@ fn error_chain(e: &anyhow::Error) -> String {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
+        Command::Explore(args) => explore::run(args),
         Command::Capture {
             scene,
             denoiser,

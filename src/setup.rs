@@ -33,7 +33,10 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// A scene opened from the command line, made ready for rendering.
+/// The `--motion` every rendering command (and the explorer) defaults to.
+pub const DEFAULT_MOTION: &str = "features";
+
+/// Parses `--motion`: the position motion vectors come from.
 pub fn parse_motion(s: &str) -> Result<MotionSource, String> {
     match s {
         "first-hit" => Ok(MotionSource::FirstHit),

@@ -12,6 +12,7 @@ packages=(
   libshaderc-dev glslang-dev glslang-tools spirv-tools
   pkg-config cmake
   fonts-dejavu-core chromium
+  xvfb libx11-xcb1 libxcursor1 libxi6 libxrandr2 libxkbcommon-x11-0
 )
 
 missing=()

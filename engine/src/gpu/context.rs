@@ -25,6 +25,9 @@ pub struct DeviceInfo {
     pub max_push_constants_size: u32,
     /// Size of the largest device-local memory heap.
     pub device_local_heap: u64,
+    /// `shaderStorageImageWriteWithoutFormat` (enabled when present): the present pass
+    /// writes swapchain images of whatever format the surface offers.
+    pub storage_write_without_format: bool,
 }
 
 /// Instance, device, queue and allocator: everything that lives as long as the program.
@@ -136,9 +139,13 @@ impl GpuContext {
             .shader_storage_image_write_without_format(
                 supported.shader_storage_image_write_without_format == vk::TRUE,
             );
+        // dynamicRendering (core in 1.3, always supported) lets the explorer's UI draw
+        // into a swapchain image without a render pass, so the render graph keeps
+        // every layout transition.
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default()
             .synchronization2(true)
-            .maintenance4(true);
+            .maintenance4(true)
+            .dynamic_rendering(true);
         let priorities = [1.0f32];
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
@@ -295,6 +302,9 @@ fn pick_device(
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             max_push_constants_size: props.limits.max_push_constants_size,
             device_local_heap: largest_device_heap(instance, p),
+            storage_write_without_format: unsafe { instance.get_physical_device_features(p) }
+                .shader_storage_image_write_without_format
+                == vk::TRUE,
         };
         candidates.push((p, info, family as u32));
     }

@@ -68,6 +68,8 @@ pub struct GpuImage {
     pub view: vk::ImageView,
     pub desc: ImageDesc,
     allocation: Option<Allocation>,
+    /// Owned elsewhere (a swapchain image): `destroy` leaves it alone.
+    external: bool,
 }
 
 impl GpuImage {
@@ -119,10 +121,29 @@ impl GpuImage {
             view,
             desc,
             allocation: Some(allocation),
+            external: false,
         })
     }
 
+    /// An image and view owned by someone else (a swapchain), described by `desc`.
+    pub fn external(image: vk::Image, view: vk::ImageView, desc: ImageDesc) -> Self {
+        Self {
+            image,
+            view,
+            desc,
+            allocation: None,
+            external: true,
+        }
+    }
+
+    pub fn is_external(&self) -> bool {
+        self.external
+    }
+
     pub fn destroy(&mut self, ctx: &GpuContext) {
+        if self.external {
+            return;
+        }
         unsafe {
             ctx.device.destroy_image_view(self.view, None);
             ctx.device.destroy_image(self.image, None);

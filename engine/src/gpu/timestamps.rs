@@ -2,6 +2,13 @@
 //! when the slot comes round again (its fence has signalled), so timing never stalls the
 //! frame being recorded. The pass name is the key everywhere: debug label, timestamp pair,
 //! profiler row.
+//!
+//! Every timestamp is followed by a second one that is never read. On lavapipe, once a
+//! graphics pass has bound a framebuffer (the explorer's UI), llvmpipe bins a timestamp
+//! query into its current scene and records it at the *next* flush, which the next
+//! timestamp command triggers: without the follower each value would land one pass late
+//! (compute passes reading ~0 ms, their time falling between passes). The follower's
+//! flush records the real one at once; elsewhere it costs one query.
 
 use super::context::GpuContext;
 use crate::error::{Result, VkContext};
@@ -9,6 +16,8 @@ use ash::vk;
 
 /// Most passes one frame may time.
 pub const MAX_TIMED_PASSES: u32 = 128;
+/// Queries per pass: begin, its follower, end, its follower.
+const QUERIES_PER_PASS: u32 = 4;
 
 /// GPU time of one pass in one frame.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -29,7 +38,7 @@ impl TimestampPool {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         let info = vk::QueryPoolCreateInfo::default()
             .query_type(vk::QueryType::TIMESTAMP)
-            .query_count(MAX_TIMED_PASSES * 2);
+            .query_count(MAX_TIMED_PASSES * QUERIES_PER_PASS);
         let pool = unsafe { ctx.device.create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
         Ok(Self {
             pool,
@@ -43,7 +52,7 @@ impl TimestampPool {
         self.names.clear();
         unsafe {
             ctx.device
-                .cmd_reset_query_pool(cmd, self.pool, 0, MAX_TIMED_PASSES * 2)
+                .cmd_reset_query_pool(cmd, self.pool, 0, MAX_TIMED_PASSES * QUERIES_PER_PASS)
         };
     }
 
@@ -55,27 +64,27 @@ impl TimestampPool {
             return false;
         }
         self.names.push(pass.to_string());
-        unsafe {
-            ctx.device.cmd_write_timestamp2(
-                cmd,
-                vk::PipelineStageFlags2::ALL_COMMANDS,
-                self.pool,
-                index * 2,
-            )
-        };
+        self.write(ctx, cmd, index * QUERIES_PER_PASS);
         true
     }
 
     pub fn end(&mut self, ctx: &GpuContext, cmd: vk::CommandBuffer) {
         let index = self.names.len() as u32 - 1;
-        unsafe {
-            ctx.device.cmd_write_timestamp2(
-                cmd,
-                vk::PipelineStageFlags2::ALL_COMMANDS,
-                self.pool,
-                index * 2 + 1,
-            )
-        };
+        self.write(ctx, cmd, index * QUERIES_PER_PASS + 2);
+    }
+
+    /// A timestamp at `query` and its follower at `query + 1` (see the module docs).
+    fn write(&self, ctx: &GpuContext, cmd: vk::CommandBuffer, query: u32) {
+        for q in [query, query + 1] {
+            unsafe {
+                ctx.device.cmd_write_timestamp2(
+                    cmd,
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    self.pool,
+                    q,
+                )
+            };
+        }
     }
 
     /// Reads the results of the last recorded frame. Call only after its fence signalled.
@@ -83,7 +92,8 @@ impl TimestampPool {
         if self.names.is_empty() {
             return Ok(Vec::new());
         }
-        let mut raw = vec![0u64; self.names.len() * 2];
+        let n = QUERIES_PER_PASS as usize;
+        let mut raw = vec![0u64; self.names.len() * n];
         unsafe {
             ctx.device.get_query_pool_results(
                 self.pool,
@@ -101,8 +111,8 @@ impl TimestampPool {
             .enumerate()
             .map(|(i, name)| PassTiming {
                 pass: name.clone(),
-                start_ms: to_ms(raw[2 * i].saturating_sub(t0)),
-                ms: to_ms(raw[2 * i + 1].saturating_sub(raw[2 * i])),
+                start_ms: to_ms(raw[n * i].saturating_sub(t0)),
+                ms: to_ms(raw[n * i + 2].saturating_sub(raw[n * i])),
             })
             .collect())
     }

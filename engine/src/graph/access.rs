@@ -22,6 +22,13 @@ pub enum Access {
     TransferDst,
     /// Read by the host after the frame's fence (readbacks).
     HostRead,
+    /// Drawn to as a colour attachment by a graphics pipeline (load and store), e.g. the
+    /// explorer's UI on top of the presented image.
+    ColorAttachment,
+    /// Handed to the presentation engine after the frame: the image ends in
+    /// `PRESENT_SRC_KHR` and nothing in the command buffer touches it afterwards (the
+    /// queue submission's signal semaphore orders presentation after it).
+    Present,
 }
 
 /// The synchronisation scope of an access.
@@ -67,6 +74,13 @@ impl Access {
                 true,
             ),
             Access::HostRead => (S::HOST, A::HOST_READ, L::UNDEFINED, false),
+            Access::ColorAttachment => (
+                S::COLOR_ATTACHMENT_OUTPUT,
+                A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE,
+                L::COLOR_ATTACHMENT_OPTIMAL,
+                true,
+            ),
+            Access::Present => (S::NONE, A::NONE, L::PRESENT_SRC_KHR, false),
         };
         AccessInfo {
             stage,
@@ -107,6 +121,20 @@ impl Default for ResourceState {
             read_stages: vk::PipelineStageFlags2::NONE,
             visible_stages: vk::PipelineStageFlags2::NONE,
             visible_access: vk::AccessFlags2::NONE,
+        }
+    }
+}
+
+impl ResourceState {
+    /// The state of an image that arrives from outside the command buffer (a swapchain
+    /// image): contents undefined, and available only after `stage` of this submission,
+    /// the stage its acquire semaphore is waited on. The first access's barrier then
+    /// starts at `stage`, which chains it to the semaphore wait, so its layout
+    /// transition cannot run before the presentation engine has released the image.
+    pub fn external(stage: vk::PipelineStageFlags2) -> Self {
+        Self {
+            last_write: Some((stage, vk::AccessFlags2::NONE)),
+            ..Self::default()
         }
     }
 }
@@ -278,6 +306,49 @@ mod tests {
         let h = transition(&mut s, Access::HostRead, false).expect("host visibility");
         assert_eq!(h.dst_stage, S::HOST);
         assert_eq!(h.src_access, A::TRANSFER_WRITE);
+    }
+
+    #[test]
+    fn swapchain_image_goes_undefined_to_present_src() {
+        // Acquired image: written by the present pass (compute), drawn over by the UI
+        // (colour attachment), then handed to the presentation engine.
+        let mut s = ResourceState::external(S::COMPUTE_SHADER);
+        let first = transition(&mut s, Access::StorageWrite, true).expect("first write");
+        assert_eq!(first.old_layout, L::UNDEFINED);
+        assert_eq!(first.new_layout, L::GENERAL);
+        // Chained to the acquire semaphore's wait stage.
+        assert_eq!(first.src_stage, S::COMPUTE_SHADER);
+        assert_eq!(first.src_access, A::NONE);
+        let ui = transition(&mut s, Access::ColorAttachment, true).expect("to attachment");
+        assert_eq!(ui.old_layout, L::GENERAL);
+        assert_eq!(ui.new_layout, L::COLOR_ATTACHMENT_OPTIMAL);
+        assert_eq!(ui.src_access, A::SHADER_STORAGE_WRITE);
+        assert!(ui.dst_access.contains(A::COLOR_ATTACHMENT_WRITE));
+        let present = transition(&mut s, Access::Present, true).expect("final transition");
+        assert_eq!(present.old_layout, L::COLOR_ATTACHMENT_OPTIMAL);
+        assert_eq!(present.new_layout, L::PRESENT_SRC_KHR);
+        assert_eq!(present.src_stage, S::COLOR_ATTACHMENT_OUTPUT);
+        assert!(present.src_access.contains(A::COLOR_ATTACHMENT_WRITE));
+        assert_eq!(present.dst_access, A::NONE);
+        assert_eq!(s.layout, L::PRESENT_SRC_KHR);
+        // Nothing further is needed once presented.
+        assert_eq!(transition(&mut s, Access::Present, true), None);
+    }
+
+    #[test]
+    fn screenshot_copy_then_present_waits_for_the_copy() {
+        let mut s = ResourceState::external(S::COMPUTE_SHADER);
+        transition(&mut s, Access::StorageWrite, true);
+        let copy = transition(&mut s, Access::TransferSrc, true).expect("to transfer src");
+        assert_eq!(copy.new_layout, L::TRANSFER_SRC_OPTIMAL);
+        assert_eq!(copy.src_access, A::SHADER_STORAGE_WRITE);
+        let present = transition(&mut s, Access::Present, true).expect("final transition");
+        assert_eq!(present.old_layout, L::TRANSFER_SRC_OPTIMAL);
+        assert_eq!(present.new_layout, L::PRESENT_SRC_KHR);
+        assert!(
+            present.src_stage.contains(S::COPY),
+            "waits for the copy's read"
+        );
     }
 
     #[test]

@@ -84,6 +84,18 @@ impl<'a> PassContext<'a> {
         Ok(self.graph.images[h.0 as usize].image.image)
     }
 
+    /// The view of a declared image (for a pass that begins its own rendering).
+    pub fn image_view(&self, h: ImageHandle) -> Result<vk::ImageView> {
+        self.access_of(Res::Image(h))?;
+        Ok(self.graph.images[h.0 as usize].image.view)
+    }
+
+    /// Shape and format of a declared image.
+    pub fn image_desc(&self, h: ImageHandle) -> Result<crate::gpu::ImageDesc> {
+        self.access_of(Res::Image(h))?;
+        Ok(self.graph.image_desc(h))
+    }
+
     /// The Vulkan buffer of a declared buffer.
     pub fn buffer(&self, h: BufferHandle) -> Result<vk::Buffer> {
         self.access_of(Res::Buffer(h))?;

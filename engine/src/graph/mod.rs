@@ -70,6 +70,11 @@ impl PassBuilder {
         self.accesses.push((Res::Buffer(h), Access::HostRead));
         self
     }
+    /// Drawn to by a graphics pipeline (the pass begins and ends its own rendering).
+    pub fn color_attachment(&mut self, h: ImageHandle) -> &mut Self {
+        self.accesses.push((Res::Image(h), Access::ColorAttachment));
+        self
+    }
 }
 
 /// The passes of one frame, in submission order.
@@ -106,6 +111,17 @@ impl<'f> Frame<'f> {
         self.passes.push(Pass {
             name: name.into(),
             accesses: vec![(Res::Buffer(buffer), Access::HostRead)],
+            record: None,
+        });
+    }
+
+    /// A pass with no commands that hands `image` (an imported swapchain image) to the
+    /// presentation engine: the graph transitions it to `PRESENT_SRC_KHR`. It must be
+    /// the image's last access in the frame.
+    pub fn add_present(&mut self, name: impl Into<String>, image: ImageHandle) {
+        self.passes.push(Pass {
+            name: name.into(),
+            accesses: vec![(Res::Image(image), Access::Present)],
             record: None,
         });
     }
@@ -159,6 +175,12 @@ impl RenderGraph {
     pub fn image(&mut self, ctx: &GpuContext, name: &str, desc: ImageDesc) -> Result<ImageHandle> {
         if let Some(&h) = self.image_names.get(name) {
             let slot = &mut self.images[h.0 as usize];
+            if slot.image.is_external() {
+                return Err(EngineError::Resource {
+                    resource: name.into(),
+                    problem: "is an imported image; the graph cannot reallocate it".into(),
+                });
+            }
             if slot.image.desc == desc {
                 return Ok(h);
             }
@@ -174,6 +196,45 @@ impl RenderGraph {
             image: GpuImage::new(ctx, name, desc)?,
             state: ResourceState::default(),
             needs_clear: true,
+        });
+        self.image_names.insert(name.to_string(), h);
+        Ok(h)
+    }
+
+    /// Imports an image the graph does not own (a swapchain image acquired this frame)
+    /// under `name`, or updates the import of that name (a recreated swapchain). Its
+    /// state restarts every import: contents undefined, usable after `available_stage`,
+    /// the stage at which this frame's submission waits for the image (see
+    /// [`ResourceState::external`]). It is never cleared and never destroyed by the graph.
+    pub fn import_image(
+        &mut self,
+        name: &str,
+        image: vk::Image,
+        view: vk::ImageView,
+        desc: ImageDesc,
+        available_stage: vk::PipelineStageFlags2,
+    ) -> Result<ImageHandle> {
+        let imported = GpuImage::external(image, view, desc);
+        let state = ResourceState::external(available_stage);
+        if let Some(&h) = self.image_names.get(name) {
+            let slot = &mut self.images[h.0 as usize];
+            if !slot.image.is_external() {
+                return Err(EngineError::Resource {
+                    resource: name.into(),
+                    problem: "is a graph-owned image; imports need a name of their own".into(),
+                });
+            }
+            slot.image = imported;
+            slot.state = state;
+            slot.needs_clear = false;
+            return Ok(h);
+        }
+        let h = ImageHandle(self.images.len() as u32);
+        self.images.push(ImageSlot {
+            name: name.to_string(),
+            image: imported,
+            state,
+            needs_clear: false,
         });
         self.image_names.insert(name.to_string(), h);
         Ok(h)
@@ -276,7 +337,23 @@ impl RenderGraph {
     /// Checks a frame before recording: handles exist, no resource is declared twice with
     /// conflicting accesses in one pass, storage images have storage-capable formats.
     pub fn validate(&self, frame: &Frame) -> Result<()> {
+        let mut presented: Vec<Res> = Vec::new();
         for pass in &frame.passes {
+            if let Some((r, _)) = pass.accesses.iter().find(|(r, _)| presented.contains(r)) {
+                return Err(EngineError::Pass {
+                    pass: pass.name.clone(),
+                    problem: format!(
+                        "uses {:?} after it was handed to presentation",
+                        self.res_name(*r)
+                    ),
+                });
+            }
+            presented.extend(
+                pass.accesses
+                    .iter()
+                    .filter(|(_, a)| *a == Access::Present)
+                    .map(|(r, _)| *r),
+            );
             let mut seen: HashMap<Res, Access> = HashMap::new();
             for &(r, a) in &pass.accesses {
                 let exists = match r {
@@ -300,10 +377,17 @@ impl RenderGraph {
                         });
                     }
                 }
-                if matches!(r, Res::Buffer(_)) && a == Access::Sampled {
+                let image_only = matches!(
+                    a,
+                    Access::Sampled | Access::ColorAttachment | Access::Present
+                );
+                if matches!(r, Res::Buffer(_)) && image_only {
                     return Err(EngineError::Pass {
                         pass: pass.name.clone(),
-                        problem: format!("buffer {:?} cannot be sampled", self.res_name(r)),
+                        problem: format!(
+                            "buffer {:?} cannot be used as {a:?} (images only)",
+                            self.res_name(r)
+                        ),
                     });
                 }
             }

@@ -4,6 +4,7 @@
 pub mod accumulate;
 pub mod motion;
 pub mod path_trace;
+pub mod present;
 pub mod surface_features;
 
 use crate::graph::{Bind, BufferHandle, ImageHandle, PassBuilder};

@@ -1,8 +1,9 @@
 //! The frame. [`Renderer::frame`] reads like the pipeline: uniforms → surface features →
-//! path trace → motion → each denoiser → readbacks, all in one render graph, submitted
-//! once. Frames alternate between two slots so recording frame N overlaps the GPU's work
+//! path trace → motion → each denoiser → readbacks → (present to a window), all in one
+//! render graph, submitted once. Frames alternate between two slots so recording frame N overlaps the GPU's work
 //! on frame N−1; timestamps and readbacks of a slot are collected when it comes round.
 
+pub mod present;
 pub mod scene_gpu;
 pub mod scene_setup;
 pub mod uniforms;
@@ -15,12 +16,15 @@ use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
 use crate::passes::accumulate::Accumulate;
 use crate::passes::motion::Motion;
 use crate::passes::path_trace::{PathTrace, PathTraceFeatures};
+use crate::passes::present::Present;
 use crate::passes::surface_features::SurfaceFeatures;
 use crate::passes::{Extent, SceneBindings};
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
+pub use present::{Overlay, PresentTarget, Screenshot};
 use scene_gpu::{EnvironmentUpload, LutUpload, SceneImages, VolumeUpload};
+use std::sync::Arc;
 use uniforms::{FrameUniforms, GpuLight, MAX_LIGHTS};
 
 const SLOTS: usize = 2;
@@ -140,6 +144,8 @@ pub struct FrameResult {
     pub timings: Vec<PassTiming>,
     /// (method, rgba pixels) for each method when readback was requested.
     pub images: Vec<(String, Vec<[f32; 4]>)>,
+    /// The presented image, UI included, when its readback was requested.
+    pub screenshot: Option<Screenshot>,
 }
 
 struct Slot {
@@ -148,6 +154,7 @@ struct Slot {
     timestamps: TimestampPool,
     uniforms: BufferHandle,
     pending: Option<(u64, Vec<(String, BufferHandle)>)>,
+    pending_screenshot: Option<present::PendingScreenshot>,
 }
 
 struct Passes {
@@ -155,6 +162,8 @@ struct Passes {
     path_trace: PathTrace,
     motion: Motion,
     accumulate: Accumulate,
+    /// Built on the first presented frame (offscreen renderers never need it).
+    present: Option<Present>,
 }
 
 pub struct Renderer {
@@ -172,13 +181,34 @@ pub struct Renderer {
     slots: Vec<Slot>,
     pool: vk::CommandPool,
     frame_index: u64,
-    // Declared last: dropped after the Drop impl has released everything above.
-    ctx: GpuContext,
+    // Declared last: dropped after the Drop impl has released everything above. Shared
+    // so an application can keep the device (and its window's swapchain) across
+    // renderers, e.g. when a setting that specialises the pipelines changes.
+    ctx: Arc<GpuContext>,
 }
 
 impl Renderer {
     pub fn new(
         ctx: GpuContext,
+        settings: RenderSettings,
+        volume: &VolumeUpload,
+        environment: Option<&EnvironmentUpload>,
+        denoisers: &[&str],
+        lut_size: u32,
+    ) -> Result<Self> {
+        Self::new_shared(
+            Arc::new(ctx),
+            settings,
+            volume,
+            environment,
+            denoisers,
+            lut_size,
+        )
+    }
+
+    /// [`Renderer::new`] on a context the caller keeps a handle to.
+    pub fn new_shared(
+        ctx: Arc<GpuContext>,
         settings: RenderSettings,
         volume: &VolumeUpload,
         environment: Option<&EnvironmentUpload>,
@@ -201,6 +231,7 @@ impl Renderer {
             path_trace: PathTrace::new(&ctx, settings.features)?,
             motion: Motion::new(&ctx)?,
             accumulate: Accumulate::new(&ctx)?,
+            present: None,
         };
         let denoisers = denoisers
             .iter()
@@ -238,6 +269,7 @@ impl Renderer {
                 timestamps: TimestampPool::new(&ctx)?,
                 uniforms,
                 pending: None,
+                pending_screenshot: None,
             });
         }
 
@@ -269,11 +301,33 @@ impl Renderer {
         &self.ctx
     }
 
+    /// The shared context (to keep the device alive beyond this renderer).
+    pub fn shared_ctx(&self) -> Arc<GpuContext> {
+        Arc::clone(&self.ctx)
+    }
+
     pub fn denoiser_names(&self) -> Vec<String> {
         self.denoisers
             .iter()
             .map(|d| d.name().to_string())
             .collect()
+    }
+
+    /// Replaces the denoisers (the explorer's picker). Waits for the frames in flight
+    /// and returns their results; every history restarts, so a denoiser picked again
+    /// never resumes from stale state.
+    pub fn set_denoisers(&mut self, names: &[&str]) -> Result<Vec<FrameResult>> {
+        let done = self.flush()?;
+        let new = names
+            .iter()
+            .map(|n| denoise::create(&self.ctx, n, self.settings.motion_source))
+            .collect::<Result<Vec<_>>>()?;
+        for d in &mut self.denoisers {
+            d.destroy(&self.ctx);
+        }
+        self.denoisers = new;
+        self.graph.reset_history("");
+        Ok(done)
     }
 
     fn uniforms(&self, inputs: &FrameInputs, majorant_max: f32) -> FrameUniforms {
@@ -329,8 +383,23 @@ impl Renderer {
         inputs: &FrameInputs,
         request: &FrameRequest,
     ) -> Result<Option<FrameResult>> {
+        self.frame_presented(inputs, request, None)
+    }
+
+    /// [`Renderer::frame`], ending on screen when `present` is given: the denoised frame
+    /// is tone-mapped into the acquired swapchain image, the overlay drawn on top, and
+    /// the submission waits for and signals the image's semaphores (see [`present`]).
+    pub fn frame_presented(
+        &mut self,
+        inputs: &FrameInputs,
+        request: &FrameRequest,
+        present: Option<&PresentTarget<'_>>,
+    ) -> Result<Option<FrameResult>> {
         let slot = (self.frame_index % SLOTS as u64) as usize;
         let completed = self.wait_slot(slot)?;
+        if present.is_some() && self.passes.present.is_none() {
+            self.passes.present = Some(Present::new(&self.ctx)?);
+        }
         let changes = self.changes(inputs, request.reset);
         if request.reset {
             self.graph.reset_history("");
@@ -391,8 +460,18 @@ impl Renderer {
         } else {
             Vec::new()
         };
-        submit(ctx, graph, &mut self.slots[slot], frame)?;
+        // On screen: tone map into the swapchain image, UI on top, hand it over.
+        let mut screenshot = None;
+        let mut semaphores = None;
+        if let (Some(target), Some(pass)) = (present, &passes.present) {
+            screenshot = present::add_present_passes(
+                ctx, graph, &mut frame, pass, slot, target, &outputs, size,
+            )?;
+            semaphores = Some((target.image.wait, target.image.signal));
+        }
+        submit(ctx, graph, &mut self.slots[slot], frame, semaphores)?;
         self.slots[slot].pending = Some((self.frame_index, readbacks));
+        self.slots[slot].pending_screenshot = screenshot;
         self.graph.end_frame();
         self.last_inputs = Some(inputs.clone());
         self.frame_index += 1;
@@ -483,15 +562,20 @@ impl Renderer {
         let Some((index, readbacks)) = slot.pending.take() else {
             return Ok(None);
         };
+        let screenshot = slot.pending_screenshot.take();
         let timings = slot.timestamps.read(&self.ctx)?;
         let mut images = Vec::new();
         for (name, buffer) in readbacks {
             images.push((name, read_pixels(&self.graph, buffer)?));
         }
+        let screenshot = screenshot
+            .map(|p| present::read_screenshot(&self.graph, p))
+            .transpose()?;
         Ok(Some(FrameResult {
             index,
             timings,
             images,
+            screenshot,
         }))
     }
 
@@ -616,7 +700,16 @@ fn add_readbacks<'f>(
     Ok(out)
 }
 
-fn submit(ctx: &GpuContext, graph: &mut RenderGraph, slot: &mut Slot, frame: Frame) -> Result<()> {
+/// Records and submits a frame. `semaphores` (acquire, render-finished) when it presents:
+/// the submission waits for the swapchain image at the stage the graph's first barrier
+/// on it starts from, and signals the semaphore presentation waits on.
+fn submit(
+    ctx: &GpuContext,
+    graph: &mut RenderGraph,
+    slot: &mut Slot,
+    frame: Frame,
+    semaphores: Option<(vk::Semaphore, vk::Semaphore)>,
+) -> Result<()> {
     let d = &ctx.device;
     unsafe {
         d.reset_fences(&[slot.fence]).vk("vkResetFences")?;
@@ -633,10 +726,24 @@ fn submit(ctx: &GpuContext, graph: &mut RenderGraph, slot: &mut Slot, frame: Fra
     graph.execute(ctx, slot.cmd, Some(&mut slot.timestamps), frame)?;
     unsafe {
         d.end_command_buffer(slot.cmd).vk("vkEndCommandBuffer")?;
-        let cmds = [slot.cmd];
-        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
-        d.queue_submit(ctx.queue, &submit, slot.fence)
-            .vk("vkQueueSubmit")?;
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
+        let (waits, signals) = match semaphores {
+            Some((wait, signal)) => (
+                vec![vk::SemaphoreSubmitInfo::default()
+                    .semaphore(wait)
+                    .stage_mask(crate::gpu::swapchain::ACQUIRE_WAIT_STAGE)],
+                vec![vk::SemaphoreSubmitInfo::default()
+                    .semaphore(signal)
+                    .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)],
+            ),
+            None => (Vec::new(), Vec::new()),
+        };
+        let submit = [vk::SubmitInfo2::default()
+            .command_buffer_infos(&cmds)
+            .wait_semaphore_infos(&waits)
+            .signal_semaphore_infos(&signals)];
+        d.queue_submit2(ctx.queue, &submit, slot.fence)
+            .vk("vkQueueSubmit2")?;
     }
     Ok(())
 }
@@ -657,6 +764,9 @@ impl Drop for Renderer {
         self.passes.path_trace.destroy(ctx);
         self.passes.motion.destroy(ctx);
         self.passes.accumulate.destroy(ctx);
+        if let Some(p) = &mut self.passes.present {
+            p.destroy(ctx);
+        }
         self.graph.destroy(ctx);
     }
 }

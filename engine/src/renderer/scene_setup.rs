@@ -12,10 +12,11 @@ use crate::gpu::GpuContext;
 use crate::image_io::ImageIoError;
 use crate::passes::path_trace::PathTraceFeatures;
 use crate::passes::Extent;
-use crate::scene::{self, EnvSource, Light, Scene, VolumeSource};
+use crate::scene::{self, Camera, EnvSource, Light, Scene, VolumeSource};
 use crate::transfer::{TfLut, LUT_SIZE};
 use crate::volume::{RawFormat, RawParams, Volume, VolumeError};
 use glam::{Vec3, Vec4};
+use std::sync::Arc;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
@@ -48,12 +49,23 @@ impl SceneSetup {
         volume_size: u32,
     ) -> Result<Self, SetupError> {
         let volume = load_volume(&scene, volume_size)?;
+        Self::with_volume(scene, &volume, size, spp)
+    }
+
+    /// [`SceneSetup::new`] with the volume already loaded (the explorer also draws its
+    /// histogram).
+    pub fn with_volume(
+        scene: Scene,
+        volume: &Volume,
+        size: Extent,
+        spp: Option<u32>,
+    ) -> Result<Self, SetupError> {
         let settings = render_settings(&scene, size, spp.unwrap_or(scene.render.spp));
         let environment = load_environment(&scene.lights)?;
         let lut_a = scene.tf_a.lut();
         let lut_b = scene.tf_b.as_ref().map(|b| b.lut());
         Ok(Self {
-            volume: VolumeUpload::from_volume(&volume),
+            volume: VolumeUpload::from_volume(volume),
             settings,
             environment,
             scene,
@@ -73,23 +85,48 @@ impl SceneSetup {
         )
     }
 
+    /// A renderer on a context the caller keeps a handle to (the explorer's, which
+    /// also owns the window's swapchain).
+    pub fn renderer_shared(
+        &self,
+        ctx: Arc<GpuContext>,
+        denoisers: &[&str],
+    ) -> EngineResult<Renderer> {
+        Renderer::new_shared(
+            ctx,
+            self.settings.clone(),
+            &self.volume,
+            self.environment.as_ref(),
+            denoisers,
+            LUT_SIZE as u32,
+        )
+    }
+
     /// The renderer's inputs for animation frame `f`.
     pub fn frame_inputs(&self, f: u32) -> FrameInputs {
         let state = self.scene.frame_state(f);
-        let c = &state.camera;
         let size = self.settings.size;
         let aspect = size.width as f32 / size.height.max(1) as f32;
+        let blended;
         let lut = match &self.lut_b {
             Some(b) if state.tf_blend > 0.0 => {
-                LutUpload::from(&TfLut::lerp(&self.lut_a, b, state.tf_blend))
+                blended = TfLut::lerp(&self.lut_a, b, state.tf_blend);
+                &blended
             }
-            _ => LutUpload::from(&self.lut_a),
+            _ => &self.lut_a,
         };
-        FrameInputs {
-            camera: CameraMatrices::look_at(c.position, c.target, c.up, c.fov_y, aspect),
-            lights: state.lights.iter().map(gpu_light).collect(),
-            lut,
-        }
+        inputs_for(&state.camera, aspect, &state.lights, lut)
+    }
+}
+
+/// The renderer's inputs for a camera, lights and a TF: the one place scene state
+/// becomes [`FrameInputs`] (a scene's frames and the explorer's edits alike).
+pub fn inputs_for(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -> FrameInputs {
+    let c = camera;
+    FrameInputs {
+        camera: CameraMatrices::look_at(c.position, c.target, c.up, c.fov_y, aspect),
+        lights: lights.iter().map(gpu_light).collect(),
+        lut: LutUpload::from(lut),
     }
 }
 

@@ -165,6 +165,21 @@ pub struct SvgfAtrousPush {
     pub pad2: f32,
 }
 
+/// `PresentPush` in present.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct PresentPush {
+    pub target_width: u32,
+    pub target_height: u32,
+    pub offset_x: i32,
+    pub offset_y: i32,
+    pub source_width: u32,
+    pub source_height: u32,
+    pub split_x: i32,
+    pub exposure: f32,
+    pub background: Vec4,
+}
+
 /// Field names and offsets of a mirror struct, for the layout test.
 #[macro_export]
 macro_rules! field_offsets {
@@ -345,6 +360,22 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 pad0,
                 pad1,
                 pad2
+            }),
+        ),
+        (
+            "present",
+            "push",
+            std::mem::size_of::<PresentPush>(),
+            field_offsets!(PresentPush {
+                target_width,
+                target_height,
+                offset_x,
+                offset_y,
+                source_width,
+                source_height,
+                split_x,
+                exposure,
+                background
             }),
         ),
     ]

@@ -1,0 +1,275 @@
+//! Mouse and keyboard to camera and UI commands, and the `--script` that plays the same
+//! commands at given frames (for tests and scripted demos).
+//!
+//! Script syntax: commands separated by `;`, each `ACTION:ARGS@FRAME`:
+//!
+//! | command | effect |
+//! | --- | --- |
+//! | `orbit:DX,DY@F` | a left-drag of (DX, DY) pixels at frame F |
+//! | `pan:DX,DY@F` | a right-drag of (DX, DY) pixels |
+//! | `zoom:STEPS@F` | wheel steps (positive zooms in) |
+//! | `key:NAME@F` | a key: `r` (reset), `f` (fit), `h` (help), `f12` (screenshot), `tab` (UI) |
+//! | `denoiser:NAME@F` | show denoiser NAME |
+//! | `split:NAME@F` | split view with NAME on the right (`split:off` ends it) |
+//!
+//! e.g. `--script "orbit:30,0@10;zoom:2@20"`.
+
+use super::camera::OrbitCamera;
+use anyhow::{bail, Context, Result};
+use winit::event::MouseButton;
+use winit::keyboard::{Key as WinitKey, NamedKey};
+
+/// The explorer's keyboard shortcuts (also listed by the help overlay).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Key {
+    Reset,
+    Fit,
+    Help,
+    Screenshot,
+    ToggleUi,
+}
+
+/// (keys, what) for the help overlay and the README.
+pub const SHORTCUTS: &[(&str, &str)] = &[
+    ("left drag", "orbit"),
+    ("right / middle drag", "pan"),
+    ("wheel", "zoom"),
+    ("R", "reset the camera"),
+    ("F", "fly to fit the volume"),
+    ("H / F1", "this help"),
+    ("F12", "screenshot (PNG of the window, EXR of the frame)"),
+    ("Tab", "hide / show the panel"),
+    ("Esc", "quit"),
+];
+
+impl Key {
+    pub fn from_winit(key: &WinitKey) -> Option<Self> {
+        match key {
+            WinitKey::Named(NamedKey::F1) => Some(Key::Help),
+            WinitKey::Named(NamedKey::F12) => Some(Key::Screenshot),
+            WinitKey::Named(NamedKey::Tab) => Some(Key::ToggleUi),
+            WinitKey::Character(c) => Self::from_name(c),
+            _ => None,
+        }
+    }
+
+    fn from_name(name: &str) -> Option<Self> {
+        match name.to_ascii_lowercase().as_str() {
+            "r" => Some(Key::Reset),
+            "f" => Some(Key::Fit),
+            "h" | "f1" => Some(Key::Help),
+            "f12" => Some(Key::Screenshot),
+            "tab" => Some(Key::ToggleUi),
+            _ => None,
+        }
+    }
+}
+
+/// What a drag does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DragKind {
+    Orbit,
+    Pan,
+}
+
+impl DragKind {
+    pub fn from_button(b: MouseButton) -> Option<Self> {
+        match b {
+            MouseButton::Left => Some(DragKind::Orbit),
+            MouseButton::Right | MouseButton::Middle => Some(DragKind::Pan),
+            _ => None,
+        }
+    }
+}
+
+/// One input command, from the mouse, the keyboard or a script.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    Drag(DragKind, f64, f64),
+    Zoom(f64),
+    Key(Key),
+    Denoiser(String),
+    /// The right-hand denoiser of a split view; `None` ends the split.
+    Split(Option<String>),
+}
+
+/// Applies a camera command; returns false for commands that are not the camera's.
+pub fn apply_to_camera(
+    camera: &mut OrbitCamera,
+    command: &Command,
+    viewport_height: f64,
+    fit: impl FnOnce(&mut OrbitCamera),
+) -> bool {
+    match *command {
+        Command::Drag(DragKind::Orbit, dx, dy) => camera.orbit(dx, dy),
+        Command::Drag(DragKind::Pan, dx, dy) => camera.pan(dx, dy, viewport_height),
+        Command::Zoom(steps) => camera.zoom(steps),
+        Command::Key(Key::Reset) => camera.reset(),
+        Command::Key(Key::Fit) => fit(camera),
+        _ => return false,
+    }
+    true
+}
+
+/// The pointer as the camera sees it: which drag is under way and where it was.
+#[derive(Clone, Debug, Default)]
+pub struct Pointer {
+    pub position: Option<(f64, f64)>,
+    pub drag: Option<DragKind>,
+}
+
+impl Pointer {
+    /// A cursor move; returns the drag command it makes, if a drag is under way.
+    pub fn moved(&mut self, x: f64, y: f64) -> Option<Command> {
+        let last = self.position.replace((x, y));
+        match (self.drag, last) {
+            (Some(kind), Some((lx, ly))) if (x, y) != (lx, ly) => {
+                Some(Command::Drag(kind, x - lx, y - ly))
+            }
+            _ => None,
+        }
+    }
+}
+
+/// Commands to play at given frames.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Script {
+    events: Vec<(u64, Command)>,
+}
+
+impl Script {
+    pub fn parse(text: &str) -> Result<Self> {
+        let mut events = Vec::new();
+        for part in text.split(';').map(str::trim).filter(|p| !p.is_empty()) {
+            let (body, frame) = part
+                .rsplit_once('@')
+                .with_context(|| format!("script command {part:?} has no @FRAME"))?;
+            let frame: u64 = frame
+                .trim()
+                .parse()
+                .with_context(|| format!("script command {part:?}: bad frame"))?;
+            let (action, args) = body
+                .split_once(':')
+                .with_context(|| format!("script command {part:?} is not ACTION:ARGS@FRAME"))?;
+            let pair = || -> Result<(f64, f64)> {
+                let (a, b) = args
+                    .split_once(',')
+                    .with_context(|| format!("script command {part:?} needs DX,DY"))?;
+                Ok((
+                    a.trim().parse().context("bad DX")?,
+                    b.trim().parse().context("bad DY")?,
+                ))
+            };
+            let command = match action.trim() {
+                "orbit" => {
+                    let (dx, dy) = pair()?;
+                    Command::Drag(DragKind::Orbit, dx, dy)
+                }
+                "pan" => {
+                    let (dx, dy) = pair()?;
+                    Command::Drag(DragKind::Pan, dx, dy)
+                }
+                "zoom" => Command::Zoom(
+                    args.trim()
+                        .parse()
+                        .with_context(|| format!("script command {part:?}: bad STEPS"))?,
+                ),
+                "key" => Command::Key(Key::from_name(args.trim()).with_context(|| {
+                    format!("script command {part:?}: unknown key (r, f, h, f12, tab)")
+                })?),
+                "denoiser" => Command::Denoiser(args.trim().to_string()),
+                "split" => match args.trim() {
+                    "off" | "" => Command::Split(None),
+                    name => Command::Split(Some(name.to_string())),
+                },
+                other => bail!(
+                    "script command {part:?}: unknown action {other:?} \
+                     (orbit, pan, zoom, key, denoiser, split)"
+                ),
+            };
+            events.push((frame, command));
+        }
+        events.sort_by_key(|(f, _)| *f);
+        Ok(Self { events })
+    }
+
+    /// The commands due at `frame`.
+    pub fn at(&self, frame: u64) -> impl Iterator<Item = &Command> {
+        self.events
+            .iter()
+            .filter(move |(f, _)| *f == frame)
+            .map(|(_, c)| c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use dvr_engine::scene::CameraSpec;
+
+    #[test]
+    fn parses_every_command_and_sorts_by_frame() {
+        let s = Script::parse("zoom:2@20; orbit:30,0@10;pan:-5,7.5@10;key:F@3;denoiser:svgf@1;split:taa@2;split:off@4")
+            .expect("parses");
+        let at = |f| s.at(f).cloned().collect::<Vec<_>>();
+        assert_eq!(
+            at(10),
+            vec![
+                Command::Drag(DragKind::Orbit, 30.0, 0.0),
+                Command::Drag(DragKind::Pan, -5.0, 7.5)
+            ]
+        );
+        assert_eq!(at(20), vec![Command::Zoom(2.0)]);
+        assert_eq!(at(3), vec![Command::Key(Key::Fit)]);
+        assert_eq!(at(1), vec![Command::Denoiser("svgf".into())]);
+        assert_eq!(at(2), vec![Command::Split(Some("taa".into()))]);
+        assert_eq!(at(4), vec![Command::Split(None)]);
+        assert!(at(5).is_empty());
+    }
+
+    #[test]
+    fn bad_scripts_say_what_is_wrong() {
+        for (text, needle) in [
+            ("orbit:30,0", "@FRAME"),
+            ("orbit:30@1", "DX,DY"),
+            ("spin:1@1", "unknown action"),
+            ("key:q@1", "unknown key"),
+            ("zoom:x@1", "STEPS"),
+            ("zoom:1@x", "bad frame"),
+        ] {
+            let e = format!("{:#}", Script::parse(text).expect_err(text));
+            assert!(e.contains(needle), "{text}: {e}");
+        }
+    }
+
+    #[test]
+    fn a_drag_is_the_difference_of_cursor_positions() {
+        let mut p = Pointer::default();
+        assert_eq!(p.moved(10.0, 10.0), None);
+        p.drag = Some(DragKind::Orbit);
+        assert_eq!(
+            p.moved(14.0, 7.0),
+            Some(Command::Drag(DragKind::Orbit, 4.0, -3.0))
+        );
+        p.drag = None;
+        assert_eq!(p.moved(20.0, 20.0), None);
+    }
+
+    #[test]
+    fn scripted_drag_moves_the_camera_like_a_mouse_drag() {
+        let mut a = OrbitCamera::from_spec(&CameraSpec::default());
+        let mut b = a;
+        let cmd = Script::parse("orbit:30,0@10").expect("parses");
+        for c in cmd.at(10) {
+            assert!(apply_to_camera(&mut a, c, 256.0, |_| {}));
+        }
+        b.orbit(30.0, 0.0);
+        assert_eq!(a, b);
+        assert!(!apply_to_camera(
+            &mut a,
+            &Command::Key(Key::Help),
+            256.0,
+            |_| {}
+        ));
+    }
+}

@@ -1,0 +1,318 @@
+//! `--record DIR`: the session as frames and as a scene that replays it.
+//!
+//! Writes `DIR/frames/NNNN.png` (the displayed denoiser's frame, tone-mapped like
+//! `dvr capture`'s PNGs), `DIR/state.jsonl` (one line per frame: camera, lights, the TF
+//! file in effect, the denoiser shown), every distinct TF as `DIR/tf/NNN.toml`, and
+//! `DIR/session.toml`, a scene whose animation replays the camera and lights frame by
+//! frame (step keyframes at each change, so values are exact), which
+//! `dvr capture --scene DIR/session.toml --size WxH` renders again.
+//!
+//! What a scene file cannot animate is replayed approximately and said so in the
+//! scene's comment: TF edits become one blend from the first TF to the last, spread
+//! over the frames between the first and the last edit (exact for a single edit); light
+//! kinds and counts are locked while recording; area-light sizes and gradient
+//! environment colours keep their first-frame values; render settings are the last ones.
+
+use anyhow::{Context, Result};
+use dvr_engine::scene::{
+    self, BuiltinVolume, CameraKey, CameraSpec, Interpolation, Light, LightKey, Scene, TfKey,
+    TransferSpec, VolumeSource,
+};
+use dvr_engine::transfer::TransferFunction;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The state of one recorded frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameState {
+    pub camera: CameraSpec,
+    pub lights: Vec<Light>,
+    /// Index into the recorder's distinct TFs.
+    pub tf: usize,
+}
+
+pub struct Recorder {
+    dir: PathBuf,
+    frames: Vec<FrameState>,
+    tfs: Vec<TransferFunction>,
+    log: std::fs::File,
+}
+
+impl Recorder {
+    pub fn new(dir: &Path) -> Result<Self> {
+        for d in [dir.to_path_buf(), dir.join("frames"), dir.join("tf")] {
+            std::fs::create_dir_all(&d).with_context(|| format!("creating {}", d.display()))?;
+        }
+        let path = dir.join("state.jsonl");
+        let log =
+            std::fs::File::create(&path).with_context(|| format!("creating {}", path.display()))?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            frames: Vec::new(),
+            tfs: Vec::new(),
+            log,
+        })
+    }
+
+    pub fn frame_path(&self, index: u64) -> PathBuf {
+        self.dir.join("frames").join(format!("{index:04}.png"))
+    }
+
+    fn tf_name(i: usize) -> String {
+        format!("tf/{i:03}.toml")
+    }
+
+    /// Records the state of the next frame.
+    pub fn push(
+        &mut self,
+        camera: CameraSpec,
+        lights: &[Light],
+        tf: &TransferFunction,
+        denoiser: &str,
+    ) -> Result<()> {
+        if self.tfs.last() != Some(tf) {
+            let path = self.dir.join(Self::tf_name(self.tfs.len()));
+            std::fs::write(&path, tf.to_toml())
+                .with_context(|| format!("writing {}", path.display()))?;
+            self.tfs.push(tf.clone());
+        }
+        let index = self.frames.len();
+        let tf_index = self.tfs.len() - 1;
+        let light_json: Vec<_> = lights
+            .iter()
+            .map(|l| {
+                serde_json::json!({
+                    "kind": format!("{:?}", l.kind()).to_lowercase(),
+                    "position": l.position().map(|p| p.to_array()),
+                    "colour": l.colour().map(|c| c.to_array()),
+                    "intensity": l.intensity(),
+                })
+            })
+            .collect();
+        let line = serde_json::json!({
+            "frame": index,
+            "camera": {
+                "position": camera.position.to_array(),
+                "target": camera.target.to_array(),
+                "up": camera.up.to_array(),
+                "fov_y_degrees": camera.fov_y_degrees,
+            },
+            "lights": light_json,
+            "tf": Self::tf_name(tf_index),
+            "denoiser": denoiser,
+        });
+        writeln!(self.log, "{line}").context("writing state.jsonl")?;
+        self.frames.push(FrameState {
+            camera,
+            lights: lights.to_vec(),
+            tf: tf_index,
+        });
+        Ok(())
+    }
+
+    pub fn frame_count(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// Writes `session.toml` from `base` (volume, render settings; procedural volumes
+    /// at `volume_size`); returns its path.
+    pub fn finish(&self, base: &Scene, volume_size: u32) -> Result<Option<PathBuf>> {
+        if self.frames.is_empty() {
+            return Ok(None);
+        }
+        let scene = session_scene(base, &self.frames, &self.tfs, Self::tf_name, volume_size)?;
+        let path = self.dir.join("session.toml");
+        let text = scene.to_toml().context("writing the session scene")?;
+        let note = "# Recorded by `dvr explore --record`: camera and light keyframes replay the \
+                    session exactly;\n# TF edits are one blend from the first TF to the last \
+                    (see src/explore/record.rs).\n";
+        std::fs::write(&path, format!("{note}{text}"))
+            .with_context(|| format!("writing {}", path.display()))?;
+        Ok(Some(path))
+    }
+}
+
+/// The scene that replays `frames` (see the module docs). `tf_file(i)` is the file
+/// (relative to the scene) holding `tfs[i]`; procedural volumes get `volume_size` unless
+/// the scene pins one.
+pub fn session_scene(
+    base: &Scene,
+    frames: &[FrameState],
+    tfs: &[TransferFunction],
+    tf_file: impl Fn(usize) -> String,
+    volume_size: u32,
+) -> Result<Scene> {
+    let first = frames.first().context("no frames recorded")?;
+    let mut s = base.clone();
+    s.name = "session".into();
+    s.frames = frames.len() as u32;
+    s.camera = first.camera;
+    s.lights = first.lights.clone();
+    // Pin what the replay must not take from elsewhere: the procedural size and
+    // absolute volume paths (the scene lives in another folder).
+    if let VolumeSource::Builtin { dataset, size } = &mut s.volume.source {
+        if size.is_none() && *dataset != BuiltinVolume::Mri {
+            *size = Some(volume_size);
+        }
+    }
+    if let VolumeSource::File { path, .. } = &mut s.volume.source {
+        if let Ok(abs) = std::fs::canonicalize(&*path) {
+            *path = abs;
+        }
+    }
+    let last_tf = frames.last().map_or(0, |f| f.tf);
+    s.transfer = TransferSpec {
+        a: tf_file(first.tf),
+        b: (last_tf != first.tf).then(|| tf_file(last_tf)),
+    };
+    s.tf_a = tfs[first.tf].clone();
+    s.tf_b = (last_tf != first.tf).then(|| tfs[last_tf].clone());
+    let mut animation = scene::Animation::default();
+    let step = Interpolation::Step;
+    // Step keys at frame 0 too: the value at rest is otherwise an implicit *linear* key
+    // there, and the replay would glide towards the first change.
+    animation.camera.push(CameraKey {
+        frame: 0,
+        position: Some(first.camera.position),
+        target: Some(first.camera.target),
+        fov_y_degrees: Some(first.camera.fov_y_degrees),
+        interpolation: step,
+    });
+    for (index, l) in first.lights.iter().enumerate() {
+        animation.light.push(LightKey {
+            index,
+            frame: 0,
+            position: l.position(),
+            colour: l.colour(),
+            intensity: Some(l.intensity()),
+            interpolation: step,
+        });
+    }
+    for (f, w) in frames.windows(2).enumerate() {
+        let frame = f as u32 + 1;
+        let (prev, cur) = (&w[0], &w[1]);
+        if cur.camera != prev.camera {
+            animation.camera.push(CameraKey {
+                frame,
+                position: Some(cur.camera.position),
+                target: Some(cur.camera.target),
+                fov_y_degrees: Some(cur.camera.fov_y_degrees),
+                interpolation: step,
+            });
+        }
+        for (index, (a, b)) in prev.lights.iter().zip(&cur.lights).enumerate() {
+            let changed =
+                |x: Option<glam::DVec3>, y: Option<glam::DVec3>| (x != y).then_some(y).flatten();
+            let key = LightKey {
+                index,
+                frame,
+                position: changed(a.position(), b.position()),
+                colour: changed(a.colour(), b.colour()),
+                intensity: (a.intensity() != b.intensity()).then_some(b.intensity()),
+                interpolation: step,
+            };
+            if key.position.is_some() || key.colour.is_some() || key.intensity.is_some() {
+                animation.light.push(key);
+            }
+        }
+    }
+    // TF: blend 0 until the first edit, 1 from the last.
+    let edits: Vec<u32> = frames
+        .windows(2)
+        .enumerate()
+        .filter(|(_, w)| w[0].tf != w[1].tf)
+        .map(|(f, _)| f as u32 + 1)
+        .collect();
+    if let (Some(&a), Some(&b), true) = (edits.first(), edits.last(), s.tf_b.is_some()) {
+        animation.tf.push(TfKey {
+            frame: a - 1,
+            blend: 0.0,
+            interpolation: Interpolation::Linear,
+        });
+        animation.tf.push(TfKey {
+            frame: b,
+            blend: 1.0,
+            interpolation: Interpolation::Linear,
+        });
+    }
+    s.animation = animation;
+    s.validate()
+        .context("the recorded session is not a valid scene")?;
+    Ok(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    fn base() -> Scene {
+        Scene::builtin("phantom/orbit").expect("built-in scene")
+    }
+
+    #[test]
+    fn replays_camera_and_lights_exactly_at_every_frame() {
+        let b = base();
+        let cam0 = b.camera;
+        let mut frames = Vec::new();
+        let mut cam = cam0;
+        let mut lights = b.lights.clone();
+        for f in 0..12 {
+            if f == 3 || f == 4 || f == 9 {
+                cam.position += DVec3::new(0.013, -0.02, 0.007);
+                cam.target += DVec3::new(0.001, 0.0, 0.0);
+            }
+            if f == 6 {
+                lights[0].set_position(DVec3::new(0.3, 0.4, 0.5));
+                lights[0].set_intensity(7.5);
+            }
+            frames.push(FrameState {
+                camera: cam,
+                lights: lights.clone(),
+                tf: 0,
+            });
+        }
+        let s = session_scene(
+            &b,
+            &frames,
+            std::slice::from_ref(&b.tf_a),
+            |i| format!("tf/{i:03}.toml"),
+            64,
+        )
+        .expect("scene");
+        assert_eq!(s.frames, 12);
+        assert!(s.animation.orbit.is_none());
+        assert_eq!(s.animation.camera.len(), 4, "frame 0 and three changes");
+        for (f, want) in frames.iter().enumerate() {
+            let got = s.frame_state(f as u32);
+            assert_eq!(got.camera, want.camera.camera(), "camera at frame {f}");
+            assert_eq!(got.lights, want.lights, "lights at frame {f}");
+        }
+    }
+
+    #[test]
+    fn a_tf_edit_becomes_a_jump_to_the_new_tf_and_the_scene_file_loads() {
+        let b = base();
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut edited = b.tf_a.clone();
+        edited.points[1].opacity = 0.05;
+        let mut rec = Recorder::new(dir.path()).expect("recorder");
+        for f in 0..6 {
+            let tf = if f < 4 { &b.tf_a } else { &edited };
+            rec.push(b.camera, &b.lights, tf, "ours").expect("push");
+        }
+        let path = rec.finish(&b, 64).expect("finish").expect("a scene");
+        let loaded = Scene::load(&path).expect("session.toml loads");
+        assert_eq!(loaded.frames, 6);
+        assert_eq!(loaded.tf_a, b.tf_a);
+        assert_eq!(loaded.tf_b.as_ref(), Some(&edited));
+        let blend = |f| loaded.frame_state(f).tf_blend;
+        assert_eq!((blend(3), blend(4), blend(5)), (0.0, 1.0, 1.0));
+        let lines = std::fs::read_to_string(dir.path().join("state.jsonl")).expect("log");
+        assert_eq!(lines.lines().count(), 6);
+        let last: serde_json::Value =
+            serde_json::from_str(lines.lines().last().expect("a line")).expect("json");
+        assert_eq!(last["tf"], "tf/001.toml");
+        assert_eq!(last["denoiser"], "ours");
+    }
+}

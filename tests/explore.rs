@@ -1,0 +1,330 @@
+//! `dvr explore` in a real window under Xvfb, as a user runs it, with the validation
+//! layer on: the screenshot shows the rendered volume and the UI panel; a scripted drag
+//! changes the view; a recorded session replays through `dvr capture` to the same
+//! frames; and without a display the command says how to get one.
+//!
+//! Each test starts its own `Xvfb` on a free display and kills it at the end. Without
+//! Xvfb the window tests are skipped with a message, unless `CI` is set (then Xvfb is
+//! required: tools/setup.sh installs it).
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+/// The panel's fill colour (src/explore/ui.rs `PANEL_FILL`) and width in pixels at
+/// scale 1 (`PANEL_WIDTH`).
+const PANEL_FILL: [u8; 3] = [30, 34, 42];
+const PANEL_WIDTH: u32 = 300;
+
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn has_xvfb() -> bool {
+    Command::new("sh")
+        .args(["-c", "command -v Xvfb"])
+        .stdout(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// Starts Xvfb on a free display, or returns None (after saying why) when it is not
+/// installed and this is not CI.
+fn xvfb() -> Option<Xvfb> {
+    if !has_xvfb() {
+        if std::env::var_os("CI").is_some() {
+            panic!("Xvfb is required in CI (tools/setup.sh installs the xvfb package)");
+        }
+        eprintln!("skipping: Xvfb is not installed (apt-get install xvfb)");
+        return None;
+    }
+    static NEXT: AtomicU32 = AtomicU32::new(0);
+    let base = 100 + (std::process::id() % 400) * 8;
+    for _ in 0..64 {
+        let n = base + NEXT.fetch_add(1, Ordering::SeqCst) % 3000;
+        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{n}"));
+        if socket.exists() || Path::new(&format!("/tmp/.X{n}-lock")).exists() {
+            continue;
+        }
+        let mut child = Command::new("Xvfb")
+            .args([
+                &format!(":{n}"),
+                "-screen",
+                "0",
+                "1280x1024x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn Xvfb");
+        let started = Instant::now();
+        while started.elapsed() < Duration::from_secs(10) {
+            if socket.exists() {
+                return Some(Xvfb {
+                    child,
+                    display: format!(":{n}"),
+                });
+            }
+            if child.try_wait().ok().flatten().is_some() {
+                break; // lost a race for the display: try the next one
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        let _ = child.kill();
+        let _ = child.wait();
+    }
+    panic!("could not start Xvfb on any display");
+}
+
+fn dvr(display: Option<&str>, args: &[&str], dir: &Path) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_dvr"));
+    cmd.args(args)
+        .current_dir(dir)
+        .env("DVR_VALIDATION", "1")
+        .env_remove("WAYLAND_DISPLAY");
+    match display {
+        Some(d) => cmd.env("DISPLAY", d),
+        None => cmd.env_remove("DISPLAY"),
+    };
+    cmd.output().expect("run dvr")
+}
+
+fn assert_clean(o: &Output) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.success(),
+        "dvr failed ({:?}):\n{err}",
+        o.status.code()
+    );
+    assert!(!err.contains("validation"), "validation messages:\n{err}");
+}
+
+struct Shot {
+    width: u32,
+    height: u32,
+    rgb: Vec<u8>,
+}
+
+impl Shot {
+    fn open(path: &Path) -> Self {
+        let img = image::open(path)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+            .to_rgb8();
+        Self {
+            width: img.width(),
+            height: img.height(),
+            rgb: img.into_raw(),
+        }
+    }
+
+    fn px(&self, x: u32, y: u32) -> [u8; 3] {
+        let i = ((y * self.width + x) * 3) as usize;
+        [self.rgb[i], self.rgb[i + 1], self.rgb[i + 2]]
+    }
+
+    /// Mean luminance-ish value and variance over a rectangle.
+    fn stats(&self, x0: u32, y0: u32, x1: u32, y1: u32) -> (f64, f64) {
+        let mut v = Vec::new();
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let p = self.px(x, y);
+                v.push((p[0] as f64 + p[1] as f64 + p[2] as f64) / 3.0);
+            }
+        }
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let var = v.iter().map(|a| (a - mean).powi(2)).sum::<f64>() / v.len() as f64;
+        (mean, var)
+    }
+}
+
+/// Mean absolute difference of the render regions (the `w × h` left part).
+fn mean_abs_diff(a: &Shot, b: &Shot, w: u32, h: u32) -> f64 {
+    let mut sum = 0.0;
+    for y in 0..h {
+        for x in 0..w {
+            let (p, q) = (a.px(x, y), b.px(x, y));
+            sum += (0..3)
+                .map(|c| (p[c] as f64 - q[c] as f64).abs())
+                .sum::<f64>()
+                / 3.0;
+        }
+    }
+    sum / (w * h) as f64
+}
+
+const SIZE: u32 = 256;
+
+fn explore_shot(x: &Xvfb, dir: &Path, name: &str, extra: &[&str]) -> Shot {
+    let shot = dir.join(name);
+    let size = format!("{SIZE}x{SIZE}");
+    let mut args = vec![
+        "explore",
+        "--scene",
+        "phantom/orbit",
+        "--size",
+        &size,
+        "--frames",
+        "30",
+        "--screenshot",
+        shot.to_str().expect("utf-8 path"),
+    ];
+    args.extend_from_slice(extra);
+    let out = dvr(Some(&x.display), &args, dir);
+    assert_clean(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("ms/frame"),
+        "no frame-rate summary:\n{stdout}"
+    );
+    Shot::open(&shot)
+}
+
+#[test]
+fn window_shows_the_volume_and_the_panel_and_a_scripted_drag_turns_it() {
+    let Some(x) = xvfb() else { return };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let a = explore_shot(&x, dir.path(), "a.png", &[]);
+    assert_eq!((a.width, a.height), (SIZE + PANEL_WIDTH, SIZE));
+
+    // The volume: the centre of the view differs from the background at its border
+    // (a smooth environment gradient), pixel by pixel and in its structure.
+    let (border, border_var) = a.stats(0, 0, SIZE, 6);
+    let (c0, c1) = (SIZE / 2 - 40, SIZE / 2 + 40);
+    let (_, centre_var) = a.stats(c0, c0, c1, c1);
+    let mut off_background = 0.0;
+    for y in c0..c1 {
+        for px in c0..c1 {
+            let p = a.px(px, y);
+            off_background += ((p[0] as f64 + p[1] as f64 + p[2] as f64) / 3.0 - border).abs();
+        }
+    }
+    off_background /= ((c1 - c0) * (c1 - c0)) as f64;
+    eprintln!(
+        "border mean {border:.1} var {border_var:.1}; centre var {centre_var:.1}, \
+         mean |centre - border| {off_background:.1}"
+    );
+    assert!(border_var < 50.0, "the border is not plain background");
+    assert!(
+        off_background > 15.0 && centre_var > 4.0 * border_var + 100.0,
+        "no volume in view"
+    );
+
+    // The UI: the panel's fill covers much of the panel region (text and widgets the
+    // rest), and the panel is not the render.
+    let mut fill = 0;
+    let mut total = 0;
+    for y in 0..SIZE {
+        for px in SIZE + 4..SIZE + PANEL_WIDTH - 4 {
+            total += 1;
+            let p = a.px(px, y);
+            if (0..3).all(|c| (p[c] as i32 - PANEL_FILL[c] as i32).abs() <= 3) {
+                fill += 1;
+            }
+        }
+    }
+    assert!(
+        fill * 4 > total,
+        "panel colour on only {fill} of {total} pixels of the panel region"
+    );
+    let (_, panel_var) = a.stats(SIZE + 4, 0, SIZE + PANEL_WIDTH - 4, SIZE);
+    assert!(panel_var > 1.0, "the panel shows no widgets or text");
+
+    // A scripted drag at frame 5 orbits the camera by 1.5 rad: a different view.
+    let b = explore_shot(&x, dir.path(), "b.png", &["--script", "orbit:150,20@5"]);
+    let d = mean_abs_diff(&a, &b, SIZE, SIZE);
+    assert!(
+        d > 8.0,
+        "the drag barely changed the view (mean |Δ| = {d:.2})"
+    );
+}
+
+#[test]
+fn a_recorded_session_replays_to_the_same_frames() {
+    let Some(x) = xvfb() else { return };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rec = dir.path().join("rec");
+    let out = dvr(
+        Some(&x.display),
+        &[
+            "explore",
+            "--scene",
+            "phantom/orbit",
+            "--size",
+            "64x64",
+            "--volume-size",
+            "48",
+            "--frames",
+            "8",
+            "--denoiser",
+            "ours",
+            "--record",
+            rec.to_str().expect("utf-8"),
+            "--script",
+            "orbit:40,10@3;zoom:1@5;pan:6,-4@6",
+        ],
+        dir.path(),
+    );
+    assert_clean(&out);
+    let session = rec.join("session.toml");
+    assert!(session.is_file(), "no session.toml");
+    let lines = std::fs::read_to_string(rec.join("state.jsonl")).expect("state.jsonl");
+    assert_eq!(lines.lines().count(), 8);
+    let cap = dir.path().join("cap");
+    let replay = dvr(
+        None,
+        &[
+            "capture",
+            "--scene",
+            session.to_str().expect("utf-8"),
+            "--size",
+            "64x64",
+            "--volume-size",
+            "48",
+            "--denoiser",
+            "ours",
+            "--out",
+            cap.to_str().expect("utf-8"),
+        ],
+        dir.path(),
+    );
+    assert_clean(&replay);
+    for f in [0, 4, 7] {
+        let name = format!("{f:04}.png");
+        let a = Shot::open(&rec.join("frames").join(&name));
+        let b = Shot::open(&cap.join("ours").join(&name));
+        assert_eq!((a.width, a.height), (64, 64));
+        let d = mean_abs_diff(&a, &b, 64, 64);
+        assert!(
+            d < 0.5,
+            "frame {f}: replay differs from the session (mean |Δ| = {d:.3})"
+        );
+    }
+    // The camera moved, so the frames before and after the drag differ.
+    let first = Shot::open(&rec.join("frames").join("0000.png"));
+    let last = Shot::open(&rec.join("frames").join("0007.png"));
+    assert!(mean_abs_diff(&first, &last, 64, 64) > 2.0);
+}
+
+#[test]
+fn without_a_display_it_says_how_to_get_one() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dvr(None, &["explore", "--frames", "1"], dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        err.contains("needs a display") && err.contains("Xvfb :99"),
+        "{err}"
+    );
+}
