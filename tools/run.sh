@@ -6,5 +6,5 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
 cargo run --release -- capture --scene phantom/orbit --frames 24 --size 256x256 \
-  --denoiser none,accum --out out/demo "$@"
+  --denoiser none,taa,svgf,ours --out out/demo "$@"
 echo "open out/demo/index.html"
