@@ -6,36 +6,12 @@ mod common;
 
 use ash::vk;
 use common::*;
-use dvr_engine::gpu::{validation, GpuContext, ImageDesc};
-use dvr_engine::graph::{Frame, ImageHandle, RenderGraph};
+use dvr_engine::gpu::{validation, ImageDesc};
+use dvr_engine::graph::{Frame, RenderGraph};
 use dvr_engine::metrics::{tonemap_srgb, Rgb32Image};
 use dvr_engine::passes::present::{Present, PresentLayout};
 use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::add_upload;
-use gpu_allocator::MemoryLocation;
-
-fn read(ctx: &GpuContext, graph: &mut RenderGraph, image: ImageHandle, n: usize) -> Vec<[f32; 4]> {
-    let buf = graph
-        .buffer(
-            ctx,
-            "test.readback",
-            (n * 16) as u64,
-            MemoryLocation::GpuToCpu,
-        )
-        .expect("buffer");
-    let mut f = Frame::new();
-    f.add_pass(
-        "readback",
-        |b| {
-            b.transfer_src(image).transfer_dst(buf);
-        },
-        move |pc| pc.copy_image_to_buffer(image, buf),
-    );
-    f.add_host_read("host_read", buf);
-    ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
-        .expect("submit");
-    bytemuck::cast_slice::<u8, [f32; 4]>(graph.buffer_ref(buf).mapped().expect("mapped")).to_vec()
-}
 
 /// Runs the present pass from `left`/`right` (w × h) into an rgba32f target.
 fn present(
@@ -84,12 +60,7 @@ fn present(
     pass.add(&mut f, l, r, size, target, target_size, &layout);
     ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
         .expect("submit");
-    let out = read(
-        &ctx,
-        &mut graph,
-        target,
-        (target_size.width * target_size.height) as usize,
-    );
+    let out = read_image(&ctx, &mut graph, target);
     let mut pass = pass;
     pass.destroy(&ctx);
     graph.destroy(&ctx);

@@ -11,37 +11,9 @@ use dvr_engine::graph::{Bind, Frame, RenderGraph};
 use dvr_engine::passes::accumulate::Accumulate;
 use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::add_upload;
-use gpu_allocator::MemoryLocation;
 
 const W: u32 = 8;
 const H: u32 = 4;
-
-fn read_image(
-    ctx: &dvr_engine::gpu::GpuContext,
-    graph: &mut RenderGraph,
-    image: dvr_engine::graph::ImageHandle,
-) -> Vec<[f32; 4]> {
-    let buf = graph
-        .buffer(
-            ctx,
-            "test.readback",
-            (W * H * 16) as u64,
-            MemoryLocation::GpuToCpu,
-        )
-        .expect("buffer");
-    let mut f = Frame::new();
-    f.add_pass(
-        "readback",
-        |b| {
-            b.transfer_src(image).transfer_dst(buf);
-        },
-        move |pc| pc.copy_image_to_buffer(image, buf),
-    );
-    f.add_host_read("host_read", buf);
-    ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
-        .expect("submit");
-    bytemuck::cast_slice::<u8, [f32; 4]>(graph.buffer_ref(buf).mapped().expect("mapped")).to_vec()
-}
 
 #[test]
 fn history_accumulates_across_frames_and_resets() {

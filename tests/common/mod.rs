@@ -109,6 +109,35 @@ pub fn mean_rgb(pixels: &[[f32; 4]]) -> [f64; 3] {
     s.map(|v| v / pixels.len() as f64)
 }
 
+/// Reads an rgba32f graph image back to the host (one submit, waited for).
+pub fn read_image(
+    ctx: &GpuContext,
+    graph: &mut dvr_engine::graph::RenderGraph,
+    image: dvr_engine::graph::ImageHandle,
+) -> Vec<[f32; 4]> {
+    let bytes = graph.image_desc(image).texel_count() * 16;
+    let buf = graph
+        .buffer(
+            ctx,
+            "test.readback",
+            bytes,
+            gpu_allocator::MemoryLocation::GpuToCpu,
+        )
+        .expect("readback buffer");
+    let mut f = dvr_engine::graph::Frame::new();
+    f.add_pass(
+        "readback",
+        |b| {
+            b.transfer_src(image).transfer_dst(buf);
+        },
+        move |pc| pc.copy_image_to_buffer(image, buf),
+    );
+    f.add_host_read("host_read", buf);
+    ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
+        .expect("submit");
+    bytemuck::cast_slice::<u8, [f32; 4]>(graph.buffer_ref(buf).mapped().expect("mapped")).to_vec()
+}
+
 /// Fails the test if the validation layer reported anything in this process.
 pub fn assert_validation_clean() {
     let msgs = validation::messages();

@@ -16,7 +16,7 @@ pub use wrls::{Wrls, WrlsVariant};
 
 use crate::error::{EngineError, Result};
 use crate::gpu::GpuContext;
-use crate::graph::{BufferHandle, Frame, History, ImageHandle, RenderGraph};
+use crate::graph::{Bind, BufferHandle, Frame, History, ImageHandle, PassBuilder, RenderGraph};
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::Extent;
 
@@ -93,14 +93,51 @@ impl DenoiseInputs {
         })
     }
 
-    /// The world positions reprojection tests against, for a motion source: 0 = the
-    /// closest first real collision (the paper's), 1 = the surface features.
-    pub fn positions(&self, denoiser: &str, motion_source: i32) -> Result<History> {
-        if motion_source == 0 {
-            Ok(self.first_hit)
-        } else {
-            Ok(self.features(denoiser)?.position)
-        }
+    /// The resources of the shared reprojection (include/reproject.glsl) for a motion
+    /// source: the frame uniforms, the motion vectors, and this and last frame's world
+    /// positions from that source.
+    pub fn reprojection(&self, denoiser: &str, motion: MotionSource) -> Result<Reprojection> {
+        let positions = match motion {
+            MotionSource::FirstHit => self.first_hit,
+            MotionSource::Features => self.features(denoiser)?.position,
+        };
+        Ok(Reprojection {
+            uniforms: self.uniforms,
+            motion: self.motion,
+            position_cur: positions.cur,
+            position_prev: positions.prev,
+            valid: positions.valid,
+        })
+    }
+}
+
+/// What every temporal denoiser's reprojecting pass declares and binds, in one place.
+#[derive(Clone, Copy, Debug)]
+pub struct Reprojection {
+    uniforms: BufferHandle,
+    motion: ImageHandle,
+    position_cur: ImageHandle,
+    position_prev: ImageHandle,
+    /// Last frame's positions exist (false on the first frame and after resets).
+    pub valid: bool,
+}
+
+impl Reprojection {
+    pub fn declare(&self, b: &mut PassBuilder) {
+        b.uniform(self.uniforms)
+            .read(self.motion)
+            .read(self.position_cur)
+            .sampled(self.position_prev);
+    }
+
+    /// Bindings named as in include/reproject.glsl and include/frame.glsl.
+    pub fn binds(&self) -> Vec<(&'static str, Bind)> {
+        vec![
+            ("frame", Bind::Buffer(self.uniforms)),
+            ("motion", Bind::Image(self.motion)),
+            ("position_cur", Bind::Image(self.position_cur)),
+            ("position_prev", Bind::ImageNearest(self.position_prev)),
+        ]
     }
 }
 
@@ -139,18 +176,17 @@ pub const NAMES: &[&str] = &[
 
 /// Builds a denoiser by name.
 pub fn create(ctx: &GpuContext, name: &str, motion: MotionSource) -> Result<Box<dyn Denoiser>> {
-    let m = motion.spec();
     Ok(match name {
         "none" => Box::new(Passthrough),
         "accum" => Box::new(Accum::new(ctx)?),
-        "taa" => Box::new(Taa::new(ctx, m)?),
-        "svgf" => Box::new(Svgf::new(ctx, m)?),
+        "taa" => Box::new(Taa::new(ctx, motion)?),
+        "svgf" => Box::new(Svgf::new(ctx, motion)?),
         n if WrlsVariant::from_name(n).is_some() => {
             let variant = WrlsVariant::from_name(n).ok_or_else(|| EngineError::Pass {
                 pass: "denoise".into(),
                 problem: format!("unknown wRLS variant {n:?}"),
             })?;
-            Box::new(Wrls::new(ctx, n, variant, m)?)
+            Box::new(Wrls::new(ctx, n, variant, motion)?)
         }
         other => {
             return Err(EngineError::Pass {

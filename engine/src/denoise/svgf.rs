@@ -27,7 +27,7 @@
 //! transfer function change: reprojection follows motion, and shading changes are
 //! followed at the moving averages' rate (the method's known lag).
 
-use super::{DenoiseInputs, Denoiser};
+use super::{DenoiseInputs, Denoiser, MotionSource};
 use crate::error::Result;
 use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
 use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
@@ -81,7 +81,7 @@ pub struct Svgf {
     atrous: ComputePipeline,
     pub params: SvgfParams,
     /// 0: motion from the first real collision (the paper's, as `ours`), 1: from features.
-    pub motion_source: i32,
+    pub motion: MotionSource,
 }
 
 impl Svgf {
@@ -89,17 +89,17 @@ impl Svgf {
     pub const COLOR_HISTORY: &'static str = "svgf.color";
     pub const MOMENTS_HISTORY: &'static str = "svgf.moments";
 
-    pub fn new(ctx: &GpuContext, motion_source: i32) -> Result<Self> {
+    pub fn new(ctx: &GpuContext, motion: MotionSource) -> Result<Self> {
         Ok(Self {
             temporal: ComputePipeline::new(
                 ctx,
                 "svgf_temporal",
-                &[("MOTION_SOURCE", SpecValue::I32(motion_source))],
+                &[("MOTION_SOURCE", SpecValue::I32(motion.spec()))],
             )?,
             variance: ComputePipeline::new(ctx, "svgf_variance", &[])?,
             atrous: ComputePipeline::new(ctx, "svgf_atrous", &[])?,
             params: SvgfParams::default(),
-            motion_source,
+            motion,
         })
     }
 }
@@ -128,14 +128,12 @@ impl Denoiser for Svgf {
         let ping = graph.image(ctx, "svgf.ping", desc)?;
         let pong = graph.image(ctx, "svgf.pong", desc)?;
         let out = graph.image(ctx, "svgf.out", desc)?;
-        let positions = input.positions(self.name(), self.motion_source)?;
-        let (pos_cur, pos_prev) = (positions.cur, positions.prev);
-        let valid = color.valid && moments.valid && positions.valid;
+        let reproj = input.reprojection(self.name(), self.motion)?;
+        let valid = color.valid && moments.valid && reproj.valid;
         let p = self.params;
-        let (noisy, motion) = (input.noisy, input.motion);
+        let noisy = input.noisy;
         let features = input.features(self.name())?;
         let (albedo, normal) = (features.albedo, features.normal);
-        let uniforms = input.uniforms;
 
         let push = SvgfTemporalPush {
             camera: input.camera.extend(1.0),
@@ -151,13 +149,10 @@ impl Denoiser for Svgf {
         frame.add_pass(
             "svgf.temporal",
             |b| {
-                b.uniform(uniforms)
-                    .read(noisy)
+                reproj.declare(b);
+                b.read(noisy)
                     .read(albedo)
                     .read(normal)
-                    .read(motion)
-                    .read(pos_cur)
-                    .sampled(pos_prev)
                     .sampled(color.prev)
                     .sampled(moments.prev)
                     .write(ping)
@@ -165,20 +160,17 @@ impl Denoiser for Svgf {
                     .write(geometry);
             },
             move |pc| {
-                let binds = [
-                    ("frame", Bind::Buffer(uniforms)),
+                let mut binds = reproj.binds();
+                binds.extend([
                     ("noisy", Bind::Image(noisy)),
                     ("feature_albedo", Bind::Image(albedo)),
                     ("feature_normal", Bind::Image(normal)),
-                    ("motion", Bind::Image(motion)),
-                    ("position_cur", Bind::Image(pos_cur)),
-                    ("position_prev", Bind::ImageNearest(pos_prev)),
                     ("color_prev", Bind::Image(color.prev)),
                     ("moments_prev", Bind::Image(moments.prev)),
                     ("integrated", Bind::Image(ping)),
                     ("moments_cur", Bind::Image(moments.cur)),
                     ("geometry", Bind::Image(geometry)),
-                ];
+                ]);
                 let groups = self.temporal.groups_2d(size.width, size.height);
                 pc.dispatch(&self.temporal, &binds, &push, groups)
             },

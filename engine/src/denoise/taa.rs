@@ -5,7 +5,7 @@
 //! the output: the average is what the next frame reprojects. Like `svgf` it is not reset
 //! on camera, light or TF changes; the clip box limits how long stale colour survives.
 
-use super::{DenoiseInputs, Denoiser};
+use super::{DenoiseInputs, Denoiser, MotionSource};
 use crate::error::Result;
 use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
 use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
@@ -36,29 +36,29 @@ pub struct Taa {
     pipeline: ComputePipeline,
     pub params: TaaParams,
     /// 0: motion from the first real collision (the paper's, as `ours`), 1: from features.
-    pub motion_source: i32,
+    pub motion: MotionSource,
 }
 
 impl Taa {
     /// The history key (for tests and resets).
     pub const HISTORY: &'static str = "taa.color";
 
-    pub fn new(ctx: &GpuContext, motion_source: i32) -> Result<Self> {
+    pub fn new(ctx: &GpuContext, motion: MotionSource) -> Result<Self> {
         Ok(Self {
             pipeline: ComputePipeline::new(
                 ctx,
                 "taa",
-                &[("MOTION_SOURCE", SpecValue::I32(motion_source))],
+                &[("MOTION_SOURCE", SpecValue::I32(motion.spec()))],
             )?,
             params: TaaParams::default(),
-            motion_source,
+            motion,
         })
     }
 }
 
 impl Denoiser for Taa {
     fn uses_surface_features(&self) -> bool {
-        self.motion_source == 1
+        self.motion == MotionSource::Features
     }
 
     fn name(&self) -> &str {
@@ -75,11 +75,9 @@ impl Denoiser for Taa {
         let size = input.size;
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
         let color = graph.history(ctx, Self::HISTORY, desc)?;
-        let positions = input.positions(self.name(), self.motion_source)?;
-        let (pos_cur, pos_prev) = (positions.cur, positions.prev);
-        let valid = color.valid && positions.valid;
+        let reproj = input.reprojection(self.name(), self.motion)?;
+        let valid = color.valid && reproj.valid;
         let p = self.params;
-        let uniforms = input.uniforms;
         let push = TaaPush {
             camera: input.camera.extend(1.0),
             width: size.width,
@@ -92,28 +90,19 @@ impl Denoiser for Taa {
             pad1: 0.0,
         };
         let noisy = input.noisy;
-        let motion = input.motion;
         frame.add_pass(
             "taa",
             |b| {
-                b.uniform(uniforms)
-                    .read(noisy)
-                    .read(motion)
-                    .read(pos_cur)
-                    .sampled(pos_prev)
-                    .sampled(color.prev)
-                    .write(color.cur);
+                reproj.declare(b);
+                b.read(noisy).sampled(color.prev).write(color.cur);
             },
             move |pc| {
-                let binds = [
-                    ("frame", Bind::Buffer(uniforms)),
+                let mut binds = reproj.binds();
+                binds.extend([
                     ("noisy", Bind::Image(noisy)),
-                    ("motion", Bind::Image(motion)),
-                    ("position_cur", Bind::Image(pos_cur)),
-                    ("position_prev", Bind::ImageNearest(pos_prev)),
                     ("history_prev", Bind::Image(color.prev)),
                     ("history_cur", Bind::Image(color.cur)),
-                ];
+                ]);
                 let groups = self.pipeline.groups_2d(size.width, size.height);
                 pc.dispatch(&self.pipeline, &binds, &push, groups)
             },

@@ -3,7 +3,7 @@
 //! `rls-nf` (no temporal feature, p = [1]). Two passes: `<name>.update` (temporal feature,
 //! reprojected models, weighted RLS update) and `<name>.spatial` (5×5 model blending).
 
-use super::{DenoiseInputs, Denoiser};
+use super::{DenoiseInputs, Denoiser, MotionSource};
 use crate::error::Result;
 use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
 use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
@@ -102,7 +102,7 @@ pub struct Wrls {
     spatial: ComputePipeline,
     pub params: WrlsParams,
     /// 0: motion from the first real collision (the paper's), 1: from surface features.
-    pub motion_source: i32,
+    pub motion: MotionSource,
 }
 
 impl Wrls {
@@ -110,12 +110,12 @@ impl Wrls {
         ctx: &GpuContext,
         name: &str,
         variant: WrlsVariant,
-        motion_source: i32,
+        motion: MotionSource,
     ) -> Result<Self> {
         let spec = [
             ("WEIGHTED", SpecValue::Bool(variant.weighted)),
             ("USE_FEATURE", SpecValue::Bool(variant.feature)),
-            ("MOTION_SOURCE", SpecValue::I32(motion_source)),
+            ("MOTION_SOURCE", SpecValue::I32(motion.spec())),
             ("PAPER_PREDICTOR", SpecValue::Bool(variant.paper_predictor)),
             ("ADAPTIVE_LAMBDA", SpecValue::Bool(variant.adaptive_lambda)),
         ];
@@ -124,14 +124,14 @@ impl Wrls {
             update: ComputePipeline::new(ctx, "wrls_update", &spec)?,
             spatial: ComputePipeline::new(ctx, "wrls_spatial", &[spec[1], spec[3]])?,
             params: WrlsParams::default(),
-            motion_source,
+            motion,
         })
     }
 }
 
 impl Denoiser for Wrls {
     fn uses_surface_features(&self) -> bool {
-        self.motion_source == 1
+        self.motion == MotionSource::Features
     }
 
     fn name(&self) -> &str {
@@ -160,11 +160,9 @@ impl Denoiser for Wrls {
             graph.history(ctx, &format!("{n}.p2"), desc)?,
         ];
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
-        let positions = input.positions(self.name(), self.motion_source)?;
-        let (pos_cur, pos_prev) = (positions.cur, positions.prev);
-        let valid = z.valid && positions.valid;
+        let reproj = input.reprojection(self.name(), self.motion)?;
+        let valid = z.valid && reproj.valid;
         let p = self.params;
-        let uniforms = input.uniforms;
         let push = WrlsUpdatePush {
             camera: input.camera.extend(1.0),
             width: size.width,
@@ -181,16 +179,11 @@ impl Denoiser for Wrls {
             pad1: 0.0,
         };
         let noisy = input.noisy;
-        let motion = input.motion;
         frame.add_pass(
             format!("{n}.update"),
             |b| {
-                b.uniform(uniforms)
-                    .read(noisy)
-                    .read(motion)
-                    .read(pos_cur)
-                    .sampled(pos_prev)
-                    .sampled(z.prev);
+                reproj.declare(b);
+                b.read(noisy).sampled(z.prev);
                 for h in beta.iter().chain(&pm) {
                     b.sampled(h.prev);
                 }
@@ -200,12 +193,9 @@ impl Denoiser for Wrls {
                 }
             },
             move |pc| {
-                let binds = [
-                    ("frame", Bind::Buffer(uniforms)),
+                let mut binds = reproj.binds();
+                binds.extend([
                     ("noisy", Bind::Image(noisy)),
-                    ("motion", Bind::Image(motion)),
-                    ("position_cur", Bind::Image(pos_cur)),
-                    ("position_prev", Bind::ImageNearest(pos_prev)),
                     ("z_prev", Bind::Image(z.prev)),
                     ("beta_r_prev", Bind::Image(beta[0].prev)),
                     ("beta_g_prev", Bind::Image(beta[1].prev)),
@@ -220,7 +210,7 @@ impl Denoiser for Wrls {
                     ("p0_cur", Bind::Image(pm[0].cur)),
                     ("p1_cur", Bind::Image(pm[1].cur)),
                     ("p2_cur", Bind::Image(pm[2].cur)),
-                ];
+                ]);
                 let groups = self.update.groups_2d(size.width, size.height);
                 pc.dispatch(&self.update, &binds, &push, groups)
             },
