@@ -64,15 +64,12 @@ fn mse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
 }
 
 /// On a static view, 64 frames of `ours` at 2 spp end closer to the 1024-spp reference
-/// than a 32-spp render without denoising (issue 4's requirement).
-///
-/// Known gap, kept visible rather than loosened: on mri/orbit at 32×32 `ours` ends at
-/// MSE 3.7e-3 against 2.1e-3 for 32 spp (accum reaches 5.3e-4; plain `rls` 6.6e-3,
-/// `wrls-nf` 3.6e-3). Not yet explained: weights scaled by the residual's own noise level
-/// instead of the paper's relative distance made it worse (5.4e-3). Run with
-/// `cargo test --test stability -- --ignored` to measure.
+/// than a 32-spp render without denoising (issue 4's requirement), with both motion
+/// sources. This test found two real faults: motion vectors measured from the pixel
+/// centre gave the jittered first collision a random sub-pixel motion on a still view
+/// (every frame resampled the models), and the paper's relative-distance weights biased
+/// and starved the fit on 2-spp noise.
 #[test]
-#[ignore = "known gap of ours on real 2-spp streams; see the doc comment"]
 fn ours_on_a_static_scene_beats_32_spp_after_64_frames() {
     let size = Extent {
         width: 32,

@@ -19,10 +19,17 @@ layout(push_constant) uniform MotionPush {
     uint pad1;
 } pc;
 
-vec2 previous_pixel(vec3 world) {
-    vec4 clip = frame.prev_view_proj * vec4(world, 1.0);
+vec2 project(mat4 view_proj, vec3 world) {
+    vec4 clip = view_proj * vec4(world, 1.0);
     vec2 ndc = clip.xy / max(clip.w, 1e-6);
     return (ndc * 0.5 + 0.5) * vec2(pc.width, pc.height);
+}
+
+// The point's own displacement, measured from where it projects now rather than from the
+// pixel centre: the first real collision comes from a jittered sample (the pixel filter
+// reaches beyond the pixel), and with a still camera its motion must be exactly zero.
+vec2 point_motion(vec3 world) {
+    return project(frame.prev_view_proj, world) - project(frame.view_proj, world);
 }
 
 vec3 far_point(vec2 pixel) {
@@ -40,7 +47,7 @@ void main() {
     vec4 feat = imageLoad(feature_position, ivec2(pixel));
     vec3 p_hit = hit.w > 0.0 ? hit.xyz : far_point(centre);
     vec3 p_feat = feat.w > 0.0 ? feat.xyz : far_point(centre);
-    vec2 m_hit = previous_pixel(p_hit) - centre;
-    vec2 m_feat = previous_pixel(p_feat) - centre;
+    vec2 m_hit = point_motion(p_hit);
+    vec2 m_feat = point_motion(p_feat);
     imageStore(motion, ivec2(pixel), vec4(m_hit, m_feat));
 }

@@ -25,6 +25,12 @@ layout(binding = 12, rgba32f) uniform writeonly image2D beta_b_cur;
 layout(binding = 13, rgba32f) uniform writeonly image2D p0_cur;
 layout(binding = 14, rgba32f) uniform writeonly image2D p1_cur;
 layout(binding = 15, rgba32f) uniform writeonly image2D p2_cur;
+// The constant model (MODEL_SELECTION): rgb β, a its scalar P; and the two models'
+// running a-priori squared errors (x constant, y feature).
+layout(binding = 16) uniform sampler2D constant_prev;
+layout(binding = 17) uniform sampler2D errors_prev;
+layout(binding = 18, rgba32f) uniform writeonly image2D constant_cur;
+layout(binding = 19, rgba32f) uniform writeonly image2D errors_cur;
 
 layout(push_constant) uniform WrlsUpdatePush {
     vec4 camera;          // xyz camera position
@@ -38,8 +44,8 @@ layout(push_constant) uniform WrlsUpdatePush {
     float tolerance;      // disocclusion tolerance, relative to camera distance
     float lambda_min;     // forgetting factor during a detected change
     float change_ratio;   // residual / noise-level ratio that counts as a change
+    float outlier_sigmas; // residual weights: k in exp(-r²/(k²·noise level))
     float pad0;
-    float pad1;
 } pc;
 
 const float P_MAX = 1e6;
@@ -67,6 +73,8 @@ void main() {
     float age;
     float noise_level = -1.0;  // running mean of the squared a-priori residual
     float streak = 0.0;        // consecutive frames far above the noise level
+    vec4 constant = vec4(0.0, 0.0, 0.0, pc.delta);
+    vec3 errors = vec3(-1.0, -1.0, 0.0);  // a-priori errors (const, feature), const streak
     if (r.valid) {
         vec4 zq = texture(z_prev, r.uv);
         z_hist = clamp(zq.rgb, lo, hi);
@@ -79,6 +87,10 @@ void main() {
         P = unpack_p(texture(p0_prev, r.uv), texture(p1_prev, r.uv), p2);
         noise_level = p2.z;
         streak = p2.w;
+        if (MODEL_SELECTION) {
+            constant = texture(constant_prev, r.uv);
+            errors = texture(errors_prev, r.uv).xyz;
+        }
     } else {
         // A new surface: start the models over.
         z = I;
@@ -92,30 +104,64 @@ void main() {
     }
 
     vec3 feature = PAPER_PREDICTOR ? z : z_hist;
-    vec4 x = predictor(feature);
-    float w = 1.0;
-    if (WEIGHTED) {
-        float d = length(I - feature) / (min(length(I), length(feature)) + 1e-4);
-        w = max(exp(-(d * d) / (pc.h * pc.h)), 1e-6);
-    }
+    // A new model's first sample has no history: its "feature" would be the sample
+    // itself, the regression target, so it only informs the constant term (frame 0 is
+    // then a bilateral filter of the noisy frame in the spatial pass).
+    vec4 x = r.valid || PAPER_PREDICTOR ? predictor(feature) : vec4(1.0, 0.0, 0.0, 0.0);
     vec3 e = I - vec3(dot(x, beta[0]), dot(x, beta[1]), dot(x, beta[2]));
     float r2 = dot(e, e);
+    bool fresh = noise_level < 0.0;
+    if (fresh) noise_level = r2;
+    bool far = r2 > pc.change_ratio * (noise_level + 1e-6);
+    streak = far ? streak + 1.0 : 0.0;
+    float w = 1.0;
+    if (WEIGHTED && PAPER_PREDICTOR) {
+        // The paper's weights: relative colour distance to the temporal feature. With
+        // 2-spp volume noise most ordinary samples lie far from it in relative terms, and
+        // dark ones more so than bright ones, so they bias the fit (measured +5.5% on a
+        // static mri view) and waste most samples.
+        float d = length(I - feature) / (min(length(I), length(feature)) + 1e-4);
+        w = max(exp(-(d * d) / (pc.h * pc.h)), 1e-6);
+    } else if (WEIGHTED && !fresh && streak < 2.0) {
+        // Ours: the a-priori residual in units of the model's own running noise level, so
+        // only samples many standard deviations out (spikes) lose weight and ordinary
+        // noise is averaged in full. A residual that stays high (a change, streak ≥ 2)
+        // is not an outlier: it is learned at full weight.
+        w = max(exp(-r2 / (pc.outlier_sigmas * pc.outlier_sigmas * (noise_level + 1e-6))), 1e-6);
+    }
     float lambda = pc.lambda;
-    if (ADAPTIVE_LAMBDA) {
-        if (noise_level < 0.0) noise_level = r2;
-        bool far = r2 > pc.change_ratio * (noise_level + 1e-6);
-        streak = far ? streak + 1.0 : 0.0;
-        // A change is a residual far above the noise level for 2–4 frames in a row: forget
-        // fast while it lasts. A spike is one frame (its weight w handles it); a residual
-        // that stays high longer is the new scene's noise level, adopted as such, so a
-        // noisier state after the change does not keep the model forgetting.
-        if (streak >= 2.0 && streak <= 4.0) lambda = pc.lambda_min;
-        if (streak > 4.0) {
-            noise_level = r2;
-            streak = 0.0;
-        }
-        // Spikes barely move the noise level; ordinary residuals track it.
-        noise_level = mix(noise_level, r2, far ? 0.02 : 0.1);
+    // A change is a residual far above the noise level for 2–4 frames in a row: forget
+    // fast while it lasts. A spike is one frame (its weight w handles it); a residual
+    // that stays high longer is the new scene's noise level, adopted as such, so a
+    // noisier state after the change does not keep the model forgetting.
+    if (ADAPTIVE_LAMBDA && streak >= 2.0 && streak <= 4.0) lambda = pc.lambda_min;
+    if (streak > 4.0) {
+        noise_level = r2;
+        streak = 0.0;
+    }
+    // Spikes barely move the noise level; ordinary residuals track it.
+    noise_level = mix(noise_level, r2, far ? 0.02 : 0.1);
+    if (MODEL_SELECTION) {
+        // Both models' a-priori errors, winsorised at the change threshold so that one
+        // spike does not decide; they rise fast (a model that stopped predicting loses at
+        // once) and fall slowly (the choice does not flicker on a static pixel).
+        vec3 ec = I - constant.rgb;
+        float rc2 = dot(ec, ec);
+        float cap = pc.change_ratio * (noise_level + 1e-6);
+        vec2 sq = min(vec2(rc2, r2), vec2(cap));
+        errors.xy = errors.x < 0.0 ? sq : mix(errors.xy, sq, mix(vec2(0.05), vec2(0.3), greaterThan(sq, errors.xy)));
+        // The same weighted RLS with p = [1] (P is a scalar), with its own change test:
+        // it cannot follow a change through a feature, so it forgets fast for as long as
+        // its residual stays far above the noise level (from the second such frame on).
+        float streak_c = rc2 > cap ? errors.z + 1.0 : 0.0;
+        errors.z = streak_c;
+        float lambda_c = streak_c >= 2.0 ? pc.lambda_min : pc.lambda;
+        float wc = streak_c >= 2.0 || !WEIGHTED ? 1.0
+                 : max(exp(-rc2 / (pc.outlier_sigmas * pc.outlier_sigmas * (noise_level + 1e-6))), 1e-6);
+        float qc = constant.a / (lambda_c / wc + constant.a);
+        constant.rgb += qc * ec;
+        constant.a = clamp((constant.a - qc * constant.a) / lambda_c, 1e-8, P_MAX);
+        if (!all_finite(constant.rgb) || isnan(constant.a)) constant = vec4(I, pc.delta);
     }
     vec4 Px = P * x;
     vec4 q = Px / (lambda / w + dot(x, Px));
@@ -147,4 +193,6 @@ void main() {
     imageStore(p0_cur, p, a);
     imageStore(p1_cur, p, b);
     imageStore(p2_cur, p, c);
+    imageStore(constant_cur, p, constant);
+    imageStore(errors_cur, p, vec4(errors, 0.0));
 }

@@ -29,6 +29,10 @@ pub struct WrlsParams {
     pub lambda_min: f32,
     /// Squared a-priori residual over its running noise level that counts as a change.
     pub change_ratio: f32,
+    /// Residual weights (not the paper's): a sample's weight falls off with its a-priori
+    /// residual in units of the model's running noise level, exp(−r²/(k²·noise)); this
+    /// is k. Only samples many standard deviations out (spikes) lose weight.
+    pub outlier_sigmas: f32,
 }
 
 impl Default for WrlsParams {
@@ -42,8 +46,9 @@ impl Default for WrlsParams {
             sigma_spatial: 2.0,
             sigma_range: 0.5,
             kappa: 2.0,
-            lambda_min: 0.5,
+            lambda_min: 0.1,
             change_ratio: 9.0,
+            outlier_sigmas: 10.0,
         }
     }
 }
@@ -57,6 +62,9 @@ pub struct WrlsVariant {
     /// The paper's exact predictor p = [1, z(t)] (z contains this frame's noisy colour).
     pub paper_predictor: bool,
     pub adaptive_lambda: bool,
+    /// Also keep the constant model p = [1] and use the temporal feature only where it
+    /// predicts measurably better (see include/wrls.glsl).
+    pub model_selection: bool,
 }
 
 impl WrlsVariant {
@@ -66,6 +74,7 @@ impl WrlsVariant {
             feature: true,
             paper_predictor: false,
             adaptive_lambda: true,
+            model_selection: true,
         };
         Some(match name {
             "ours" => ours,
@@ -76,19 +85,24 @@ impl WrlsVariant {
             "wrls-paper" => Self {
                 paper_predictor: true,
                 adaptive_lambda: false,
+                model_selection: false,
                 ..ours
             },
+            // The paper's ablations keep its single model.
             "rls" => Self {
                 weighted: false,
+                model_selection: false,
                 ..ours
             },
             "wrls-nf" => Self {
                 feature: false,
+                model_selection: false,
                 ..ours
             },
             "rls-nf" => Self {
                 weighted: false,
                 feature: false,
+                model_selection: false,
                 ..ours
             },
             _ => return None,
@@ -118,11 +132,12 @@ impl Wrls {
             ("MOTION_SOURCE", SpecValue::I32(motion.spec())),
             ("PAPER_PREDICTOR", SpecValue::Bool(variant.paper_predictor)),
             ("ADAPTIVE_LAMBDA", SpecValue::Bool(variant.adaptive_lambda)),
+            ("MODEL_SELECTION", SpecValue::Bool(variant.model_selection)),
         ];
         Ok(Self {
             name: name.to_string(),
             update: ComputePipeline::new(ctx, "wrls_update", &spec)?,
-            spatial: ComputePipeline::new(ctx, "wrls_spatial", &[spec[1], spec[3]])?,
+            spatial: ComputePipeline::new(ctx, "wrls_spatial", &[spec[1], spec[3], spec[5]])?,
             params: WrlsParams::default(),
             motion,
         })
@@ -159,6 +174,9 @@ impl Denoiser for Wrls {
             graph.history(ctx, &format!("{n}.p1"), desc)?,
             graph.history(ctx, &format!("{n}.p2"), desc)?,
         ];
+        // The constant model and both models' a-priori errors (model selection).
+        let constant = graph.history(ctx, &format!("{n}.constant"), desc)?;
+        let errors = graph.history(ctx, &format!("{n}.errors"), desc)?;
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
         let reproj = input.reprojection(self.name(), self.motion)?;
         let valid = z.valid && reproj.valid;
@@ -175,8 +193,8 @@ impl Denoiser for Wrls {
             tolerance: p.tolerance,
             lambda_min: p.lambda_min,
             change_ratio: p.change_ratio,
+            outlier_sigmas: p.outlier_sigmas,
             pad0: 0.0,
-            pad1: 0.0,
         };
         let noisy = input.noisy;
         frame.add_pass(
@@ -184,13 +202,11 @@ impl Denoiser for Wrls {
             |b| {
                 reproj.declare(b);
                 b.read(noisy).sampled(z.prev);
-                for h in beta.iter().chain(&pm) {
+                for h in beta.iter().chain(&pm).chain([&constant, &errors]) {
                     b.sampled(h.prev);
-                }
-                b.write(z.cur);
-                for h in beta.iter().chain(&pm) {
                     b.write(h.cur);
                 }
+                b.write(z.cur);
             },
             move |pc| {
                 let mut binds = reproj.binds();
@@ -210,6 +226,10 @@ impl Denoiser for Wrls {
                     ("p0_cur", Bind::Image(pm[0].cur)),
                     ("p1_cur", Bind::Image(pm[1].cur)),
                     ("p2_cur", Bind::Image(pm[2].cur)),
+                    ("constant_prev", Bind::Image(constant.prev)),
+                    ("errors_prev", Bind::Image(errors.prev)),
+                    ("constant_cur", Bind::Image(constant.cur)),
+                    ("errors_cur", Bind::Image(errors.cur)),
                 ]);
                 let groups = self.update.groups_2d(size.width, size.height);
                 pc.dispatch(&self.update, &binds, &push, groups)
@@ -232,6 +252,8 @@ impl Denoiser for Wrls {
                     .read(noisy)
                     .read(pm[0].cur)
                     .read(pm[2].cur)
+                    .read(constant.cur)
+                    .read(errors.cur)
                     .write(out);
                 for h in &beta {
                     b.read(h.cur);
@@ -247,6 +269,8 @@ impl Denoiser for Wrls {
                     ("denoised", Bind::Image(out)),
                     ("p0", Bind::Image(pm[0].cur)),
                     ("p2", Bind::Image(pm[2].cur)),
+                    ("constant", Bind::Image(constant.cur)),
+                    ("errors", Bind::Image(errors.cur)),
                 ];
                 let groups = self.spatial.groups_2d(size.width, size.height);
                 pc.dispatch(&self.spatial, &binds, &spush, groups)

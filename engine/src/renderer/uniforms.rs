@@ -90,8 +90,8 @@ pub struct WrlsUpdatePush {
     pub tolerance: f32,
     pub lambda_min: f32,
     pub change_ratio: f32,
+    pub outlier_sigmas: f32,
     pub pad0: f32,
-    pub pad1: f32,
 }
 
 #[repr(C)]
@@ -277,8 +277,8 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 tolerance,
                 lambda_min,
                 change_ratio,
-                pad0,
-                pad1
+                outlier_sigmas,
+                pad0
             }),
         ),
         (

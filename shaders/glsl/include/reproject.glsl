@@ -29,14 +29,14 @@ vec2 to_pixel(mat4 view_proj, vec3 world, ivec2 size) {
 }
 
 // Disocclusion by a screen-space round trip: what was at the reprojected place last
-// frame, projected with this frame's camera, must land within `tolerance` pixels of this
-// pixel. Unlike comparing world positions, this tolerates the stochastic depth of the
-// first real collision in semi-transparent media (with a still camera every surface maps
-// back onto itself; under motion a depth error only moves the round trip by its
-// parallax), and it also tests pixels whose ray missed this frame: a background pixel
-// where the object was last frame sends the object's point back to where the object is
-// now, far from here, so no colour is dragged into the background. Where last frame's
-// ray missed but this one hit, only a still pixel keeps its history (a semi-transparent
+// frame must have moved on screen as this pixel's surface did (within `tolerance`
+// pixels). Unlike comparing world positions, this tolerates the stochastic depth and the
+// jittered sample position of the first real collision in semi-transparent media (with a
+// still camera every point's motion is zero; under motion a depth error only changes it
+// by its parallax), and it also tests pixels whose ray missed this frame: a background
+// pixel where the object was last frame compares the object's motion with the
+// background's, so no colour is dragged into the background. Where last frame's ray
+// missed but this one hit, only a still pixel keeps its history (a semi-transparent
 // pixel whose first collision comes and goes), anything moving is a disocclusion.
 Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, float tolerance) {
     Reprojection r;
@@ -49,8 +49,14 @@ Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, flo
         vec4 cur = imageLoad(position_cur, p);
         vec4 prev = texelFetch(position_prev, ivec2(q), 0);
         if (prev.w > 0.0) {
+            // Compare displacements, not places: that point's own motion must carry it
+            // from where it was last frame to where it is now as this pixel's motion
+            // does. The first real collision comes from a jittered sample (the pixel
+            // filter reaches beyond the pixel), so comparing places would reject still
+            // pixels at random; with a deterministic position the two tests agree.
+            vec2 was = to_pixel(frame.prev_view_proj, prev.xyz, size);
             vec2 back = to_pixel(frame.view_proj, prev.xyz, size);
-            r.valid = length(back - (vec2(p) + 0.5)) <= tolerance;
+            r.valid = length(back - was + delta) <= tolerance;
         } else if (cur.w > 0.0) {
             r.valid = length(delta) <= tolerance;
         }

@@ -17,8 +17,23 @@ layout(constant_id = 10) const bool USE_FEATURE = true;
 layout(constant_id = 11) const bool PAPER_PREDICTOR = false;
 // Per-pixel automatic forgetting (beyond the paper): when the a-priori residual stays far
 // above its running noise level for consecutive frames (a light/TF change, not a single
-// spike), the model forgets fast (λ_min) until it has caught up.
+// spike), the model forgets fast (λ_min = 0.1) until it has caught up.
 layout(constant_id = 12) const bool ADAPTIVE_LAMBDA = true;
+// Model selection (beyond the paper; "model no more than a scene needs"): each pixel also
+// keeps the constant model p = [1] and tracks both models' a-priori (out-of-sample)
+// squared errors; the temporal feature is used only where it predicts measurably better
+// (a changing pixel), the constant model where it does not (a static one: fitting three
+// more coefficients to noise costs variance, measured 2x the MSE of p = [1] there).
+layout(constant_id = 13) const bool MODEL_SELECTION = true;
+
+// Weight of the feature model given both models' running a-priori squared errors
+// (x: constant model, y: feature model): 0 until the feature removes a clear share of
+// the constant model's error, 1 once it removes a quarter.
+float feature_share(vec2 errors) {
+    if (!MODEL_SELECTION) return 1.0;
+    if (errors.x <= 0.0 || errors.y <= 0.0) return 0.0;
+    return smoothstep(0.05, 0.25, 1.0 - errors.y / errors.x);
+}
 
 mat4 unpack_p(vec4 a, vec4 b, vec4 c) {
     return mat4(
