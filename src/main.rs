@@ -44,7 +44,7 @@ pub struct SceneArgs {
     pub volume_size: u32,
     /// Position the temporal denoisers reproject with: `features` (opacity-threshold
     /// surface, or the expected first collision through semi-transparent layers; measured
-    /// 1.5–2 dB better for every temporal method) or `first-hit` (the closest first real
+    /// 0.2–0.5 dB better for every temporal method) or `first-hit` (the closest first real
     /// collision among the frame's samples, the paper's choice).
     #[arg(long, default_value = setup::DEFAULT_MOTION, value_parser = setup::parse_motion)]
     pub motion: dvr_engine::denoise::MotionSource,
