@@ -42,13 +42,18 @@ layout(push_constant) uniform WrlsUpdatePush {
     float h;              // weight bandwidth (0.75)
     float delta;          // initial P = delta · I
     float tolerance;      // disocclusion tolerance, relative to camera distance
-    float lambda_min;     // forgetting factor during a detected change
     float change_ratio;   // residual / noise-level ratio that counts as a change
     float outlier_sigmas; // residual weights: k in exp(-r²/(k²·noise level))
     float pad0;
+    float pad1;
 } pc;
 
 const float P_MAX = 1e6;
+
+// P of a model that has seen nothing: δ·I over the predictor's dimensions.
+mat4 initial_p() {
+    return USE_FEATURE ? mat4(pc.delta) : mat4(pc.delta, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+}
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -99,8 +104,7 @@ void main() {
         beta[0] = vec4(0.0);
         beta[1] = vec4(0.0);
         beta[2] = vec4(0.0);
-        P = mat4(pc.delta);
-        if (!USE_FEATURE) P = mat4(pc.delta, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0);
+        P = initial_p();
     }
 
     vec3 feature = PAPER_PREDICTOR ? z : z_hist;
@@ -112,7 +116,9 @@ void main() {
     float r2 = dot(e, e);
     bool fresh = noise_level < 0.0;
     if (fresh) noise_level = r2;
-    bool far = r2 > pc.change_ratio * (noise_level + 1e-6);
+    // The change threshold, fixed before this frame's restart may raise the noise level.
+    float cap = pc.change_ratio * (noise_level + 1e-6);
+    bool far = r2 > cap;
     streak = far ? streak + 1.0 : 0.0;
     float w = 1.0;
     if (WEIGHTED && PAPER_PREDICTOR) {
@@ -129,12 +135,23 @@ void main() {
         // is not an outlier: it is learned at full weight.
         w = max(exp(-r2 / (pc.outlier_sigmas * pc.outlier_sigmas * (noise_level + 1e-6))), 1e-6);
     }
-    float lambda = pc.lambda;
-    // A change is a residual far above the noise level for 2–4 frames in a row: forget
-    // fast while it lasts. A spike is one frame (its weight w handles it); a residual
-    // that stays high longer is the new scene's noise level, adopted as such, so a
-    // noisier state after the change does not keep the model forgetting.
-    if (ADAPTIVE_LAMBDA && streak >= 2.0 && streak <= 4.0) lambda = pc.lambda_min;
+    if (ADAPTIVE_LAMBDA && streak >= 2.0) {
+        // A confirmed change: the residual far above the noise level twice in a row (a
+        // spike is once, and its weight handles it). Start the model over from this
+        // sample, as for a new surface, and take the residual as the noise level until
+        // the new state's own is measured, so a noisier state after the change does not
+        // read as further changes.
+        beta[0] = vec4(0.0);
+        beta[1] = vec4(0.0);
+        beta[2] = vec4(0.0);
+        P = initial_p();
+        x = vec4(1.0, 0.0, 0.0, 0.0);
+        e = I;
+        noise_level = max(noise_level, r2);
+        streak = 0.0;
+    }
+    // Without automatic forgetting, a residual that stays high is adopted as the new
+    // noise level after a few frames.
     if (streak > 4.0) {
         noise_level = r2;
         streak = 0.0;
@@ -147,26 +164,30 @@ void main() {
         // once) and fall slowly (the choice does not flicker on a static pixel).
         vec3 ec = I - constant.rgb;
         float rc2 = dot(ec, ec);
-        float cap = pc.change_ratio * (noise_level + 1e-6);
-        vec2 sq = min(vec2(rc2, r2), vec2(cap));
+        vec2 sq = min(vec2(rc2, r2), vec2(pc.change_ratio * (noise_level + 1e-6)));
         errors.xy = errors.x < 0.0 ? sq : mix(errors.xy, sq, mix(vec2(0.05), vec2(0.3), greaterThan(sq, errors.xy)));
         // The same weighted RLS with p = [1] (P is a scalar), with its own change test:
-        // it cannot follow a change through a feature, so it forgets fast for as long as
-        // its residual stays far above the noise level (from the second such frame on).
+        // it cannot follow a change through a feature, so it starts over when its
+        // residual is far above the noise level twice in a row.
         float streak_c = rc2 > cap ? errors.z + 1.0 : 0.0;
+        float wc = WEIGHTED && streak_c < 2.0
+                 ? max(exp(-rc2 / (pc.outlier_sigmas * pc.outlier_sigmas * (noise_level + 1e-6))), 1e-6)
+                 : 1.0;
+        if (ADAPTIVE_LAMBDA && streak_c >= 2.0) {
+            constant = vec4(0.0, 0.0, 0.0, pc.delta);
+            ec = I;
+            streak_c = 0.0;
+        }
         errors.z = streak_c;
-        float lambda_c = streak_c >= 2.0 ? pc.lambda_min : pc.lambda;
-        float wc = streak_c >= 2.0 || !WEIGHTED ? 1.0
-                 : max(exp(-rc2 / (pc.outlier_sigmas * pc.outlier_sigmas * (noise_level + 1e-6))), 1e-6);
-        float qc = constant.a / (lambda_c / wc + constant.a);
+        float qc = constant.a / (pc.lambda / wc + constant.a);
         constant.rgb += qc * ec;
-        constant.a = clamp((constant.a - qc * constant.a) / lambda_c, 1e-8, P_MAX);
+        constant.a = clamp((constant.a - qc * constant.a) / pc.lambda, 1e-8, P_MAX);
         if (!all_finite(constant.rgb) || isnan(constant.a)) constant = vec4(I, pc.delta);
     }
     vec4 Px = P * x;
-    vec4 q = Px / (lambda / w + dot(x, Px));
+    vec4 q = Px / (pc.lambda / w + dot(x, Px));
     for (int c = 0; c < 3; ++c) beta[c] += q * e[c];
-    P = (P - outerProduct(q, Px)) / lambda;
+    P = (P - outerProduct(q, Px)) / pc.lambda;
     // fp32 hygiene: keep P symmetric with a positive, bounded diagonal (wind-up guard
     // for predictors that stop exciting some direction on long static runs).
     P = 0.5 * (P + transpose(P));

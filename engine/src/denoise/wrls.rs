@@ -25,8 +25,6 @@ pub struct WrlsParams {
     /// Standard errors by which a neighbour's prediction may differ from the pixel's own
     /// and still be blended (ours' spatial weights).
     pub kappa: f32,
-    /// Forgetting factor while a change is detected (adaptive λ only).
-    pub lambda_min: f32,
     /// Squared a-priori residual over its running noise level that counts as a change.
     pub change_ratio: f32,
     /// Residual weights (not the paper's): a sample's weight falls off with its a-priori
@@ -46,7 +44,6 @@ impl Default for WrlsParams {
             sigma_spatial: 2.0,
             sigma_range: 0.5,
             kappa: 2.0,
-            lambda_min: 0.1,
             change_ratio: 9.0,
             outlier_sigmas: 10.0,
         }
@@ -54,13 +51,16 @@ impl Default for WrlsParams {
 }
 
 /// Which variant: the paper's ablation switches (weighting, temporal feature) and our
-/// two changes to it (predictor from the reprojected history, automatic forgetting).
+/// changes to it (predictor from the reprojected history, residual-scaled weights,
+/// automatic forgetting, constant/feature model selection).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct WrlsVariant {
     pub weighted: bool,
     pub feature: bool,
     /// The paper's exact predictor p = [1, z(t)] (z contains this frame's noisy colour).
     pub paper_predictor: bool,
+    /// Automatic forgetting: a model whose residual is far above its noise level twice in
+    /// a row starts over (a light/TF change); without it λ stays 0.998.
     pub adaptive_lambda: bool,
     /// Also keep the constant model p = [1] and use the temporal feature only where it
     /// predicts measurably better (see include/wrls.glsl).
@@ -191,10 +191,10 @@ impl Denoiser for Wrls {
             h: p.h,
             delta: p.delta,
             tolerance: p.tolerance,
-            lambda_min: p.lambda_min,
             change_ratio: p.change_ratio,
             outlier_sigmas: p.outlier_sigmas,
             pad0: 0.0,
+            pad1: 0.0,
         };
         let noisy = input.noisy;
         frame.add_pass(

@@ -88,10 +88,10 @@ pub struct WrlsUpdatePush {
     pub h: f32,
     pub delta: f32,
     pub tolerance: f32,
-    pub lambda_min: f32,
     pub change_ratio: f32,
     pub outlier_sigmas: f32,
     pub pad0: f32,
+    pub pad1: f32,
 }
 
 #[repr(C)]
@@ -275,10 +275,10 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 h,
                 delta,
                 tolerance,
-                lambda_min,
                 change_ratio,
                 outlier_sigmas,
-                pad0
+                pad0,
+                pad1
             }),
         ),
         (

@@ -15,9 +15,9 @@ layout(constant_id = 10) const bool USE_FEATURE = true;
 // static regions converge like a long average. PAPER_PREDICTOR = true restores the
 // paper's exact formulation for comparison (`wrls-paper`).
 layout(constant_id = 11) const bool PAPER_PREDICTOR = false;
-// Per-pixel automatic forgetting (beyond the paper): when the a-priori residual stays far
-// above its running noise level for consecutive frames (a light/TF change, not a single
-// spike), the model forgets fast (λ_min = 0.1) until it has caught up.
+// Per-pixel automatic forgetting (beyond the paper): when the a-priori residual is far
+// above its running noise level twice in a row (a light/TF change, not a single spike),
+// the model starts over from the current sample, like a model on a new surface.
 layout(constant_id = 12) const bool ADAPTIVE_LAMBDA = true;
 // Model selection (beyond the paper; "model no more than a scene needs"): each pixel also
 // keeps the constant model p = [1] and tracks both models' a-priori (out-of-sample)
