@@ -123,3 +123,35 @@ fn ours_follows_a_sudden_change_within_a_few_frames() {
     assert!(ours <= 8, "ours took {ours} frames");
     assert_validation_clean();
 }
+
+/// Mean absolute error of the output's mean over the last 20 frames of a slow ramp
+/// (mean 1 → 3 over 60 frames, after 40 static frames).
+fn ramp_lag(name: &str) -> f32 {
+    let mut h = Harness::new(name, W, H);
+    let n = (W * H) as usize;
+    for f in 0..40u64 {
+        h.step(&noisy_frame(n, 1.0, 0.5, 4000 + f));
+    }
+    let mut err = 0.0;
+    for k in 0..60u64 {
+        let mean = 1.0 + 2.0 * (k + 1) as f32 / 60.0;
+        let out = h.step(&noisy_frame(n, mean, 0.5 * mean, 5000 + k));
+        if k >= 40 {
+            let got = out.iter().map(|p| p[0]).sum::<f32>() / n as f32;
+            err += (got - mean).abs() / 20.0;
+        }
+    }
+    err
+}
+
+/// The temporal feature earns its place where the signal changes gradually (a TF or
+/// light animation): the constant model lags a ramp, the feature model follows it, and
+/// `ours` selects the feature there.
+#[test]
+fn ours_follows_a_slow_ramp_that_the_constant_model_lags() {
+    let ours = ramp_lag("ours");
+    let constant = ramp_lag("wrls-nf");
+    println!("mean error on a ramp: ours {ours:.4}, wrls-nf {constant:.4}");
+    assert!(ours * 2.0 < constant, "ours {ours} vs wrls-nf {constant}");
+    assert_validation_clean();
+}

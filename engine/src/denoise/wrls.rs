@@ -15,6 +15,7 @@ use ash::vk;
 pub struct WrlsParams {
     pub lambda: f32,
     pub alpha: f32,
+    /// Bandwidth of the paper's relative-distance weights (`wrls-paper` only).
     pub h: f32,
     /// Initial P = delta · I for a new model.
     pub delta: f32,
