@@ -12,8 +12,10 @@ use common::*;
 use dvr_engine::denoise::rae::{RaeWeights, NETS};
 use std::path::{Path, PathBuf};
 
-/// Agreement bound between the shaders and torch (HDR units; outputs are ~0..10).
-const TOLERANCE: f32 = 2e-4;
+/// Agreement bound between the shaders and torch, in HDR units (fixture outputs reach
+/// ~1.5). Measured on lavapipe: 1.1e-6 (phantom), 9.5e-7 (mri); the margin allows for
+/// other devices' FMA contraction and exp/log precision.
+const TOLERANCE: f32 = 5e-5;
 
 fn assets() -> PathBuf {
     dvr_engine::transfer::assets_dir().join("rae")
