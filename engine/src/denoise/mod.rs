@@ -4,12 +4,14 @@
 
 mod accum;
 mod passthrough;
+pub mod rae;
 pub mod svgf;
 pub mod taa;
 pub mod wrls;
 
 pub use accum::Accum;
 pub use passthrough::Passthrough;
+pub use rae::{Rae, RaeWeights};
 pub use svgf::Svgf;
 pub use taa::Taa;
 pub use wrls::{Wrls, WrlsVariant};
@@ -172,6 +174,9 @@ pub const NAMES: &[&str] = &[
     "rls",
     "wrls-nf",
     "rls-nf",
+    "rae",
+    "rae-phantom",
+    "rae-mri",
 ];
 
 /// Builds a denoiser by name.
@@ -181,6 +186,13 @@ pub fn create(ctx: &GpuContext, name: &str, motion: MotionSource) -> Result<Box<
         "accum" => Box::new(Accum::new(ctx)?),
         "taa" => Box::new(Taa::new(ctx, motion)?),
         "svgf" => Box::new(Svgf::new(ctx, motion)?),
+        n if rae::NETS.iter().any(|(name, _)| *name == n) => {
+            let net = rae::NETS
+                .iter()
+                .find(|(name, _)| *name == n)
+                .map_or("phantom", |(_, net)| *net);
+            Box::new(Rae::new(ctx, n, RaeWeights::builtin(net)?)?)
+        }
         n if WrlsVariant::from_name(n).is_some() => {
             let variant = WrlsVariant::from_name(n).ok_or_else(|| EngineError::Pass {
                 pass: "denoise".into(),

@@ -121,6 +121,44 @@ pub struct TaaPush {
     pub pad1: f32,
 }
 
+/// rae_conv.comp's push constants (see engine/src/denoise/rae.rs).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct RaeConvPush {
+    pub width: u32,
+    pub height: u32,
+    pub groups_a: u32,
+    pub groups_b: u32,
+    pub a_upsample: u32,
+    pub b_enabled: u32,
+    pub weights_offset: u32,
+    pub bias_offset: u32,
+    pub slope: f32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
+}
+
+/// rae_pool.comp's push constants.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct RaePoolPush {
+    pub width: u32,
+    pub height: u32,
+    pub groups: u32,
+    pub pad0: u32,
+}
+
+/// rae_io.comp's push constants.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct RaeIoPush {
+    pub width: u32,
+    pub height: u32,
+    pub src_width: u32,
+    pub src_height: u32,
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct SvgfTemporalPush {
@@ -310,6 +348,47 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 tolerance,
                 pad0,
                 pad1
+            }),
+        ),
+        (
+            "rae_conv",
+            "push",
+            std::mem::size_of::<RaeConvPush>(),
+            field_offsets!(RaeConvPush {
+                width,
+                height,
+                groups_a,
+                groups_b,
+                a_upsample,
+                b_enabled,
+                weights_offset,
+                bias_offset,
+                slope,
+                pad0,
+                pad1,
+                pad2
+            }),
+        ),
+        (
+            "rae_pool",
+            "push",
+            std::mem::size_of::<RaePoolPush>(),
+            field_offsets!(RaePoolPush {
+                width,
+                height,
+                groups,
+                pad0
+            }),
+        ),
+        (
+            "rae_io",
+            "push",
+            std::mem::size_of::<RaeIoPush>(),
+            field_offsets!(RaeIoPush {
+                width,
+                height,
+                src_width,
+                src_height
             }),
         ),
         (
