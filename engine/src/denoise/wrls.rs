@@ -45,7 +45,7 @@ impl Default for WrlsParams {
             sigma_spatial: 2.0,
             sigma_range: 0.5,
             kappa: 2.0,
-            change_ratio: 9.0,
+            change_ratio: 12.0,
             outlier_sigmas: 10.0,
         }
     }
