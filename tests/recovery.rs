@@ -21,7 +21,7 @@ const REFERENCE_SPP: u32 = 128;
 /// The bound this test asserts. A method that forgets perfectly at the jump and then
 /// averages needs about 0.8 × (frames before the jump) to come within 1 dB of the
 /// jump-free level (10·log10(15/12) ≈ 1 dB). Measured for `ours` (a model restarts once
-/// its residual is far above the noise level twice in a row): tf-jump 11, light-jump 4.
+/// its residual is far above the noise level twice in a row): tf-jump 11, light-jump 5.
 const MAX_RECOVERY_FRAMES: usize = 12;
 
 fn rgb(px: &[[f32; 4]]) -> Rgb32Image {
