@@ -9,7 +9,7 @@ mod common;
 
 use common::harness::Harness;
 use common::*;
-use dvr_engine::denoise::rae::{RaeWeights, NETS};
+use dvr_engine::denoise::rae::{network_for, RaeWeights, NETS};
 use std::path::{Path, PathBuf};
 
 /// Agreement bound between the shaders and torch, in HDR units (fixture outputs reach
@@ -98,7 +98,13 @@ fn shaders_match_torch_on_a_clip() {
 
 #[test]
 fn shipped_weights_load() {
-    for (_, net) in NETS {
+    let picked = [Some("phantom"), Some("mri"), Some("cloud"), None].map(network_for);
+    assert_eq!(picked, ["phantom", "mri", "mri", "mri"]);
+    let named = NETS
+        .iter()
+        .map(|(_, net)| *net)
+        .filter(|net| *net != "auto");
+    for net in named.chain(picked) {
         let w = RaeWeights::builtin(net).unwrap_or_else(|e| panic!("{net}: {e}"));
         assert!(w.levels() >= 2);
         assert!(!w.floats.is_empty());

@@ -111,7 +111,7 @@ impl Harness {
     fn new(name: &str) -> Self {
         let ctx = context();
         let graph = RenderGraph::new(&ctx).expect("graph");
-        let denoiser = denoise::create(&ctx, name, Default::default()).expect("denoiser");
+        let denoiser = denoise::create(&ctx, name, Default::default(), None).expect("denoiser");
         Self {
             ctx,
             graph,

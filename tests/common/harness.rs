@@ -27,7 +27,7 @@ impl Harness {
     pub fn new(name: &str, width: u32, height: u32) -> Self {
         let ctx = super::context();
         let graph = RenderGraph::new(&ctx).expect("graph");
-        let denoiser = denoise::create(&ctx, name, Default::default()).expect("denoiser");
+        let denoiser = denoise::create(&ctx, name, Default::default(), None).expect("denoiser");
         Self {
             ctx,
             graph,

@@ -179,18 +179,24 @@ pub const NAMES: &[&str] = &[
     "rae-mri",
 ];
 
-/// Builds a denoiser by name.
-pub fn create(ctx: &GpuContext, name: &str, motion: MotionSource) -> Result<Box<dyn Denoiser>> {
+/// Builds a denoiser by name. `dataset` is the built-in dataset the scene's volume is, if
+/// any (learned denoisers pick their network by it).
+pub fn create(
+    ctx: &GpuContext,
+    name: &str,
+    motion: MotionSource,
+    dataset: Option<&str>,
+) -> Result<Box<dyn Denoiser>> {
     Ok(match name {
         "none" => Box::new(Passthrough),
         "accum" => Box::new(Accum::new(ctx)?),
         "taa" => Box::new(Taa::new(ctx, motion)?),
         "svgf" => Box::new(Svgf::new(ctx, motion)?),
         n if rae::NETS.iter().any(|(name, _)| *name == n) => {
-            let net = rae::NETS
-                .iter()
-                .find(|(name, _)| *name == n)
-                .map_or("phantom", |(_, net)| *net);
+            let net = match rae::NETS.iter().find(|(name, _)| *name == n) {
+                Some((_, "auto")) | None => rae::network_for(dataset),
+                Some((_, net)) => *net,
+            };
             Box::new(Rae::new(ctx, n, RaeWeights::builtin(net)?)?)
         }
         n if WrlsVariant::from_name(n).is_some() => {

@@ -58,6 +58,9 @@ pub struct RenderSettings {
     pub seed: u32,
     /// What the temporal denoisers reproject with.
     pub motion_source: denoise::MotionSource,
+    /// The built-in dataset the volume is, if it is one (`rae` runs the network trained
+    /// on it).
+    pub dataset: Option<&'static str>,
 }
 
 impl Default for RenderSettings {
@@ -78,6 +81,7 @@ impl Default for RenderSettings {
             density_scale: 100.0,
             seed: 1,
             motion_source: denoise::MotionSource::FirstHit,
+            dataset: None,
         }
     }
 }
@@ -235,7 +239,7 @@ impl Renderer {
         };
         let denoisers = denoisers
             .iter()
-            .map(|n| denoise::create(&ctx, n, settings.motion_source))
+            .map(|n| denoise::create(&ctx, n, settings.motion_source, settings.dataset))
             .collect::<Result<Vec<_>>>()?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
@@ -320,7 +324,14 @@ impl Renderer {
         let done = self.flush()?;
         let new = names
             .iter()
-            .map(|n| denoise::create(&self.ctx, n, self.settings.motion_source))
+            .map(|n| {
+                denoise::create(
+                    &self.ctx,
+                    n,
+                    self.settings.motion_source,
+                    self.settings.dataset,
+                )
+            })
             .collect::<Result<Vec<_>>>()?;
         for d in &mut self.denoisers {
             d.destroy(&self.ctx);

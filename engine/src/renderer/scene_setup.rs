@@ -170,6 +170,10 @@ pub fn render_settings(scene: &Scene, size: Extent, spp: u32) -> RenderSettings 
         hg_g: r.hg_g as f32,
         step_voxels: r.step_size as f32,
         density_scale: scene.volume.density_scale as f32,
+        dataset: match &scene.volume.source {
+            VolumeSource::Builtin { dataset, .. } => Some(dataset.name()),
+            VolumeSource::File { .. } => None,
+        },
         ..Default::default()
     }
 }
