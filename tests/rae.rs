@@ -68,7 +68,6 @@ fn shaders_match_torch_on_a_clip() {
             .find(|(_, n)| *n == net)
             .map(|(d, _)| *d)
             .unwrap();
-        let name = if name == "rae" { "rae-phantom" } else { name };
         let mut h = Harness::new(name, f.width, f.height);
         let mut worst = 0.0f32;
         let mut peak = 0.0f32;
