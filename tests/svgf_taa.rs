@@ -239,14 +239,7 @@ impl Harness {
                 MemoryLocation::GpuToCpu,
             )
             .expect("buffer");
-        f.add_pass(
-            "readback",
-            |b| {
-                b.transfer_src(out).transfer_dst(rb);
-            },
-            move |pc| pc.copy_image_to_buffer(out, rb),
-        );
-        f.add_host_read("host_read", rb);
+        f.add_readback("output", out, rb);
         let graph = &mut self.graph;
         let ctx = &self.ctx;
         ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))

@@ -125,14 +125,7 @@ pub fn read_image(
         )
         .expect("readback buffer");
     let mut f = dvr_engine::graph::Frame::new();
-    f.add_pass(
-        "readback",
-        |b| {
-            b.transfer_src(image).transfer_dst(buf);
-        },
-        move |pc| pc.copy_image_to_buffer(image, buf),
-    );
-    f.add_host_read("host_read", buf);
+    f.add_readback("test", image, buf);
     ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
         .expect("submit");
     bytemuck::cast_slice::<u8, [f32; 4]>(graph.buffer_ref(buf).mapped().expect("mapped")).to_vec()

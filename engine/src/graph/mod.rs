@@ -106,6 +106,19 @@ impl<'f> Frame<'f> {
         });
     }
 
+    /// Copies `image` into the host-visible `buffer` and makes it readable by the host:
+    /// passes `readback_<label>` (the copy) and `host_read_<label>`.
+    pub fn add_readback(&mut self, label: &str, image: ImageHandle, buffer: BufferHandle) {
+        self.add_pass(
+            format!("readback_{label}"),
+            |b| {
+                b.transfer_src(image).transfer_dst(buffer);
+            },
+            move |pc| pc.copy_image_to_buffer(image, buffer),
+        );
+        self.add_host_read(format!("host_read_{label}"), buffer);
+    }
+
     /// A pass with accesses but no commands: makes a readback visible to the host.
     pub fn add_host_read(&mut self, name: impl Into<String>, buffer: BufferHandle) {
         self.passes.push(Pass {

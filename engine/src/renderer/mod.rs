@@ -697,15 +697,7 @@ fn add_readbacks<'f>(
             bytes,
             MemoryLocation::GpuToCpu,
         )?;
-        let image = *image;
-        frame.add_pass(
-            format!("readback_{name}"),
-            |b| {
-                b.transfer_src(image).transfer_dst(buffer);
-            },
-            move |pc| pc.copy_image_to_buffer(image, buffer),
-        );
-        frame.add_host_read(format!("host_read_{name}"), buffer);
+        frame.add_readback(name, *image, buffer);
         out.push((name.clone(), buffer));
     }
     Ok(out)

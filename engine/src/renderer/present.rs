@@ -134,14 +134,7 @@ pub(crate) fn add_present_passes<'f>(
             bytes,
             MemoryLocation::GpuToCpu,
         )?;
-        frame.add_pass(
-            "readback_present",
-            |b| {
-                b.transfer_src(swapchain_image).transfer_dst(buffer);
-            },
-            move |pc| pc.copy_image_to_buffer(swapchain_image, buffer),
-        );
-        frame.add_host_read("host_read_present", buffer);
+        frame.add_readback("present", swapchain_image, buffer);
         Some(PendingScreenshot {
             buffer,
             width: extent.width,
