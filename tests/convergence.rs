@@ -7,31 +7,15 @@ mod common;
 
 use common::*;
 use dvr_engine::renderer::scene_gpu::{LutUpload, VolumeUpload};
-use dvr_engine::renderer::{RenderSettings, Renderer};
+use dvr_engine::renderer::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
 use dvr_engine::transfer::TransferFunction;
 use dvr_engine::volume::Volume;
 use glam::Vec3;
 
-fn mse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (0..3).map(|c| ((x[c] - y[c]) as f64).powi(2)).sum::<f64>())
-        .sum::<f64>()
-        / (3 * a.len()) as f64
-}
-
-fn phantom_renderer(seed: u32) -> (Renderer, dvr_engine::renderer::FrameInputs) {
-    let volume = VolumeUpload::from_volume(&Volume::builtin("phantom", 32).expect("phantom"));
+/// The phantom seen from above the front, an opaque TF, a point light and a dim sky.
+fn phantom_view() -> FrameInputs {
     let tf = TransferFunction::preset("phantom-opaque").expect("preset");
-    let settings = RenderSettings {
-        seed,
-        density_scale: 150.0,
-        max_bounces: 4,
-        ..settings(16, 1)
-    };
-    let r =
-        Renderer::new(context(), settings, &volume, None, &["none"], LUT as u32).expect("renderer");
-    let camera = dvr_engine::renderer::CameraMatrices::look_at(
+    let camera = CameraMatrices::look_at(
         Vec3::new(0.4, 1.5, 0.4),
         Vec3::ZERO,
         Vec3::Z,
@@ -42,7 +26,20 @@ fn phantom_renderer(seed: u32) -> (Renderer, dvr_engine::renderer::FrameInputs) 
         point_light(Vec3::new(-0.9, 1.1, 1.0), 20.0),
         environment(0.25),
     ];
-    (r, inputs(camera, lights, LutUpload::from(&tf.lut())))
+    inputs(camera, lights, LutUpload::from(&tf.lut()))
+}
+
+fn phantom_renderer(seed: u32) -> (Renderer, FrameInputs) {
+    let volume = VolumeUpload::from_volume(&Volume::builtin("phantom", 32).expect("phantom"));
+    let settings = RenderSettings {
+        seed,
+        density_scale: 150.0,
+        max_bounces: 4,
+        ..settings(16, 1)
+    };
+    let r =
+        Renderer::new(context(), settings, &volume, None, &["none"], LUT as u32).expect("renderer");
+    (r, phantom_view())
 }
 
 #[test]
@@ -91,7 +88,6 @@ fn majorant_grid_matches_a_global_majorant_on_odd_sized_volumes() {
                 max: vec![1.0],
             };
         }
-        let tf = TransferFunction::preset("phantom-opaque").expect("preset");
         let s = RenderSettings {
             density_scale: 150.0,
             max_bounces: 2,
@@ -99,19 +95,7 @@ fn majorant_grid_matches_a_global_majorant_on_odd_sized_volumes() {
         };
         let mut r =
             Renderer::new(context(), s, &volume, None, &["none"], LUT as u32).expect("renderer");
-        let camera = dvr_engine::renderer::CameraMatrices::look_at(
-            Vec3::new(0.4, 1.5, 0.4),
-            Vec3::ZERO,
-            Vec3::Z,
-            40f32.to_radians(),
-            1.0,
-        );
-        let lights = vec![
-            point_light(Vec3::new(-0.9, 1.1, 1.0), 20.0),
-            environment(0.25),
-        ];
-        r.reference(&inputs(camera, lights, LutUpload::from(&tf.lut())), 512, 4)
-            .expect("render")
+        r.reference(&phantom_view(), 512, 4).expect("render")
     };
     let (grid, global) = (render(false), render(true));
     let (mg, mo) = (mean_rgb(&grid)[0], mean_rgb(&global)[0]);

@@ -55,14 +55,6 @@ fn every_denoiser_stays_finite_and_bounded_on_every_built_in_animation() {
     assert_validation_clean();
 }
 
-fn mse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (0..3).map(|c| ((x[c] - y[c]) as f64).powi(2)).sum::<f64>())
-        .sum::<f64>()
-        / (3 * a.len()) as f64
-}
-
 /// On a static view, 64 frames of `ours` at 2 spp end closer to the 1024-spp reference
 /// than a 32-spp render without denoising (issue 4's requirement), with both motion
 /// sources. This test found two real faults: motion vectors measured from the pixel

@@ -99,6 +99,15 @@ pub fn inputs(camera: CameraMatrices, lights: Vec<GpuLight>, lut: LutUpload) -> 
     }
 }
 
+/// Mean squared error over the colour channels of two rgba images.
+pub fn mse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (0..3).map(|c| ((x[c] - y[c]) as f64).powi(2)).sum::<f64>())
+        .sum::<f64>()
+        / (3 * a.len()) as f64
+}
+
 pub fn mean_rgb(pixels: &[[f32; 4]]) -> [f64; 3] {
     let mut s = [0.0f64; 3];
     for p in pixels {
