@@ -171,6 +171,22 @@ struct Gfx {
     ctx: Arc<GpuContext>,
 }
 
+impl Gfx {
+    /// Rebuilds the swapchain at the window's size (resized, out of date or
+    /// suboptimal); the UI renderer follows its format.
+    fn recreate_swapchain(&mut self, size: winit::dpi::PhysicalSize<u32>) -> Result<()> {
+        let extent = vk::Extent2D {
+            width: size.width,
+            height: size.height,
+        };
+        self.swapchain.recreate(&self.ctx, extent)?;
+        if let Some(o) = self.overlay.as_mut() {
+            o.set_format(self.swapchain.format)?;
+        }
+        Ok(())
+    }
+}
+
 impl Drop for Gfx {
     fn drop(&mut self) {
         let _ = self.ctx.wait_idle();
@@ -497,17 +513,7 @@ impl Explorer {
         if let Some(gfx) = self.gfx.as_mut() {
             let e = gfx.swapchain.extent;
             if self.resized || (e.width, e.height) != (size.width, size.height) {
-                let ctx = Arc::clone(&gfx.ctx);
-                gfx.swapchain.recreate(
-                    &ctx,
-                    vk::Extent2D {
-                        width: size.width,
-                        height: size.height,
-                    },
-                )?;
-                if let Some(o) = gfx.overlay.as_mut() {
-                    o.set_format(gfx.swapchain.format)?;
-                }
+                gfx.recreate_swapchain(size)?;
                 self.resized = false;
             }
         }
@@ -586,14 +592,7 @@ impl Explorer {
         }
         self.ui.stats.render_size = (vw, vh);
         let Some(image) = gfx.swapchain.acquire()? else {
-            let ctx = Arc::clone(&gfx.ctx);
-            gfx.swapchain.recreate(
-                &ctx,
-                vk::Extent2D {
-                    width: size.width,
-                    height: size.height,
-                },
-            )?;
+            gfx.recreate_swapchain(size)?;
             return Ok(());
         };
         let bg = ui::PANEL_FILL.to_normalized_gamma_f32();

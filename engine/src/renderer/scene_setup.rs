@@ -75,14 +75,7 @@ impl SceneSetup {
     }
 
     pub fn renderer(&self, ctx: GpuContext, denoisers: &[&str]) -> EngineResult<Renderer> {
-        Renderer::new(
-            ctx,
-            self.settings.clone(),
-            &self.volume,
-            self.environment.as_ref(),
-            denoisers,
-            LUT_SIZE as u32,
-        )
+        self.renderer_shared(Arc::new(ctx), denoisers)
     }
 
     /// A renderer on a context the caller keeps a handle to (the explorer's, which
