@@ -50,13 +50,12 @@ void main() {
     ivec2 size = ivec2(pc.width, pc.height);
     if (p.x >= size.x || p.y >= size.y) return;
     vec3 zi = imageLoad(z, p).rgb;
-    vec3 own = vec3(dot(predictor(zi), imageLoad(beta_r, p)), dot(predictor(zi), imageLoad(beta_g, p)),
-                    dot(predictor(zi), imageLoad(beta_b, p)));
+    vec4 xi = predictor(zi);
+    vec3 own = vec3(dot(xi, imageLoad(beta_r, p)), dot(xi, imageLoad(beta_g, p)), dot(xi, imageLoad(beta_b, p)));
     float var_i = prediction_variance(p, imageLoad(p0, p).x);
     vec4 ci = imageLoad(constant, p);
     float var_ci = prediction_variance(p, ci.a);
     float share = feature_share(imageLoad(errors, p).xy);
-    vec4 xi = predictor(zi);
     float norm_i = dot(zi, zi) + 1e-4;
     vec3 sum = vec3(0.0);
     float wsum = 0.0;

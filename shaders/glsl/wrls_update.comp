@@ -135,7 +135,7 @@ void main() {
         // is not an outlier: it is learned at full weight.
         w = max(exp(-r2 / (pc.outlier_sigmas * pc.outlier_sigmas * (noise_level + 1e-6))), 1e-6);
     }
-    if (ADAPTIVE_LAMBDA && streak >= 2.0) {
+    if (RESTART_ON_CHANGE && streak >= 2.0) {
         // A confirmed change: the residual far above the noise level twice in a row (a
         // spike is once, and its weight handles it). Start the model over from this
         // sample, as for a new surface, and take the residual as the noise level until
@@ -173,7 +173,7 @@ void main() {
         float wc = WEIGHTED && streak_c < 2.0
                  ? max(exp(-rc2 / (pc.outlier_sigmas * pc.outlier_sigmas * (noise_level + 1e-6))), 1e-6)
                  : 1.0;
-        if (ADAPTIVE_LAMBDA && streak_c >= 2.0) {
+        if (RESTART_ON_CHANGE && streak_c >= 2.0) {
             constant = vec4(0.0, 0.0, 0.0, pc.delta);
             ec = I;
             streak_c = 0.0;
@@ -214,6 +214,8 @@ void main() {
     imageStore(p0_cur, p, a);
     imageStore(p1_cur, p, b);
     imageStore(p2_cur, p, c);
-    imageStore(constant_cur, p, constant);
-    imageStore(errors_cur, p, vec4(errors, 0.0));
+    if (MODEL_SELECTION) {
+        imageStore(constant_cur, p, constant);
+        imageStore(errors_cur, p, vec4(errors, 0.0));
+    }
 }

@@ -62,7 +62,7 @@ pub struct WrlsVariant {
     pub paper_predictor: bool,
     /// Automatic forgetting: a model whose residual is far above its noise level twice in
     /// a row starts over (a light/TF change); without it λ stays 0.998.
-    pub adaptive_lambda: bool,
+    pub restart_on_change: bool,
     /// Also keep the constant model p = [1] and use the temporal feature only where it
     /// predicts measurably better (see include/wrls.glsl).
     pub model_selection: bool,
@@ -74,18 +74,18 @@ impl WrlsVariant {
             weighted: true,
             feature: true,
             paper_predictor: false,
-            adaptive_lambda: true,
+            restart_on_change: true,
             model_selection: true,
         };
         Some(match name {
             "ours" => ours,
             "ours-fixed-lambda" => Self {
-                adaptive_lambda: false,
+                restart_on_change: false,
                 ..ours
             },
             "wrls-paper" => Self {
                 paper_predictor: true,
-                adaptive_lambda: false,
+                restart_on_change: false,
                 model_selection: false,
                 ..ours
             },
@@ -132,7 +132,10 @@ impl Wrls {
             ("USE_FEATURE", SpecValue::Bool(variant.feature)),
             ("MOTION_SOURCE", SpecValue::I32(motion.spec())),
             ("PAPER_PREDICTOR", SpecValue::Bool(variant.paper_predictor)),
-            ("ADAPTIVE_LAMBDA", SpecValue::Bool(variant.adaptive_lambda)),
+            (
+                "RESTART_ON_CHANGE",
+                SpecValue::Bool(variant.restart_on_change),
+            ),
             ("MODEL_SELECTION", SpecValue::Bool(variant.model_selection)),
         ];
         Ok(Self {

@@ -18,7 +18,7 @@ layout(constant_id = 11) const bool PAPER_PREDICTOR = false;
 // Per-pixel automatic forgetting (beyond the paper): when the a-priori residual is far
 // above its running noise level twice in a row (a light/TF change, not a single spike),
 // the model starts over from the current sample, like a model on a new surface.
-layout(constant_id = 12) const bool ADAPTIVE_LAMBDA = true;
+layout(constant_id = 12) const bool RESTART_ON_CHANGE = true;
 // Model selection (beyond the paper; "model no more than a scene needs"): each pixel also
 // keeps the constant model p = [1] and tracks both models' a-priori (out-of-sample)
 // squared errors; the temporal feature is used only where it predicts measurably better
