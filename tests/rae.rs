@@ -9,13 +9,17 @@ mod common;
 
 use common::harness::Harness;
 use common::*;
-use dvr_engine::denoise::rae::{network_for, RaeWeights, NETS};
+use dvr_engine::denoise::rae::{network_for, resolve, Precision, RaeWeights, NETS};
 use std::path::{Path, PathBuf};
 
 /// Agreement bound between the shaders and torch, in HDR units (fixture outputs reach
 /// ~1.5). Measured on lavapipe: 1.1e-6 (phantom), 9.5e-7 (mri); the margin allows for
 /// other devices' FMA contraction and exp/log precision.
 const TOLERANCE: f32 = 5e-5;
+/// The same for fp16 tensors, relative to the clip's largest output (at least 1).
+/// Measured on lavapipe (which converts to fp16 toward zero): see
+/// fp16_tensors_stay_close_to_torch's output and README.md.
+const F16_TOLERANCE: f32 = 1e-2;
 
 fn assets() -> PathBuf {
     dvr_engine::transfer::assets_dir().join("rae")
@@ -53,45 +57,63 @@ fn fixture(net: &str) -> Fixture {
     }
 }
 
+/// Runs fixture `net` through denoiser `name` on the device; returns the largest
+/// difference from torch over the clip and the largest expected output.
+fn difference_from_torch(name: &str, net: &str) -> (f32, f32) {
+    let f = fixture(net);
+    let mut h = Harness::new(name, f.width, f.height);
+    let mut worst = 0.0f32;
+    let mut peak = 0.0f32;
+    for (t, (input, expected)) in f.input.iter().zip(&f.expected).enumerate() {
+        let out = h.step(input);
+        let diff = out
+            .iter()
+            .zip(expected)
+            .flat_map(|(o, e)| (0..3).map(move |c| (o[c] - e[c]).abs()))
+            .fold(0.0f32, f32::max);
+        peak = expected
+            .iter()
+            .flat_map(|e| e[..3].to_vec())
+            .fold(peak, f32::max);
+        println!("{name} on {net} frame {t}: max |shader - torch| = {diff:.3e}");
+        worst = worst.max(diff);
+    }
+    println!(
+        "{name} on {net}: max abs difference {worst:.3e} over 3 frames (outputs up to {peak:.3})"
+    );
+    assert!(peak > 0.0, "{net}: the fixture's output is all zero");
+    (worst, peak)
+}
+
 #[test]
 fn shaders_match_torch_on_a_clip() {
     for net in ["phantom", "mri"] {
-        let path =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/rae/{net}.bin"));
-        if !path.exists() {
-            assert_ne!(net, "phantom", "the phantom fixture must exist");
-            continue;
-        }
-        let f = fixture(net);
         let name = NETS
             .iter()
-            .find(|(_, n)| *n == net)
-            .map(|(d, _)| *d)
+            .find(|(_, n, p)| *n == net && *p == Precision::F32)
+            .map(|(d, ..)| *d)
             .unwrap();
-        let mut h = Harness::new(name, f.width, f.height);
-        let mut worst = 0.0f32;
-        let mut peak = 0.0f32;
-        for (t, (input, expected)) in f.input.iter().zip(&f.expected).enumerate() {
-            let out = h.step(input);
-            let diff = out
-                .iter()
-                .zip(expected)
-                .flat_map(|(o, e)| (0..3).map(move |c| (o[c] - e[c]).abs()))
-                .fold(0.0f32, f32::max);
-            peak = expected
-                .iter()
-                .flat_map(|e| e[..3].to_vec())
-                .fold(peak, f32::max);
-            println!("{net} frame {t}: max |shader - torch| = {diff:.3e}");
-            worst = worst.max(diff);
-        }
-        println!("{net}: max abs difference {worst:.3e} over 3 frames (outputs up to {peak:.3})");
+        let (worst, _) = difference_from_torch(name, net);
         assert!(
             worst < TOLERANCE,
             "{net}: shaders differ from torch by {worst}"
         );
-        assert!(peak > 0.0, "{net}: the fixture's output is all zero");
     }
+    assert_validation_clean();
+}
+
+/// fp16 tensors (`rae-fp16`, the mri network without a dataset) against torch's fp32:
+/// each of the 16 layers' outputs and the recurrent state are rounded to half precision.
+#[test]
+fn fp16_tensors_stay_close_to_torch() {
+    assert_eq!(resolve("rae-fp16", None), Some(("mri", Precision::F16)));
+    let (worst, peak) = difference_from_torch("rae-fp16", "mri");
+    assert!(
+        worst < F16_TOLERANCE * peak.max(1.0),
+        "rae-fp16: differs from torch's fp32 by {worst} (outputs up to {peak})"
+    );
+    // It is really half precision: fp32 agreement would be ~1e-6.
+    assert!(worst > TOLERANCE, "rae-fp16 matches fp32 to {worst}");
     assert_validation_clean();
 }
 
@@ -101,7 +123,7 @@ fn shipped_weights_load() {
     assert_eq!(picked, ["phantom", "mri", "mri", "mri"]);
     let named = NETS
         .iter()
-        .map(|(_, net)| *net)
+        .map(|(_, net, _)| *net)
         .filter(|net| *net != "auto");
     for net in named.chain(picked) {
         let w = RaeWeights::builtin(net).unwrap_or_else(|e| panic!("{net}: {e}"));

@@ -8,7 +8,11 @@ then regenerates the agreement fixture tests/fixtures/rae/<net>.bin.
 Loss (Chaitanya et al. 2017), in the network's log1p space, per frame t of a clip with
 weights rising towards the clip's end: 0.8 L1(y, r) + 0.1 L1(LoG*y, LoG*r)
 + 0.1 L1(y_t - y_{t-1}, r_t - r_{t-1}).
-Augmentation: random 48x48 crops, flips, 90-degree rotations, time reversal.
+Augmentation: random square crops (--crop), flips, 90-degree rotations, time reversal.
+
+--init assets/rae/<net>.json starts from a shipped network instead of random weights
+(fine-tuning: a network pre-trained on a larger, cheaper data set, then trained on the
+scarce full-specification clips); the manifest records where it started from.
 """
 import argparse
 import json
@@ -95,6 +99,7 @@ def main():
     ap.add_argument("--val-clips", type=int, default=4)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--init", default=None, help="manifest of a network to start from (fine-tuning)")
     a = ap.parse_args()
     net = a.net or a.dataset
     torch.set_num_threads(a.threads)
@@ -110,7 +115,15 @@ def main():
     va_n, va_r = noisy[n - nv :], ref[n - nv :]
     print(f"{a.dataset}: {n - nv} training clips, {nv} validation clips, {tuple(noisy.shape[1:])}", flush=True)
 
-    model = rae.Rae([int(w) for w in a.widths.split(",")])
+    init = None
+    if a.init:
+        model, m0 = rae.load(a.init)
+        init = {"manifest": os.path.relpath(os.path.abspath(a.init), ROOT),
+                "training_data": m0.get("training_data"), "training": m0.get("training"),
+                "initialised_from": m0.get("initialised_from")}
+        a.widths = ",".join(str(w) for w in model.widths)
+    else:
+        model = rae.Rae([int(w) for w in a.widths.split(",")])
     opt = torch.optim.Adam(model.parameters(), lr=a.lr)
     budget = a.minutes * 60
     t0 = time.time()
@@ -163,20 +176,20 @@ def main():
         "name": net,
         "trained": True,
         "dataset": a.dataset,
-        "training_data": {"file": f"out/rae-data/{a.dataset}.npz", "sha256_16": str(d["hash"]),
+        "training_data": {"file": os.path.relpath(os.path.join(os.path.abspath(a.data), f"{a.dataset}.npz"), ROOT), "sha256_16": str(d["hash"]),
                           "settings": str(d["settings"]), "clips_train": int(n - nv), "clips_validation": int(nv)},
         "training": {"seconds": round(train_s, 1), "iterations": it, "batch": a.batch, "crop": a.crop,
                      "optimizer": f"Adam lr {a.lr} cosine to 0", "threads": a.threads, "seed": a.seed,
                      "loss": "0.8 L1 + 0.1 L1(LoG 7x7 sigma 1) + 0.1 L1(temporal difference), log1p space, "
                              "frame weights " + str(FRAME_WEIGHTS.tolist()),
-                     "augmentation": "48x48 crops, flips, rot90, time reversal",
+                     "augmentation": f"{a.crop}x{a.crop} crops, flips, rot90, time reversal",
                      "final_validation_loss": round(vl, 5),
                      "final_validation_parts_l1_log_temporal": [round(p, 5) for p in parts],
                      "validation_l1_of_noisy_input": round(base, 5)},
+        "initialised_from": init,
         "validation_curve": curve,
-        "deviations": "64x64 clips with 256-spp references instead of 128x128 with 1024 spp (lavapipe time); "
-                      "one recurrent conv per encoder level and one conv per decoder level; widths "
-                      + a.widths,
+        "deviations": "one recurrent conv per encoder level and one conv per decoder level; widths " + a.widths
+                      + " (sized for CPU training and lavapipe inference)",
     }
     out = os.path.join(ROOT, "assets", "rae")
     rae.save(model, os.path.join(out, f"{net}.bin"), os.path.join(out, f"{net}.json"), extra)

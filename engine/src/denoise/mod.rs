@@ -177,6 +177,7 @@ pub const NAMES: &[&str] = &[
     "rae",
     "rae-phantom",
     "rae-mri",
+    "rae-fp16",
 ];
 
 /// Builds a denoiser by name. `dataset` is the built-in dataset the scene's volume is, if
@@ -192,12 +193,12 @@ pub fn create(
         "accum" => Box::new(Accum::new(ctx)?),
         "taa" => Box::new(Taa::new(ctx, motion)?),
         "svgf" => Box::new(Svgf::new(ctx, motion)?),
-        n if rae::NETS.iter().any(|(name, _)| *name == n) => {
-            let net = match rae::NETS.iter().find(|(name, _)| *name == n) {
-                Some((_, "auto")) | None => rae::network_for(dataset),
-                Some((_, net)) => *net,
-            };
-            Box::new(Rae::new(ctx, n, RaeWeights::builtin(net)?)?)
+        n if rae::resolve(n, dataset).is_some() => {
+            let (net, precision) = rae::resolve(n, dataset).ok_or_else(|| EngineError::Pass {
+                pass: "denoise".into(),
+                problem: format!("unknown RAE variant {n:?}"),
+            })?;
+            Box::new(Rae::new(ctx, n, RaeWeights::builtin(net)?, precision)?)
         }
         n if WrlsVariant::from_name(n).is_some() => {
             let variant = WrlsVariant::from_name(n).ok_or_else(|| EngineError::Pass {

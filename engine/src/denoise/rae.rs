@@ -4,7 +4,7 @@
 //! compute passes. The network is defined once in `tools/rae/model.py`; this file and
 //! shaders/glsl/rae_*.comp are its mirror:
 //!
-//! - `rae.input` (rae_io.comp, MODE 0): log(1 + max(rgb, 0)) into the input tensor,
+//! - `rae.input` (rae_input.comp): log(1 + max(rgb, 0)) into the input tensor,
 //!   replicate-padded to a multiple of 2^levels (any frame size works);
 //! - per encoder level l: `enc{l}.feat` = lrelu(conv3×3(x_l)), `enc{l}.rec` =
 //!   lrelu(conv3×3([a_l, h_l of the previous frame])) — the recurrent state, a graph
@@ -13,14 +13,16 @@
 //! - `bottleneck` = lrelu(conv3×3(x_L));
 //! - per decoder level l (coarse to fine): `dec{l}` = lrelu(conv3×3([up2(d_{l+1}), h_l])),
 //!   the nearest upsampling and the concatenation fused into the convolution's fetch;
-//! - `out` = conv3×3(d_0) (linear) and `rae.output` (rae_io.comp, MODE 1):
+//! - `out` = conv3×3(d_0) (linear) and `rae.output` (rae_output.comp):
 //!   exp(max(y, 0)) − 1, cropped to the frame.
 //!
-//! Tensors are rgba32f images with four channels per texel, channel group g of pixel
-//! (x, y) at texel (g·width + x, y) (so the widest tensor is width × channels/4 texels
-//! wide, within the 4096-texel minimum of Vulkan's image-size limit for frames up to
-//! 1024 wide at 16 channels). Everything is fp32, so the shaders match torch to about
-//! 1e-5 (tests/rae.rs). Weights and their manifest are `assets/rae/<net>.{json,bin}`
+//! Tensors are images with four channels per texel, channel group g of pixel (x, y) at
+//! texel (g·width + x, y) (so the widest tensor is width × channels/4 texels wide,
+//! within the 4096-texel minimum of Vulkan's image-size limit for frames up to 1024 wide
+//! at 16 channels). They are rgba32f ([`Precision::F32`]: the shaders match torch to
+//! about 1e-6) or rgba16f ([`Precision::F16`], the `*_f16` shader variants: half the
+//! memory traffic, arithmetic still fp32; tests/rae.rs bounds its difference from
+//! torch's fp32). Weights and their manifest are `assets/rae/<net>.{json,bin}`
 //! (read at creation through `$DVR_ASSETS` like the TF presets); a missing, truncated or
 //! inconsistent file is an error naming the file. Like the paper's network, the
 //! recurrent state is never reset on camera, light or TF changes: the network was
@@ -28,7 +30,7 @@
 
 use super::{DenoiseInputs, Denoiser};
 use crate::error::{EngineError, Result};
-use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
+use crate::gpu::{ComputePipeline, GpuContext, ImageDesc};
 use crate::graph::{Bind, BufferHandle, Frame, ImageHandle, RenderGraph};
 use crate::renderer::uniforms::{RaeConvPush, RaeIoPush, RaePoolPush};
 use ash::vk;
@@ -41,13 +43,52 @@ pub const IN_CHANNELS: u32 = 3;
 /// The manifest format this engine reads.
 pub const FORMAT: &str = "dvr-rae-1";
 
-/// Denoiser names and the shipped network each runs; `rae` picks by dataset
-/// ([`network_for`]).
-pub const NETS: &[(&str, &str)] = &[
-    ("rae", "auto"),
-    ("rae-phantom", "phantom"),
-    ("rae-mri", "mri"),
+/// Storage precision of the tensors (weights and arithmetic are fp32 in both).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    F32,
+    F16,
+}
+
+impl Precision {
+    fn format(self) -> vk::Format {
+        match self {
+            Precision::F32 => vk::Format::R32G32B32A32_SFLOAT,
+            Precision::F16 => vk::Format::R16G16B16A16_SFLOAT,
+        }
+    }
+
+    /// The shader variant: `rae_conv` or `rae_conv_f16`.
+    fn shader(self, stem: &str) -> String {
+        match self {
+            Precision::F32 => stem.to_string(),
+            Precision::F16 => format!("{stem}_f16"),
+        }
+    }
+}
+
+/// Denoiser names, the shipped network each runs (`auto`: by dataset, [`network_for`])
+/// and the tensors' precision.
+pub const NETS: &[(&str, &str, Precision)] = &[
+    ("rae", "auto", Precision::F32),
+    ("rae-phantom", "phantom", Precision::F32),
+    ("rae-mri", "mri", Precision::F32),
+    ("rae-fp16", "auto", Precision::F16),
 ];
+
+/// The network and precision denoiser `name` runs on a scene of built-in `dataset`, or
+/// None if `name` is not a RAE.
+pub fn resolve(name: &str, dataset: Option<&str>) -> Option<(&'static str, Precision)> {
+    let (_, net, precision) = NETS.iter().find(|(n, ..)| *n == name)?;
+    Some((
+        if *net == "auto" {
+            network_for(dataset)
+        } else {
+            net
+        },
+        *precision,
+    ))
+}
 
 /// The network `rae` runs: the one trained on the scene's built-in dataset, else the mri
 /// network, which generalised best to the never-trained cloud (suite eval, 1024-spp
@@ -248,6 +289,7 @@ impl RaeWeights {
 pub struct Rae {
     name: String,
     pub weights: RaeWeights,
+    precision: Precision,
     conv: ComputePipeline,
     pool: ComputePipeline,
     input: ComputePipeline,
@@ -258,14 +300,21 @@ pub struct Rae {
 
 impl Rae {
     /// `name` prefixes this instance's graph resources and passes.
-    pub fn new(ctx: &GpuContext, name: &str, weights: RaeWeights) -> Result<Self> {
+    pub fn new(
+        ctx: &GpuContext,
+        name: &str,
+        weights: RaeWeights,
+        precision: Precision,
+    ) -> Result<Self> {
+        let pipeline = |stem: &str| ComputePipeline::new(ctx, &precision.shader(stem), &[]);
         Ok(Self {
             name: name.to_string(),
             weights,
-            conv: ComputePipeline::new(ctx, "rae_conv", &[])?,
-            pool: ComputePipeline::new(ctx, "rae_pool", &[])?,
-            input: ComputePipeline::new(ctx, "rae_io", &[("MODE", SpecValue::I32(0))])?,
-            output: ComputePipeline::new(ctx, "rae_io", &[("MODE", SpecValue::I32(1))])?,
+            precision,
+            conv: pipeline("rae_conv")?,
+            pool: pipeline("rae_pool")?,
+            input: pipeline("rae_input")?,
+            output: pipeline("rae_output")?,
             uploaded: Cell::new(None),
         })
     }
@@ -276,8 +325,8 @@ impl Rae {
     }
 
     /// A tensor image of `channels` channels at `w` × `h`.
-    fn tensor(w: u32, h: u32, channels: u32) -> ImageDesc {
-        ImageDesc::d2(w * groups(channels), h, vk::Format::R32G32B32A32_SFLOAT)
+    fn tensor(&self, w: u32, h: u32, channels: u32) -> ImageDesc {
+        ImageDesc::d2(w * groups(channels), h, self.precision.format())
     }
 }
 
@@ -335,7 +384,7 @@ impl Denoiser for Rae {
             self.uploaded.set(Some(weights));
         }
 
-        let x0 = graph.image(ctx, &format!("{n}.x0"), Self::tensor(pw, ph, IN_CHANNELS))?;
+        let x0 = graph.image(ctx, &format!("{n}.x0"), self.tensor(pw, ph, IN_CHANNELS))?;
         let noisy = input.noisy;
         let io_push = RaeIoPush {
             width: pw,
@@ -361,7 +410,7 @@ impl Denoiser for Rae {
         for l in 0..levels {
             let w = wts.widths[l as usize];
             let (lw, lh) = size(l);
-            let a = graph.image(ctx, &format!("{n}.enc{l}.a"), Self::tensor(lw, lh, w))?;
+            let a = graph.image(ctx, &format!("{n}.enc{l}.a"), self.tensor(lw, lh, w))?;
             convs.push(Conv {
                 layer: wts.layer(&format!("enc{l}.feat")),
                 a: x,
@@ -372,7 +421,7 @@ impl Denoiser for Rae {
                 size: (lw, lh),
                 slope: wts.slope,
             });
-            let h = graph.history(ctx, &self.history_name(l), Self::tensor(lw, lh, w))?;
+            let h = graph.history(ctx, &self.history_name(l), self.tensor(lw, lh, w))?;
             convs.push(Conv {
                 layer: wts.layer(&format!("enc{l}.rec")),
                 a,
@@ -385,7 +434,7 @@ impl Denoiser for Rae {
             });
             hidden.push(h.cur);
             let (nw, nh) = size(l + 1);
-            let pooled = graph.image(ctx, &format!("{n}.x{}", l + 1), Self::tensor(nw, nh, w))?;
+            let pooled = graph.image(ctx, &format!("{n}.x{}", l + 1), self.tensor(nw, nh, w))?;
             pools.push(Pool {
                 before: convs.len(),
                 src: h.cur,
@@ -398,11 +447,7 @@ impl Denoiser for Rae {
         }
         let (bw, bh) = size(levels);
         let bottom = wts.widths[levels as usize];
-        let mut d = graph.image(
-            ctx,
-            &format!("{n}.bottleneck"),
-            Self::tensor(bw, bh, bottom),
-        )?;
+        let mut d = graph.image(ctx, &format!("{n}.bottleneck"), self.tensor(bw, bh, bottom))?;
         convs.push(Conv {
             layer: wts.layer("bottleneck"),
             a: x,
@@ -416,7 +461,7 @@ impl Denoiser for Rae {
         for l in (0..levels).rev() {
             let (lw, lh) = size(l);
             let w = wts.widths[l as usize];
-            let out = graph.image(ctx, &format!("{n}.dec{l}"), Self::tensor(lw, lh, w))?;
+            let out = graph.image(ctx, &format!("{n}.dec{l}"), self.tensor(lw, lh, w))?;
             convs.push(Conv {
                 layer: wts.layer(&format!("dec{l}")),
                 a: d,
@@ -429,7 +474,7 @@ impl Denoiser for Rae {
             });
             d = out;
         }
-        let y = graph.image(ctx, &format!("{n}.y"), Self::tensor(pw, ph, IN_CHANNELS))?;
+        let y = graph.image(ctx, &format!("{n}.y"), self.tensor(pw, ph, IN_CHANNELS))?;
         convs.push(Conv {
             layer: wts.layer("out"),
             a: d,

@@ -121,7 +121,8 @@ pub struct TaaPush {
     pub pad1: f32,
 }
 
-/// rae_conv.comp's push constants (see engine/src/denoise/rae.rs).
+/// `RaeConvPush` in include/rae_conv.glsl (rae_conv.comp and its fp16 variant; see
+/// engine/src/denoise/rae.rs).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct RaeConvPush {
@@ -139,7 +140,7 @@ pub struct RaeConvPush {
     pub pad2: u32,
 }
 
-/// rae_pool.comp's push constants.
+/// `RaePoolPush` in include/rae_pool.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct RaePoolPush {
@@ -149,7 +150,7 @@ pub struct RaePoolPush {
     pub pad0: u32,
 }
 
-/// rae_io.comp's push constants.
+/// `RaeIoPush` in include/rae_io.glsl (the input and output transforms).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct RaeIoPush {
@@ -381,7 +382,7 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
             }),
         ),
         (
-            "rae_io",
+            "rae_input",
             "push",
             std::mem::size_of::<RaeIoPush>(),
             field_offsets!(RaeIoPush {
