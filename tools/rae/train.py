@@ -120,7 +120,8 @@ def main():
         model, m0 = rae.load(a.init)
         init = {"manifest": os.path.relpath(os.path.abspath(a.init), ROOT),
                 "training_data": m0.get("training_data"), "training": m0.get("training"),
-                "initialised_from": m0.get("initialised_from")}
+                "initialised_from": m0.get("initialised_from"),
+                "validation_curve": m0.get("validation_curve")}
         a.widths = ",".join(str(w) for w in model.widths)
     else:
         model = rae.Rae([int(w) for w in a.widths.split(",")])
@@ -139,6 +140,13 @@ def main():
         model.train()
         return loss.item(), parts
 
+    if init is not None:
+        # Where fine-tuning starts: the pre-trained network on these validation clips.
+        vl, parts = validate()
+        curve.append({"iteration": 0, "seconds": 0.0, "train": None, "validation": round(vl, 5)})
+        print(f"it 0 (pre-trained {a.init}) val {vl:.4f} (l1 {parts[0]:.4f} log {parts[1]:.4f} "
+              f"temporal {parts[2]:.4f})", flush=True)
+        best = (vl, {k: v.clone() for k, v in model.state_dict().items()})
     while True:
         el = time.time() - t0
         if el > budget:
