@@ -100,6 +100,9 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--init", default=None, help="manifest of a network to start from (fine-tuning)")
+    ap.add_argument("--extra-data", default=None,
+                    help="another gen_data.py folder whose clips of this dataset join the training set "
+                         "(half of each batch; none are used for validation)")
     a = ap.parse_args()
     net = a.net or a.dataset
     torch.set_num_threads(a.threads)
@@ -114,6 +117,12 @@ def main():
     tr_n, tr_r = noisy[: n - nv], ref[: n - nv]
     va_n, va_r = noisy[n - nv :], ref[n - nv :]
     print(f"{a.dataset}: {n - nv} training clips, {nv} validation clips, {tuple(noisy.shape[1:])}", flush=True)
+    extra = None
+    if a.extra_data:
+        e = np.load(os.path.join(a.extra_data, f"{a.dataset}.npz"))
+        extra = (rae.normalise(torch.from_numpy(e["noisy"])), rae.normalise(torch.from_numpy(e["ref"])), e)
+        print(f"  + {extra[0].shape[0]} extra training clips {tuple(extra[0].shape[1:])} from {a.extra_data}",
+              flush=True)
 
     init = None
     if a.init:
@@ -154,8 +163,17 @@ def main():
         lr = a.lr * 0.5 * (1 + math.cos(math.pi * min(el / budget, 1.0)))
         for g in opt.param_groups:
             g["lr"] = lr
-        idx = rng.choice(tr_n.shape[0], a.batch, replace=False)
-        bn, br = augment(tr_n[idx], tr_r[idx], rng, a.crop)
+        if extra is None:
+            idx = rng.choice(tr_n.shape[0], a.batch, replace=False)
+            bn, br = augment(tr_n[idx], tr_r[idx], rng, a.crop)
+        else:
+            # Half the batch from each set; crops may not exceed the smaller clips.
+            k = a.batch // 2
+            idx = rng.choice(tr_n.shape[0], a.batch - k, replace=False)
+            jdx = rng.choice(extra[0].shape[0], k, replace=False)
+            bn, br = augment(tr_n[idx], tr_r[idx], rng, a.crop)
+            en, er = augment(extra[0][jdx], extra[1][jdx], rng, a.crop)
+            bn, br = torch.cat([bn, en]), torch.cat([br, er])
         loss, _ = clip_loss(model, bn, br)
         opt.zero_grad()
         loss.backward()
@@ -185,7 +203,12 @@ def main():
         "trained": True,
         "dataset": a.dataset,
         "training_data": {"file": os.path.relpath(os.path.join(os.path.abspath(a.data), f"{a.dataset}.npz"), ROOT), "sha256_16": str(d["hash"]),
-                          "settings": str(d["settings"]), "clips_train": int(n - nv), "clips_validation": int(nv)},
+                          "settings": str(d["settings"]), "clips_train": int(n - nv), "clips_validation": int(nv),
+                          "extra_training_data": None if extra is None else {
+                              "file": os.path.relpath(os.path.join(os.path.abspath(a.extra_data),
+                                                                   f"{a.dataset}.npz"), ROOT),
+                              "sha256_16": str(extra[2]["hash"]), "settings": str(extra[2]["settings"]),
+                              "clips_train": int(extra[0].shape[0]), "share_of_each_batch": 0.5}},
         "training": {"seconds": round(train_s, 1), "iterations": it, "batch": a.batch, "crop": a.crop,
                      "optimizer": f"Adam lr {a.lr} cosine to 0", "threads": a.threads, "seed": a.seed,
                      "loss": "0.8 L1 + 0.1 L1(LoG 7x7 sigma 1) + 0.1 L1(temporal difference), log1p space, "
