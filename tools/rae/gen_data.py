@@ -9,9 +9,10 @@ DATA/<dataset>.npz (noisy, ref: (clips, frames, 3, H, W) float32) with a content
     nice -n 10 /opt/rae-venv/bin/python tools/rae/gen_data.py --dataset phantom --clips 24
 
 The defaults (64x64 clips, 256-spp references) make the cheap pre-training set; the
-issue's setting (7-frame 128x128 clips with 1024-spp references, about 6 min per clip
-on lavapipe on this 2-core machine) is --size 128x128 --ref-spp 1024 (pipeline.sh runs
-both). Clips already rendered are reused, so a run can be resumed or extended.
+issue's setting (7-frame 128x128 clips with 1024-spp references, about 7 min per clip
+on lavapipe with two rendering at once on this 2-core machine) is
+--size 128x128 --ref-spp 1024 (pipeline.sh runs both). Clips already rendered are
+reused, so a run can be resumed or extended.
 """
 import argparse
 import hashlib
