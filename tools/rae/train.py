@@ -86,6 +86,15 @@ def augment(noisy, ref, rng, crop):
     return noisy.contiguous(), ref.contiguous()
 
 
+def load_clips(folder, dataset):
+    """A gen_data.py pack: normalised noisy and reference clips, and what the manifest
+    records of it (file relative to the repository, content hash, settings)."""
+    path = os.path.join(os.path.abspath(folder), f"{dataset}.npz")
+    d = np.load(path)
+    info = {"file": os.path.relpath(path, ROOT), "sha256_16": str(d["hash"]), "settings": str(d["settings"])}
+    return rae.normalise(torch.from_numpy(d["noisy"])), rae.normalise(torch.from_numpy(d["ref"])), info
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--dataset", required=True)
@@ -109,9 +118,7 @@ def main():
     torch.manual_seed(a.seed)
     rng = np.random.default_rng(a.seed)
 
-    d = np.load(os.path.join(a.data, f"{a.dataset}.npz"))
-    noisy = rae.normalise(torch.from_numpy(d["noisy"]))
-    ref = rae.normalise(torch.from_numpy(d["ref"]))
+    noisy, ref, data_info = load_clips(a.data, a.dataset)
     n = noisy.shape[0]
     nv = min(a.val_clips, n // 4)
     tr_n, tr_r = noisy[: n - nv], ref[: n - nv]
@@ -119,8 +126,7 @@ def main():
     print(f"{a.dataset}: {n - nv} training clips, {nv} validation clips, {tuple(noisy.shape[1:])}", flush=True)
     extra = None
     if a.extra_data:
-        e = np.load(os.path.join(a.extra_data, f"{a.dataset}.npz"))
-        extra = (rae.normalise(torch.from_numpy(e["noisy"])), rae.normalise(torch.from_numpy(e["ref"])), e)
+        extra = load_clips(a.extra_data, a.dataset)
         print(f"  + {extra[0].shape[0]} extra training clips {tuple(extra[0].shape[1:])} from {a.extra_data}",
               flush=True)
 
@@ -198,17 +204,13 @@ def main():
     # The identity baseline: the validation L1 of the noisy input itself.
     with torch.no_grad():
         base = sum(((va_n[:, t] - va_r[:, t]).abs().mean().item()) for t in range(va_n.shape[1])) / va_n.shape[1]
-    extra = {
+    record = {
         "name": net,
         "trained": True,
         "dataset": a.dataset,
-        "training_data": {"file": os.path.relpath(os.path.join(os.path.abspath(a.data), f"{a.dataset}.npz"), ROOT), "sha256_16": str(d["hash"]),
-                          "settings": str(d["settings"]), "clips_train": int(n - nv), "clips_validation": int(nv),
+        "training_data": {**data_info, "clips_train": int(n - nv), "clips_validation": int(nv),
                           "extra_training_data": None if extra is None else {
-                              "file": os.path.relpath(os.path.join(os.path.abspath(a.extra_data),
-                                                                   f"{a.dataset}.npz"), ROOT),
-                              "sha256_16": str(extra[2]["hash"]), "settings": str(extra[2]["settings"]),
-                              "clips_train": int(extra[0].shape[0]), "share_of_each_batch": 0.5}},
+                              **extra[2], "clips_train": int(extra[0].shape[0]), "share_of_each_batch": 0.5}},
         "training": {"seconds": round(train_s, 1), "iterations": it, "batch": a.batch, "crop": a.crop,
                      "optimizer": f"Adam lr {a.lr} cosine to 0", "threads": a.threads, "seed": a.seed,
                      "loss": "0.8 L1 + 0.1 L1(LoG 7x7 sigma 1) + 0.1 L1(temporal difference), log1p space, "
@@ -223,7 +225,7 @@ def main():
                       + " (sized for CPU training and lavapipe inference)",
     }
     out = os.path.join(ROOT, "assets", "rae")
-    rae.save(model, os.path.join(out, f"{net}.bin"), os.path.join(out, f"{net}.json"), extra)
+    rae.save(model, os.path.join(out, f"{net}.bin"), os.path.join(out, f"{net}.json"), record)
     print(f"saved assets/rae/{net}: {rae.param_count(model)} parameters, {it} iterations in {train_s:.0f}s, "
           f"validation {vl:.4f} (noisy input L1 {base:.4f})", flush=True)
     subprocess.run([sys.executable, os.path.join(os.path.dirname(__file__), "fixture.py"), "--net", net], check=True)
