@@ -138,20 +138,23 @@ fn bad_weight_files_are_clear_errors() {
     let manifest = std::fs::read_to_string(assets().join("phantom.json")).expect("manifest");
     let bin = std::fs::read(assets().join("phantom.bin")).expect("weights");
 
+    let load_error = |manifest: &str| {
+        let e = RaeWeights::load(&dir.path().join(manifest))
+            .expect_err("a bad weight file must not load")
+            .to_string();
+        println!("{e}");
+        e
+    };
+
     // Truncated weights: the error names the .bin file and says truncated.
     std::fs::write(dir.path().join("phantom.json"), &manifest).unwrap();
     std::fs::write(dir.path().join("phantom.bin"), &bin[..bin.len() - 100]).unwrap();
-    let e = RaeWeights::load(&dir.path().join("phantom.json"))
-        .unwrap_err()
-        .to_string();
-    println!("{e}");
+    let e = load_error("phantom.json");
     assert!(e.contains("phantom.bin") && e.contains("truncated"), "{e}");
 
     // A manifest naming a weight file that does not exist.
     std::fs::remove_file(dir.path().join("phantom.bin")).unwrap();
-    let e = RaeWeights::load(&dir.path().join("phantom.json"))
-        .unwrap_err()
-        .to_string();
+    let e = load_error("phantom.json");
     assert!(
         e.contains("phantom.bin") && e.contains("cannot read"),
         "{e}"
@@ -162,16 +165,12 @@ fn bad_weight_files_are_clear_errors() {
     assert_ne!(bad, manifest, "the widths edit must apply");
     std::fs::write(dir.path().join("bad.json"), bad).unwrap();
     std::fs::write(dir.path().join("phantom.bin"), &bin).unwrap();
-    let e = RaeWeights::load(&dir.path().join("bad.json"))
-        .unwrap_err()
-        .to_string();
+    let e = load_error("bad.json");
     assert!(e.contains("bad.json") && e.contains("layer"), "{e}");
 
     // Not JSON at all.
     std::fs::write(dir.path().join("junk.json"), "widths = 3").unwrap();
-    let e = RaeWeights::load(&dir.path().join("junk.json"))
-        .unwrap_err()
-        .to_string();
+    let e = load_error("junk.json");
     assert!(
         e.contains("junk.json") && e.contains("not a RAE manifest"),
         "{e}"

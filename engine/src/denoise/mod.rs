@@ -188,25 +188,22 @@ pub fn create(
     motion: MotionSource,
     dataset: Option<&str>,
 ) -> Result<Box<dyn Denoiser>> {
+    if let Some((net, precision)) = rae::resolve(name, dataset) {
+        return Ok(Box::new(Rae::new(
+            ctx,
+            name,
+            RaeWeights::builtin(net)?,
+            precision,
+        )?));
+    }
+    if let Some(variant) = WrlsVariant::from_name(name) {
+        return Ok(Box::new(Wrls::new(ctx, name, variant, motion)?));
+    }
     Ok(match name {
         "none" => Box::new(Passthrough),
         "accum" => Box::new(Accum::new(ctx)?),
         "taa" => Box::new(Taa::new(ctx, motion)?),
         "svgf" => Box::new(Svgf::new(ctx, motion)?),
-        n if rae::resolve(n, dataset).is_some() => {
-            let (net, precision) = rae::resolve(n, dataset).ok_or_else(|| EngineError::Pass {
-                pass: "denoise".into(),
-                problem: format!("unknown RAE variant {n:?}"),
-            })?;
-            Box::new(Rae::new(ctx, n, RaeWeights::builtin(net)?, precision)?)
-        }
-        n if WrlsVariant::from_name(n).is_some() => {
-            let variant = WrlsVariant::from_name(n).ok_or_else(|| EngineError::Pass {
-                pass: "denoise".into(),
-                problem: format!("unknown wRLS variant {n:?}"),
-            })?;
-            Box::new(Wrls::new(ctx, n, variant, motion)?)
-        }
         other => {
             return Err(EngineError::Pass {
                 pass: "denoise".into(),

@@ -330,6 +330,40 @@ impl Rae {
     }
 }
 
+/// The input or output transform (rae_input / rae_output): reads `src` of `src_size`,
+/// writes all of `dst` of `dst_size` (padding by replication or cropping).
+fn add_io_pass<'f>(
+    frame: &mut Frame<'f>,
+    name: String,
+    pipeline: &'f ComputePipeline,
+    src: ImageHandle,
+    src_size: (u32, u32),
+    dst: ImageHandle,
+    dst_size: (u32, u32),
+) {
+    let push = RaeIoPush {
+        width: dst_size.0,
+        height: dst_size.1,
+        src_width: src_size.0,
+        src_height: src_size.1,
+    };
+    frame.add_pass(
+        name,
+        |b| {
+            b.read(src).write(dst);
+        },
+        move |pc| {
+            let binds = [("src", Bind::Image(src)), ("dst", Bind::Image(dst))];
+            pc.dispatch(
+                pipeline,
+                &binds,
+                &push,
+                pipeline.groups_2d(dst_size.0, dst_size.1),
+            )
+        },
+    );
+}
+
 struct Conv<'a> {
     layer: &'a RaeLayer,
     a: ImageHandle,
@@ -385,22 +419,14 @@ impl Denoiser for Rae {
         }
 
         let x0 = graph.image(ctx, &format!("{n}.x0"), self.tensor(pw, ph, IN_CHANNELS))?;
-        let noisy = input.noisy;
-        let io_push = RaeIoPush {
-            width: pw,
-            height: ph,
-            src_width: fw,
-            src_height: fh,
-        };
-        frame.add_pass(
+        add_io_pass(
+            frame,
             format!("{n}.input"),
-            |b| {
-                b.read(noisy).write(x0);
-            },
-            move |pc| {
-                let binds = [("src", Bind::Image(noisy)), ("dst", Bind::Image(x0))];
-                pc.dispatch(&self.input, &binds, &io_push, self.input.groups_2d(pw, ph))
-            },
+            &self.input,
+            input.noisy,
+            (fw, fh),
+            x0,
+            (pw, ph),
         );
 
         let mut convs: Vec<Conv> = Vec::new();
@@ -553,26 +579,14 @@ impl Denoiser for Rae {
             &format!("{n}.out"),
             ImageDesc::d2(fw, fh, vk::Format::R32G32B32A32_SFLOAT),
         )?;
-        let io_push = RaeIoPush {
-            width: fw,
-            height: fh,
-            src_width: pw,
-            src_height: ph,
-        };
-        frame.add_pass(
+        add_io_pass(
+            frame,
             format!("{n}.output"),
-            |b| {
-                b.read(y).write(out);
-            },
-            move |pc| {
-                let binds = [("src", Bind::Image(y)), ("dst", Bind::Image(out))];
-                pc.dispatch(
-                    &self.output,
-                    &binds,
-                    &io_push,
-                    self.output.groups_2d(fw, fh),
-                )
-            },
+            &self.output,
+            y,
+            (pw, ph),
+            out,
+            (fw, fh),
         );
         Ok(out)
     }
