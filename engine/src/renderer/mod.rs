@@ -8,7 +8,7 @@ pub mod scene_gpu;
 pub mod scene_setup;
 pub mod uniforms;
 
-use crate::denoise::{self, Changes, DenoiseInputs, Denoiser};
+use crate::denoise::{self, Changes, DenoiseInputs, Denoiser, Retrace};
 use crate::error::{EngineError, Result, VkContext};
 use crate::gpu::timestamps::{PassTiming, TimestampPool};
 use crate::gpu::GpuContext;
@@ -239,7 +239,15 @@ impl Renderer {
         };
         let denoisers = denoisers
             .iter()
-            .map(|n| denoise::create(&ctx, n, settings.motion_source, settings.dataset))
+            .map(|n| {
+                denoise::create(
+                    &ctx,
+                    n,
+                    settings.motion_source,
+                    settings.dataset,
+                    settings.features,
+                )
+            })
             .collect::<Result<Vec<_>>>()?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
@@ -330,6 +338,7 @@ impl Renderer {
                     n,
                     self.settings.motion_source,
                     self.settings.dataset,
+                    self.settings.features,
                 )
             })
             .collect::<Result<Vec<_>>>()?;
@@ -449,6 +458,23 @@ impl Renderer {
             features.map(|f| f.position.cur),
             size,
         )?;
+        // Last frame's samples can be traced again in this frame's scene (ours' temporal
+        // gradients) when the scene changed and last frame's radiance is still valid.
+        let retrace = match &self.last_inputs {
+            Some(last)
+                if noisy.radiance_history.valid
+                    && (changes.lights || changes.transfer_function) =>
+            {
+                Some(Retrace {
+                    scene,
+                    radiance_prev: noisy.radiance_history.prev,
+                    inv_view_proj_prev: (last.camera.proj * last.camera.view).inverse(),
+                    camera_prev: last.camera.position,
+                    frame_prev: self.frame_index.wrapping_sub(1) as u32,
+                })
+            }
+            _ => None,
+        };
         let input = DenoiseInputs {
             uniforms: scene.uniforms,
             noisy: noisy.radiance,
@@ -460,6 +486,7 @@ impl Renderer {
             camera: inputs.camera.position,
             spp: self.settings.spp,
             changes,
+            retrace,
         };
         let mut outputs: Vec<(String, ImageHandle)> = Vec::new();
         for d in &self.denoisers {

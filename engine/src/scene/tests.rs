@@ -43,9 +43,9 @@ fn parse_err(text: &str) -> String {
 }
 
 #[test]
-fn there_are_24_builtins_and_all_are_valid() {
+fn there_are_30_builtins_and_all_are_valid() {
     let names = Scene::builtin_names();
-    assert_eq!(names.len(), 24);
+    assert_eq!(names.len(), 30);
     for dataset in ["phantom", "mri", "cloud"] {
         for anim in builtin::ANIMATIONS {
             assert!(names.contains(&format!("{dataset}/{anim}")));
@@ -177,8 +177,8 @@ fn tf_edit_blends_smoothly_and_the_lut_follows() {
     assert_eq!(*blends.last().expect("frames"), 1.0);
     assert!(blends.windows(2).all(|w| w[1] > w[0] && w[1] - w[0] < 0.05));
     let (a, b) = s.tf_luts();
-    assert_eq!(s.tf_lut(0.0), a);
-    assert_eq!(s.tf_lut(1.0), b);
+    assert_eq!(s.tf_lut(0.0, 0.0), a);
+    assert_eq!(s.tf_lut(1.0, 0.0), b);
     assert!(s.features().tf_blend);
     assert!(!builtin("phantom/orbit").features().tf_blend);
 }
@@ -363,6 +363,16 @@ fn errors_name_the_file_and_the_field() {
             "bad.toml: animation.tf[0].blend:",
         ),
         ("b = \"cloud-edit\"", "", "bad.toml: animation.tf[0].blend:|transfer.b"),
+        (
+            "frames = 10",
+            "frames = 10\n[[animation.tf]]\nframe = 1\nshift = 1.5",
+            "bad.toml: animation.tf[0].shift:|[-1, 1]",
+        ),
+        (
+            "frames = 10",
+            "frames = 10\n[[animation.tf]]\nframe = 1",
+            "bad.toml: animation.tf[0].blend:|blend, shift or both",
+        ),
         (
             "frames = 10",
             "frames = 10\n[animation.orbit]\ndegrees_per_frame = 2\n[[animation.camera]]\nframe = 0\nposition = [1, 1, 1]",
