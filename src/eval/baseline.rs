@@ -6,6 +6,7 @@
 use super::progress::Progress;
 use super::reference::ReferenceCache;
 use super::score::{score, FrameReference};
+use super::timing::Timing;
 use crate::setup::Setup;
 use anyhow::Result;
 use dvr_engine::image_io::to_rgb;
@@ -54,6 +55,7 @@ pub fn units(frame_count: u32, ref_spp: u32) -> f64 {
 
 /// Measures the curve with `renderer` (after the evaluated frames: it changes the
 /// renderer's seed).
+#[allow(clippy::too_many_arguments)]
 pub fn measure(
     renderer: &mut Renderer,
     setup: &Setup,
@@ -62,6 +64,7 @@ pub fn measure(
     ref_spp: u32,
     progress: &mut Progress,
     label: &str,
+    timing: &Timing,
 ) -> Result<Vec<BaselinePoint>> {
     renderer.settings.seed = renderer.settings.seed.wrapping_add(SEED_OFFSET);
     let mut points = Vec::new();
@@ -69,11 +72,15 @@ pub fn measure(
         let reference = FrameReference::new(&references.load(f)?);
         for n in levels(ref_spp) {
             let pixels = renderer.reference(&setup.inputs(f), n, BATCH)?;
-            let s = score(
-                &reference,
-                &to_rgb(setup.width(), setup.height(), &pixels),
-                None,
-            );
+            let s = timing.metrics_wait.time(|| {
+                timing.metrics.time(|| {
+                    score(
+                        &reference,
+                        &to_rgb(setup.width(), setup.height(), &pixels),
+                        None,
+                    )
+                })
+            });
             points.push(BaselinePoint {
                 frame: f,
                 spp: n,

@@ -7,6 +7,7 @@ use super::images::{write_display_png, write_flip_png};
 use super::progress::Progress;
 use super::reference::{frame_name, ReferenceCache, ReferenceKey};
 use super::score::{score, FrameReference};
+use super::timing::Timing;
 use super::{scenes, EvalArgs, GPU_WARMUP_FRAMES};
 use crate::setup::Setup;
 use crate::SceneArgs;
@@ -166,6 +167,7 @@ struct FrameState<'a> {
     previous_reference: Option<Rgb32Image>,
     rows: Vec<MetricRow>,
     timings: Vec<Vec<PassTiming>>,
+    timing: &'a Timing,
 }
 
 impl FrameState<'_> {
@@ -176,7 +178,9 @@ impl FrameState<'_> {
     /// Scores and writes one finished frame (frames arrive in order).
     fn process(&mut self, done: FrameResult) -> Result<()> {
         let f = done.index as u32;
+        let started = std::time::Instant::now();
         let reference = FrameReference::new(&self.scene.references.load(f)?);
+        self.timing.metrics.add(started.elapsed());
         let (w, h) = (self.setup.width(), self.setup.height());
         for (method, pixels) in &done.images {
             let hdr = to_rgb(w, h, pixels);
@@ -184,7 +188,9 @@ impl FrameState<'_> {
                 .previous
                 .get(method)
                 .zip(self.previous_reference.as_ref());
+            let started = std::time::Instant::now();
             let s = score(&reference, &hdr, previous);
+            self.timing.metrics.add(started.elapsed());
             let dir = self.method_dir(method);
             write_display_png(&dir.join(format!("{}.png", frame_name(f))), &s.display)?;
             write_flip_png(
@@ -210,6 +216,7 @@ impl FrameState<'_> {
         }
         self.previous_reference = Some(reference.display);
         self.timings.push(done.timings);
+        self.timing.metrics_wait.add(started.elapsed());
         Ok(())
     }
 }
@@ -271,10 +278,13 @@ pub fn evaluate_scene(
     scene: &PlannedScene,
     label: &str,
     progress: &mut Progress,
+    timing: &Timing,
 ) -> Result<SceneResult> {
     progress.show(&format!("{label} | loading"));
     let setup = Setup::new(&scene_args(args, &scene.name))?;
-    ensure_references(scene, &setup, args.ref_spp, progress, label)?;
+    timing
+        .references
+        .time(|| ensure_references(scene, &setup, args.ref_spp, progress, label))?;
 
     let names: Vec<&str> = methods.iter().map(String::as_str).collect();
     let mut renderer = setup.renderer(&names)?;
@@ -290,6 +300,7 @@ pub fn evaluate_scene(
         previous_reference: None,
         rows: Vec::new(),
         timings: Vec::new(),
+        timing,
     };
     let request = FrameRequest {
         readback: true,
@@ -303,6 +314,7 @@ pub fn evaluate_scene(
             setup.frames
         )
     };
+    let frames_started = std::time::Instant::now();
     for f in 0..setup.frames {
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
             state.process(done)?;
@@ -312,17 +324,21 @@ pub fn evaluate_scene(
     for done in renderer.flush()? {
         state.process(done)?;
     }
+    timing.frames.add(frames_started.elapsed());
 
     let ms_per_spp = path_trace_ms_per_spp(&state.timings, setup.settings.spp);
-    let baseline = baseline::measure(
-        &mut renderer,
-        &setup,
-        &scene.references,
-        ms_per_spp,
-        args.ref_spp,
-        progress,
-        label,
-    )?;
+    let baseline = timing.baseline.time(|| {
+        baseline::measure(
+            &mut renderer,
+            &setup,
+            &scene.references,
+            ms_per_spp,
+            args.ref_spp,
+            progress,
+            label,
+            timing,
+        )
+    })?;
     let device = renderer.ctx().info.name.clone();
     crate::profile::write_json(
         &scene.dir.join("timings.json"),
