@@ -116,36 +116,46 @@ pub fn profile(
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut renderer = setup.renderer(&names)?;
+    let peak = dvr_engine::passes::bandwidth::measure(renderer.ctx())
+        .context("measuring the peak bandwidth")?;
     let started = Instant::now();
-    let mut frames: Vec<Vec<PassTiming>> = Vec::new();
+    // Streaming statistics and a bounded window of raw frames: memory stays flat
+    // however many frames run.
+    let mut stats = profile::Stats::new();
+    let mut window = profile::Window::new(profile::WINDOW_FRAMES);
+    let mut keep = |timings: Vec<PassTiming>| {
+        stats.add_frame(&timings);
+        window.push(timings);
+    };
     let request = FrameRequest::default();
     for f in 0..setup.frames {
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
-            frames.push(done.timings);
+            keep(done.timings);
         }
         progress("profile", f + 1, setup.frames, started);
     }
-    frames.extend(renderer.flush()?.into_iter().map(|r| r.timings));
+    for done in renderer.flush()? {
+        keep(done.timings);
+    }
     eprintln!();
-    let (passes, total) = profile::aggregate(&frames);
-    let report = Profile {
+    let run = profile::RunInfo {
         device: renderer.ctx().info.name.clone(),
         scene: setup.name.clone(),
         width: setup.width(),
         height: setup.height(),
         spp: setup.settings.spp,
         denoisers: renderer.denoiser_names(),
-        warmup_frames: profile::WARMUP_FRAMES,
-        passes,
-        total,
-        frames: frames.clone(),
     };
+    let report = Profile::new(run, &stats, &window, Some(peak));
     print!("{}", profile::table(&report));
     if let Some(p) = json {
         profile::write_json(p, &report)?;
     }
     if let Some(p) = trace {
-        profile::write_json(p, &profile::chrome_trace(&frames))?;
+        profile::write_json(
+            p,
+            &profile::chrome_trace(window.frames(), window.first(), &report.frames_note),
+        )?;
     }
     Ok(())
 }

@@ -383,6 +383,7 @@ mod tests {
             pass: pass.into(),
             start_ms: 0.0,
             ms,
+            bytes: 0,
         }
     }
 

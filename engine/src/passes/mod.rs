@@ -2,6 +2,7 @@
 //! owns its pipeline and adds itself to a frame, declaring exactly what it touches.
 
 pub mod accumulate;
+pub mod bandwidth;
 pub mod motion;
 pub mod path_trace;
 pub mod present;
