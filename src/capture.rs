@@ -82,7 +82,8 @@ pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
     let dir = out.join("reference");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let started = Instant::now();
-    let batch = 32;
+    // As few dispatches per frame as the device takes.
+    let batch = renderer.samples_per_dispatch();
     for f in 0..setup.frames {
         let pixels = renderer.reference(&setup.inputs(f), spp, batch)?;
         let img = to_rgb(setup.width(), setup.height(), &pixels);

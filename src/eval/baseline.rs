@@ -15,9 +15,6 @@ use dvr_engine::renderer::Renderer;
 /// Largest sample count of the baseline curve.
 pub const MAX_SPP: u32 = 256;
 
-/// Samples per submission while accumulating.
-const BATCH: u32 = 32;
-
 /// Seed offset of the baseline's sample stream, so it is independent of the
 /// references' (which would otherwise share its first n samples and flatter it).
 const SEED_OFFSET: u32 = 0x5eed_0b11;
@@ -71,7 +68,8 @@ pub fn measure(
     for f in frames(setup.frames) {
         let reference = FrameReference::new(&references.load(f)?);
         for n in levels(ref_spp) {
-            let pixels = renderer.reference(&setup.inputs(f), n, BATCH)?;
+            let batch = renderer.samples_per_dispatch();
+            let pixels = renderer.reference(&setup.inputs(f), n, batch)?;
             let s = timing.metrics_wait.time(|| {
                 timing.metrics.time(|| {
                     score(

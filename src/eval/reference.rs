@@ -10,9 +10,6 @@ use dvr_engine::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// Samples per reference batch (one submission).
-const BATCH: u32 = 32;
-
 /// What a reference frame depends on. Written before the first frame is rendered, so
 /// frames finished under it are reusable after an interruption.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -184,7 +181,9 @@ impl ReferenceCache {
         renderer: &mut dvr_engine::renderer::Renderer,
         f: u32,
     ) -> Result<()> {
-        let pixels = renderer.reference(&setup.inputs(f), self.key.ref_spp, BATCH)?;
+        // As few dispatches as the device takes (one per frame on a GPU at 256x256).
+        let batch = renderer.samples_per_dispatch();
+        let pixels = renderer.reference(&setup.inputs(f), self.key.ref_spp, batch)?;
         let img = to_rgb(setup.width(), setup.height(), &pixels);
         write_png(&self.png(f), &img)?;
         let tmp = self.dir.join(format!("{}.partial.exr", frame_name(f)));

@@ -55,3 +55,9 @@ pub struct Extent {
     pub width: u32,
     pub height: u32,
 }
+
+impl Extent {
+    pub fn pixels(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+}
