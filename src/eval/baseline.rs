@@ -3,6 +3,7 @@
 //! path-trace time per sample of the evaluated frames times n, so it sits on the same
 //! axis as the denoisers (which pay path tracing at `--spp` plus their own passes).
 
+use super::overlap::Overlap;
 use super::progress::Progress;
 use super::reference::ReferenceCache;
 use super::score::{score, FrameReference};
@@ -11,6 +12,7 @@ use crate::setup::Setup;
 use anyhow::Result;
 use dvr_engine::image_io::to_rgb;
 use dvr_engine::renderer::Renderer;
+use std::sync::Arc;
 
 /// Largest sample count of the baseline curve.
 pub const MAX_SPP: u32 = 256;
@@ -61,37 +63,37 @@ pub fn measure(
     ref_spp: u32,
     progress: &mut Progress,
     label: &str,
-    timing: &Timing,
+    timing: &Arc<Timing>,
 ) -> Result<Vec<BaselinePoint>> {
     renderer.settings.seed = renderer.settings.seed.wrapping_add(SEED_OFFSET);
-    let mut points = Vec::new();
+    // Each level is scored on the pool while the GPU renders the next.
+    let mut jobs = Overlap::new(timing);
+    let (w, h) = (setup.width(), setup.height());
     for f in frames(setup.frames) {
-        let reference = FrameReference::new(&references.load(f)?);
+        let hdr = references.load(f)?;
+        let reference = Arc::new(timing.metrics.time(|| FrameReference::new(&hdr)));
         for n in levels(ref_spp) {
             let batch = renderer.samples_per_dispatch();
             let pixels = renderer.reference(&setup.inputs(f), n, batch)?;
-            let s = timing.metrics_wait.time(|| {
-                timing.metrics.time(|| {
-                    score(
-                        &reference,
-                        &to_rgb(setup.width(), setup.height(), &pixels),
-                        None,
-                    )
+            let (reference, job_timing) = (Arc::clone(&reference), Arc::clone(timing));
+            jobs.spawn(move || {
+                let s = job_timing
+                    .metrics
+                    .time(|| score(&reference, &to_rgb(w, h, &pixels), None));
+                Ok(BaselinePoint {
+                    frame: f,
+                    spp: n,
+                    gpu_ms: path_trace_ms_per_spp * f64::from(n),
+                    psnr: s.psnr,
                 })
-            });
-            points.push(BaselinePoint {
-                frame: f,
-                spp: n,
-                gpu_ms: path_trace_ms_per_spp * f64::from(n),
-                psnr: s.psnr,
-            });
+            })?;
             progress.advance(
                 f64::from(n),
                 &format!("{label} | baseline frame {f}, {n} spp"),
             );
         }
     }
-    Ok(points)
+    jobs.finish()
 }
 
 /// The curve averaged over the measured frames: (spp, mean GPU ms, mean PSNR).

@@ -30,6 +30,7 @@ mod baseline;
 mod csv;
 mod html;
 mod images;
+mod overlap;
 mod plots;
 mod progress;
 mod reference;

@@ -42,11 +42,18 @@ pub struct Timing {
     /// Wall time the main thread spent scoring and writing frames, or waiting for that
     /// work to finish, instead of rendering.
     pub metrics_wait: Counter,
+    /// GPU time of every pass the eval's renderers ran (references, frames, baseline).
+    pub gpu: Counter,
 }
 
 impl Timing {
     pub fn shared() -> Arc<Self> {
         Arc::new(Self::default())
+    }
+
+    /// Adds GPU time reported in milliseconds.
+    pub fn add_gpu_ms(&self, ms: f64) {
+        self.gpu.add(Duration::from_secs_f64(ms.max(0.0) * 1e-3));
     }
 
     /// One line: the wall time and where it went.
@@ -56,14 +63,16 @@ impl Timing {
         format!(
             "eval timing: wall {wall:.1} s | references {:.1} s | frames {:.1} s | baseline \
              {:.1} s | reports {:.1} s | metrics {:.1} s CPU | main thread on metrics and frame \
-             writes {:.1} s ({:.1}% of wall)",
+             writes {:.1} s ({:.1}% of wall) | GPU busy {:.1} s (wall = {:.2}x GPU time)",
             self.references.secs(),
             self.frames.secs(),
             self.baseline.secs(),
             self.reports.secs(),
             self.metrics.secs(),
             self.metrics_wait.secs(),
-            share(self.metrics_wait.secs())
+            share(self.metrics_wait.secs()),
+            self.gpu.secs(),
+            wall / self.gpu.secs().max(1e-9)
         )
     }
 }
@@ -81,5 +90,11 @@ mod tests {
         assert_eq!(t.references.time(|| 7), 7);
         let line = t.summary(Duration::from_secs(4));
         assert!(line.contains("metrics 2.0 s CPU"), "{line}");
+        t.add_gpu_ms(500.0);
+        let line = t.summary(Duration::from_secs(4));
+        assert!(
+            line.contains("GPU busy 0.5 s (wall = 8.00x GPU time)"),
+            "{line}"
+        );
     }
 }
