@@ -114,6 +114,23 @@ pub fn profile(
     json: Option<&Path>,
     trace: Option<&Path>,
 ) -> Result<()> {
+    let (report, window) = run_profile(args, denoisers)?;
+    print!("{}", profile::table(&report));
+    if let Some(p) = json {
+        profile::write_json(p, &report)?;
+    }
+    if let Some(p) = trace {
+        profile::write_json(
+            p,
+            &profile::chrome_trace(window.frames(), window.first(), &report.frames_note),
+        )?;
+    }
+    Ok(())
+}
+
+/// Renders the profile's frames: the report (streaming statistics of every frame, the
+/// measured peak bandwidth) and the window of raw frames for the trace.
+pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, profile::Window)> {
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut renderer = setup.renderer(&names)?;
@@ -147,18 +164,7 @@ pub fn profile(
         spp: setup.settings.spp,
         denoisers: renderer.denoiser_names(),
     };
-    let report = Profile::new(run, &stats, &window, Some(peak));
-    print!("{}", profile::table(&report));
-    if let Some(p) = json {
-        profile::write_json(p, &report)?;
-    }
-    if let Some(p) = trace {
-        profile::write_json(
-            p,
-            &profile::chrome_trace(window.frames(), window.first(), &report.frames_note),
-        )?;
-    }
-    Ok(())
+    Ok((Profile::new(run, &stats, &window, Some(peak)), window))
 }
 
 fn progress(what: &str, done: u32, total: u32, started: Instant) {

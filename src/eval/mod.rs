@@ -31,13 +31,13 @@ mod csv;
 mod html;
 mod images;
 mod overlap;
-mod plots;
+pub mod plots;
 mod progress;
 mod reference;
-mod run;
+pub mod run;
 mod scenes;
 mod score;
-mod timing;
+pub mod timing;
 
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
@@ -89,7 +89,8 @@ pub struct EvalArgs {
     pub motion: dvr_engine::denoise::MotionSource,
 }
 
-pub fn eval(args: &EvalArgs) -> Result<()> {
+/// Runs the eval; returns where its time went.
+pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     let started = Instant::now();
     if args.ref_spp == 0 {
         bail!("--ref-spp must be at least 1");
@@ -144,8 +145,9 @@ pub fn eval(args: &EvalArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         args.out.join("index.html").display()
     );
-    eprintln!("{}", timing.summary(started.elapsed()));
-    Ok(())
+    let wall = started.elapsed();
+    eprintln!("{}", timing.summary(wall));
+    Ok(timing.outcome(wall))
 }
 
 fn write_reports(

@@ -123,12 +123,19 @@ impl SceneResult {
     }
 }
 
+/// Whether `pass` is one of `method`'s own passes (named `<method>` or
+/// `<method>.<step>`).
+pub fn owned_by(pass: &str, method: &str) -> bool {
+    pass == method
+        || pass
+            .strip_prefix(method)
+            .is_some_and(|r| r.starts_with('.'))
+}
+
 /// GPU time of `method` in one frame: every pass no method owns (surface features,
 /// path trace, motion, …) plus the method's own passes, which are named after it
 /// (`accum`, `ours.update`, `ours.spatial`; `none` has none).
 pub fn method_gpu_ms(timings: &[PassTiming], method: &str, methods: &[String]) -> f64 {
-    let owned_by =
-        |pass: &str, m: &str| pass == m || pass.strip_prefix(m).is_some_and(|r| r.starts_with('.'));
     timings
         .iter()
         .filter(|t| !UNCOUNTED_PREFIXES.iter().any(|p| t.pass.starts_with(p)))

@@ -29,6 +29,19 @@ impl Counter {
     }
 }
 
+/// Where a finished eval's time went, in seconds (see [`Timing`]).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Outcome {
+    pub wall_s: f64,
+    pub gpu_s: f64,
+    pub references_s: f64,
+    pub frames_s: f64,
+    pub baseline_s: f64,
+    pub reports_s: f64,
+    pub metrics_cpu_s: f64,
+    pub metrics_wait_s: f64,
+}
+
 /// The phases of an eval (wall time on the main thread) and the metrics' CPU time.
 #[derive(Debug, Default)]
 pub struct Timing {
@@ -54,6 +67,20 @@ impl Timing {
     /// Adds GPU time reported in milliseconds.
     pub fn add_gpu_ms(&self, ms: f64) {
         self.gpu.add(Duration::from_secs_f64(ms.max(0.0) * 1e-3));
+    }
+
+    /// The figures of a finished eval that took `wall`, for a benchmark's record.
+    pub fn outcome(&self, wall: Duration) -> Outcome {
+        Outcome {
+            wall_s: wall.as_secs_f64(),
+            gpu_s: self.gpu.secs(),
+            references_s: self.references.secs(),
+            frames_s: self.frames.secs(),
+            baseline_s: self.baseline.secs(),
+            reports_s: self.reports.secs(),
+            metrics_cpu_s: self.metrics.secs(),
+            metrics_wait_s: self.metrics_wait.secs(),
+        }
     }
 
     /// One line: the wall time and where it went.
