@@ -139,7 +139,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     };
     let first = profiles.first();
     let record = Record {
-        device: first.map(|p| p.device.as_str()).unwrap_or(""),
+        device: first.map(|p| p.run.device.as_str()).unwrap_or(""),
         peak_bandwidth: first.and_then(|p| p.peak_bandwidth.as_ref()),
         profile_scene: &args.scene,
         profile_frames: args.frames,
@@ -220,8 +220,8 @@ fn profile_csv(profiles: &[Profile]) -> String {
             let _ = writeln!(
                 s,
                 "{}x{},{},{:.4},{:.4},{:.4},{:.3},{:.2},{}",
-                p.width,
-                p.height,
+                p.run.width,
+                p.run.height,
                 r.pass,
                 r.mean_ms,
                 r.median_ms,
@@ -262,7 +262,8 @@ pub fn method_rows(p: &Profile) -> Vec<MethodRow> {
         })
         .collect();
     let peak = p.peak_bandwidth.as_ref().map(|b| b.gb_per_s);
-    p.denoisers
+    p.run
+        .denoisers
         .iter()
         .map(|m| {
             let own: Vec<&PassTiming> = means.iter().filter(|t| owned_by(&t.pass, m)).collect();
@@ -277,7 +278,7 @@ pub fn method_rows(p: &Profile) -> Vec<MethodRow> {
                 own_percent_of_peak: peak
                     .filter(|&b| b > 0.0 && own_ms > 0.0)
                     .map(|b| 100.0 * rate / b),
-                frame_ms: method_gpu_ms(&means, m, &p.denoisers),
+                frame_ms: method_gpu_ms(&means, m, &p.run.denoisers),
             }
         })
         .collect()
@@ -290,8 +291,8 @@ fn methods_csv(profiles: &[Profile]) -> String {
             let _ = writeln!(
                 s,
                 "{}x{},{},{:.4},{:.3},{},{:.4}",
-                p.width,
-                p.height,
+                p.run.width,
+                p.run.height,
                 r.method,
                 r.own_ms,
                 r.own_bytes / 1e6,

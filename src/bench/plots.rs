@@ -80,7 +80,7 @@ pub fn pass_chart(p: &Profile, stem: &Path) -> Result<()> {
     let chart = MethodBars {
         title: format!(
             "{} {}x{}: own GPU time per denoiser",
-            p.device, p.width, p.height
+            p.run.device, p.run.width, p.run.height
         ),
         bars,
     };

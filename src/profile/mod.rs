@@ -62,12 +62,8 @@ impl Window {
 /// What `--json` writes.
 #[derive(Clone, Debug, Serialize)]
 pub struct Profile {
-    pub device: String,
-    pub scene: String,
-    pub width: u32,
-    pub height: u32,
-    pub spp: u32,
-    pub denoisers: Vec<String>,
+    #[serde(flatten)]
+    pub run: RunInfo,
     pub warmup_frames: usize,
     /// Frames rendered (the statistics cover all of them after the warm-up).
     pub frames_rendered: usize,
@@ -88,12 +84,7 @@ impl Profile {
     pub fn new(run: RunInfo, stats: &Stats, window: &Window, peak: Option<PeakBandwidth>) -> Self {
         let (passes, total) = stats.summary(peak.as_ref().map(|p| p.gb_per_s));
         Self {
-            device: run.device,
-            scene: run.scene,
-            width: run.width,
-            height: run.height,
-            spp: run.spp,
-            denoisers: run.denoisers,
+            run,
             warmup_frames: WARMUP_FRAMES,
             frames_rendered: stats.frames_seen(),
             peak_bandwidth: peak,
@@ -107,7 +98,7 @@ impl Profile {
 }
 
 /// What a profile ran.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize)]
 pub struct RunInfo {
     pub device: String,
     pub scene: String,
@@ -131,14 +122,15 @@ fn window_note(window: &Window, rendered: usize) -> String {
 }
 
 pub fn table(p: &Profile) -> String {
+    let r = &p.run;
     let mut s = format!(
         "{} | {} | {}x{} | {} spp | denoisers: {}\n",
-        p.device,
-        p.scene,
-        p.width,
-        p.height,
-        p.spp,
-        p.denoisers.join(",")
+        r.device,
+        r.scene,
+        r.width,
+        r.height,
+        r.spp,
+        r.denoisers.join(",")
     );
     match &p.peak_bandwidth {
         Some(b) => s.push_str(&format!(
