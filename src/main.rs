@@ -82,16 +82,19 @@ enum Command {
     /// Evaluate denoisers against cached references: metrics.csv, summary.csv, plots
     /// and an HTML results page.
     Eval(eval::EvalArgs),
-    /// Per-pass GPU timings over many frames: table, JSON and Chrome trace.
+    /// Per-pass GPU timings over many frames, with each pass's declared bytes, GB/s and
+    /// share of the peak bandwidth: table, JSON and Chrome trace.
     Profile {
         #[command(flatten)]
         scene: SceneArgs,
         #[arg(long, default_value = "none", value_delimiter = ',')]
         denoiser: Vec<String>,
-        /// Write the statistics and raw per-frame timings as JSON.
+        /// Write the statistics (per pass: times, bytes, GB/s, % of the measured peak
+        /// bandwidth) and the last 300 frames' raw timings as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Write a Chrome trace-event file (Perfetto, chrome://tracing).
+        /// Write a Chrome trace-event file (Perfetto, chrome://tracing) of the last 300
+        /// frames.
         #[arg(long)]
         trace: Option<PathBuf>,
     },
