@@ -82,7 +82,8 @@ pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
     let dir = out.join("reference");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let started = Instant::now();
-    let batch = 32;
+    // As few dispatches per frame as the device takes.
+    let batch = renderer.samples_per_dispatch();
     for f in 0..setup.frames {
         let pixels = renderer.reference(&setup.inputs(f), spp, batch)?;
         let img = to_rgb(setup.width(), setup.height(), &pixels);
@@ -113,41 +114,57 @@ pub fn profile(
     json: Option<&Path>,
     trace: Option<&Path>,
 ) -> Result<()> {
+    let (report, window) = run_profile(args, denoisers)?;
+    print!("{}", profile::table(&report));
+    if let Some(p) = json {
+        profile::write_json(p, &report)?;
+    }
+    if let Some(p) = trace {
+        profile::write_json(
+            p,
+            &profile::chrome_trace(window.frames(), window.first(), &report.frames_note),
+        )?;
+    }
+    Ok(())
+}
+
+/// Renders the profile's frames: the report (streaming statistics of every frame, the
+/// measured peak bandwidth) and the window of raw frames for the trace.
+pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, profile::Window)> {
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut renderer = setup.renderer(&names)?;
+    let peak = dvr_engine::passes::bandwidth::measure(renderer.ctx())
+        .context("measuring the peak bandwidth")?;
     let started = Instant::now();
-    let mut frames: Vec<Vec<PassTiming>> = Vec::new();
+    // Streaming statistics and a bounded window of raw frames: memory stays flat
+    // however many frames run.
+    let mut stats = profile::Stats::new();
+    let mut window = profile::Window::new(profile::WINDOW_FRAMES);
+    let mut keep = |timings: Vec<PassTiming>| {
+        stats.add_frame(&timings);
+        window.push(timings);
+    };
     let request = FrameRequest::default();
     for f in 0..setup.frames {
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
-            frames.push(done.timings);
+            keep(done.timings);
         }
         progress("profile", f + 1, setup.frames, started);
     }
-    frames.extend(renderer.flush()?.into_iter().map(|r| r.timings));
+    for done in renderer.flush()? {
+        keep(done.timings);
+    }
     eprintln!();
-    let (passes, total) = profile::aggregate(&frames);
-    let report = Profile {
+    let run = profile::RunInfo {
         device: renderer.ctx().info.name.clone(),
         scene: setup.name.clone(),
         width: setup.width(),
         height: setup.height(),
         spp: setup.settings.spp,
         denoisers: renderer.denoiser_names(),
-        warmup_frames: profile::WARMUP_FRAMES,
-        passes,
-        total,
-        frames: frames.clone(),
     };
-    print!("{}", profile::table(&report));
-    if let Some(p) = json {
-        profile::write_json(p, &report)?;
-    }
-    if let Some(p) = trace {
-        profile::write_json(p, &profile::chrome_trace(&frames))?;
-    }
-    Ok(())
+    Ok((Profile::new(run, &stats, &window, Some(peak)), window))
 }
 
 fn progress(what: &str, done: u32, total: u32, started: Instant) {

@@ -1,8 +1,10 @@
 //! `dvr`: real-time Monte Carlo direct volume rendering with temporal denoising.
 //! Subcommands: explore (the interactive window), capture (offscreen sequences),
 //! reference (high-sample references), eval (denoisers against references: metrics,
-//! plots, HTML), profile (per-pass GPU timing), scenes (the built-in scenes).
+//! plots, HTML), profile (per-pass GPU timing), bench (the one-call GPU benchmark), scenes
+//! (the built-in scenes).
 
+mod bench;
 mod capture;
 mod eval;
 mod explore;
@@ -80,19 +82,26 @@ enum Command {
     /// Evaluate denoisers against cached references: metrics.csv, summary.csv, plots
     /// and an HTML results page.
     Eval(eval::EvalArgs),
-    /// Per-pass GPU timings over many frames: table, JSON and Chrome trace.
+    /// Per-pass GPU timings over many frames, with each pass's declared bytes, GB/s and
+    /// share of the peak bandwidth: table, JSON and Chrome trace.
     Profile {
         #[command(flatten)]
         scene: SceneArgs,
         #[arg(long, default_value = "none", value_delimiter = ',')]
         denoiser: Vec<String>,
-        /// Write the statistics and raw per-frame timings as JSON.
+        /// Write the statistics (per pass: times, bytes, GB/s, % of the measured peak
+        /// bandwidth) and the last 300 frames' raw timings as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Write a Chrome trace-event file (Perfetto, chrome://tracing).
+        /// Write a Chrome trace-event file (Perfetto, chrome://tracing) of the last 300
+        /// frames.
         #[arg(long)]
         trace: Option<PathBuf>,
     },
+    /// The one-call GPU benchmark: profiles every denoiser at 256x256, 1280x720 and
+    /// 1920x1080 and runs the eval suite at 256x256 against 1024-spp references; writes
+    /// one small folder of CSV, JSON and plots (`tools/gpu-bench.sh` wraps it).
+    Bench(bench::BenchArgs),
     /// List the built-in scenes, or print one as a TOML scene file.
     Scenes {
         /// Print this scene as TOML (a starting point for your own).
@@ -144,13 +153,14 @@ fn run(cli: Cli) -> Result<()> {
             ref_spp,
             out,
         } => capture::reference(&scene, ref_spp, &out),
-        Command::Eval(args) => eval::eval(&args),
+        Command::Eval(args) => eval::eval(&args).map(|_| ()),
         Command::Profile {
             scene,
             denoiser,
             json,
             trace,
         } => capture::profile(&scene, &denoiser, json.as_deref(), trace.as_deref()),
+        Command::Bench(args) => bench::run(&args),
         Command::Scenes { dump } => setup::list_scenes(dump.as_deref()),
     }
 }

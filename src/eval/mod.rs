@@ -30,12 +30,14 @@ mod baseline;
 mod csv;
 mod html;
 mod images;
-mod plots;
+mod overlap;
+pub mod plots;
 mod progress;
 mod reference;
-mod run;
+pub mod run;
 mod scenes;
 mod score;
+pub mod timing;
 
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
@@ -87,7 +89,8 @@ pub struct EvalArgs {
     pub motion: dvr_engine::denoise::MotionSource,
 }
 
-pub fn eval(args: &EvalArgs) -> Result<()> {
+/// Runs the eval; returns where its time went.
+pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     let started = Instant::now();
     if args.ref_spp == 0 {
         bail!("--ref-spp must be at least 1");
@@ -116,18 +119,21 @@ pub fn eval(args: &EvalArgs) -> Result<()> {
         .with_context(|| format!("creating {}", args.out.display()))?;
     let plan = run::Plan::new(args, &names, &methods)?;
     let mut progress = progress::Progress::new(plan.total_units());
+    let timing = timing::Timing::shared();
     let mut results = Vec::new();
     let mut device = String::new();
     for (i, scene) in plan.scenes.iter().enumerate() {
         let label = format!("[{}/{}] {}", i + 1, plan.scenes.len(), scene.name);
-        let r = run::evaluate_scene(args, &methods, scene, &label, &mut progress)
+        let r = run::evaluate_scene(args, &methods, scene, &label, &mut progress, &timing)
             .with_context(|| format!("evaluating {}", scene.name))?;
         device.clone_from(&r.device);
-        plots::scene_plots(&args.out, &r)?;
-        results.push(r);
-        // Everything is rewritten after each scene, so an interrupted eval leaves a
-        // consistent report of the scenes it finished.
-        write_reports(args, &methods, &results, &device, started)?;
+        timing.reports.time(|| -> Result<()> {
+            plots::scene_plots(&args.out, &r)?;
+            results.push(r);
+            // Everything is rewritten after each scene, so an interrupted eval leaves a
+            // consistent report of the scenes it finished.
+            write_reports(args, &methods, &results, &device, started)
+        })?;
     }
     progress.finish();
     let overall = csv::overall_summary(&results, &methods);
@@ -139,7 +145,9 @@ pub fn eval(args: &EvalArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         args.out.join("index.html").display()
     );
-    Ok(())
+    let wall = started.elapsed();
+    eprintln!("{}", timing.summary(wall));
+    Ok(timing.outcome(wall))
 }
 
 fn write_reports(

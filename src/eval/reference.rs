@@ -10,9 +10,6 @@ use dvr_engine::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// Samples per reference batch (one submission).
-const BATCH: u32 = 32;
-
 /// What a reference frame depends on. Written before the first frame is rendered, so
 /// frames finished under it are reusable after an interruption.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -72,6 +69,7 @@ pub fn frame_name(f: u32) -> String {
 }
 
 /// One scene's reference folder.
+#[derive(Clone, Debug)]
 pub struct ReferenceCache {
     pub dir: PathBuf,
     key: ReferenceKey,
@@ -176,19 +174,26 @@ impl ReferenceCache {
         Ok(note)
     }
 
-    /// Renders frame `f` and stores it; the EXR is written under a temporary name and
-    /// renamed, so an interruption never leaves a truncated frame that looks finished.
+    /// Renders frame `f` in as few dispatches as the device takes (one per frame on a
+    /// GPU at 256x256; lavapipe's loop limiter needs 4-sample ones).
     pub fn render(
         &self,
         setup: &Setup,
         renderer: &mut dvr_engine::renderer::Renderer,
         f: u32,
-    ) -> Result<()> {
-        let pixels = renderer.reference(&setup.inputs(f), self.key.ref_spp, BATCH)?;
-        let img = to_rgb(setup.width(), setup.height(), &pixels);
-        write_png(&self.png(f), &img)?;
+    ) -> Result<Rgb32Image> {
+        let batch = renderer.samples_per_dispatch();
+        let pixels = renderer.reference(&setup.inputs(f), self.key.ref_spp, batch)?;
+        Ok(to_rgb(setup.width(), setup.height(), &pixels))
+    }
+
+    /// Stores rendered frame `f` (eval writes it on a worker thread while the next one
+    /// renders); the EXR is written under a temporary name and renamed, so an
+    /// interruption never leaves a truncated frame that looks finished.
+    pub fn store(&self, f: u32, img: &Rgb32Image) -> Result<()> {
+        write_png(&self.png(f), img)?;
         let tmp = self.dir.join(format!("{}.partial.exr", frame_name(f)));
-        write_exr(&tmp, &img)?;
+        write_exr(&tmp, img)?;
         std::fs::rename(&tmp, self.exr(f))
             .with_context(|| format!("renaming {} to {}", tmp.display(), self.exr(f).display()))
     }
