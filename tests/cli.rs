@@ -242,6 +242,24 @@ fn bad_inputs_get_clear_errors() {
 }
 
 #[test]
+fn too_many_samples_per_frame_point_to_ref_spp() {
+    // `dvr reference` takes its sample count from --ref-spp, not --spp.
+    let o = dvr(&[
+        "reference",
+        "--spp",
+        "512",
+        "--frames",
+        "1",
+        "--size",
+        "8x8",
+    ]);
+    assert_error(&o, &["--ref-spp 512", "--spp"]);
+    // Elsewhere --spp is the noisy input's 1 to 4 samples per frame.
+    let o = dvr(&["capture", "--spp", "9", "--frames", "1", "--size", "8x8"]);
+    assert_error(&o, &["--spp 9", "1 to 4", "--ref-spp"]);
+}
+
+#[test]
 fn a_missing_device_is_reported_clearly() {
     let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
         .args([

@@ -3,9 +3,9 @@
 //! path-trace time per sample of the evaluated frames times n, so it sits on the same
 //! axis as the denoisers (which pay path tracing at `--spp` plus their own passes).
 
-use super::progress::Progress;
 use super::reference::ReferenceCache;
 use super::score::{score, FrameReference};
+use crate::progress::Progress;
 use crate::setup::Setup;
 use anyhow::Result;
 use dvr_engine::image_io::to_rgb;
