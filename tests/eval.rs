@@ -383,21 +383,22 @@ fn results_page_works_in_headless_chromium() {
     eval(&out, 4, 16);
     let url = |hash: &str| format!("file://{}#{hash}", out.join("index.html").display());
 
-    // Without a hash: frame 0, the last method against the reference, side by side.
+    // Without a hash: the last frame, the last method against the reference, side by
+    // side.
     let dom = run_chromium(&bin, &["--dump-dom".into(), url("")]);
     assert_eq!(
         attr(&dom, "<body", "data-ready"),
         "1",
         "the page script ran"
     );
-    assert_eq!(attr(&dom, "<body", "data-frame"), "0");
+    assert_eq!(attr(&dom, "<body", "data-frame"), "3");
     assert_eq!(
         attr(&dom, "id=\"img-a\"", "src"),
-        "cloud_orbit/accum/0000.png"
+        "cloud_orbit/accum/0003.png"
     );
     assert_eq!(
         attr(&dom, "id=\"img-b\"", "src"),
-        "cloud_orbit/reference/0000.png"
+        "cloud_orbit/reference/0003.png"
     );
 
     // The hash drives the controls through their own handlers: the frame slider to
@@ -510,14 +511,14 @@ fn main_job_page_shows_the_reference_and_a_row_per_method() {
     let url = format!("file://{}", out.join("index.html").display());
     let dom = run_chromium(&bin, &["--dump-dom".into(), url]);
     assert_eq!(attr(&dom, "<body", "data-ready"), "1");
-    // The reference and every method at frame 0, all loaded.
+    // The reference and every method at the last frame, all loaded.
     assert_eq!(
         attr(&dom, "id=\"grid-reference\"", "src"),
-        "phantom_orbit/reference/0000.png"
+        "phantom_orbit/reference/0002.png"
     );
     for m in methods {
         let src = attr(&dom, &format!("id=\"grid-{m}\""), "src");
-        assert_eq!(src, format!("phantom_orbit/{m}/0000.png"));
+        assert_eq!(src, format!("phantom_orbit/{m}/0002.png"));
     }
     assert_all_images_loaded(&dom);
     // One metrics row per method, in the order they ran.
