@@ -42,6 +42,7 @@ pub fn capture(
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut renderer = setup.renderer(&names)?;
+    crate::setup::create_out_dir(out)?;
     for m in renderer.denoiser_names() {
         std::fs::create_dir_all(out.join(&m))
             .with_context(|| format!("creating {}", out.join(&m).display()))?;
@@ -111,6 +112,7 @@ pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
     }
     let setup = Setup::new(args)?;
     let mut renderer = setup.renderer(&["none"])?;
+    crate::setup::create_out_dir(out)?;
     let dir = out.join("reference");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let started = Instant::now();

@@ -20,7 +20,7 @@ pub struct DemoArgs {
     /// Output folder (its references are reused by the next run).
     #[arg(long, default_value = "out/demo")]
     pub out: PathBuf,
-    /// Image size, WIDTHxHEIGHT (default: by device, see `dvr demo --help`).
+    /// Image size, WIDTHxHEIGHT (default: by device; the first line printed says which).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Frames of the animation (default: by device).

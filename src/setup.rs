@@ -104,6 +104,18 @@ pub fn denoiser_list(names: &[String]) -> Result<Vec<String>> {
     Ok(methods)
 }
 
+/// Creates the `--out` folder (and its parents); a file in the way is named as such,
+/// not as the system's "File exists".
+pub fn create_out_dir(out: &Path) -> Result<()> {
+    if out.exists() && !out.is_dir() {
+        bail!(
+            "--out {}: that is a file; --out names a folder",
+            out.display()
+        );
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))
+}
+
 /// A scene opened from the command line, made ready for rendering.
 pub struct Setup {
     pub name: String,

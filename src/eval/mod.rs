@@ -107,8 +107,7 @@ pub fn eval(args: &EvalArgs) -> Result<()> {
         crate::video::require_ffmpeg()?;
     }
     let names = scenes::select(&args.scene)?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    crate::setup::create_out_dir(&args.out)?;
     let plan = run::Plan::new(args, &names, &methods)?;
     let mut progress = crate::progress::Progress::new(plan.total_units());
     let mut results = Vec::new();
@@ -120,7 +119,9 @@ pub fn eval(args: &EvalArgs) -> Result<()> {
         device.clone_from(&r.device);
         plots::scene_plots(&args.out, &r)?;
         if args.video.video {
-            progress.show(&format!("{label} | videos"));
+            progress.newline();
+            let dir = crate::video::dir(&args.out.join(&r.dir));
+            eprintln!("{label}: writing videos to {}", dir.display());
             videos::write_scene_videos(&args.out, &r, args.video.video_fps)?;
         }
         results.push(r);
