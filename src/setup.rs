@@ -8,7 +8,7 @@ use dvr_engine::denoise::MotionSource;
 use dvr_engine::gpu::GpuContext;
 use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
-use dvr_engine::renderer::{FrameInputs, RenderSettings, Renderer, MAX_SAMPLES_PER_DISPATCH};
+use dvr_engine::renderer::{FrameInputs, RenderSettings, Renderer};
 use dvr_engine::scene::Scene;
 use std::path::Path;
 
@@ -126,13 +126,6 @@ pub struct Setup {
 
 impl Setup {
     pub fn new(args: &SceneArgs) -> Result<Self> {
-        if let Some(n) = args.spp.filter(|&n| n == 0 || n > MAX_SAMPLES_PER_DISPATCH) {
-            bail!(
-                "--spp {n}: the noisy input takes 1 to {MAX_SAMPLES_PER_DISPATCH} samples per \
-                 pixel per frame (lavapipe cuts longer sample loops short); for a {n}-spp image \
-                 render a reference with --ref-spp (`dvr reference` or `dvr eval`)"
-            );
-        }
         let mut scene = open_scene(&args.scene)?;
         if let Some(n) = args.frames {
             scene = scene.with_frames(n)?;

@@ -224,7 +224,7 @@ impl Renderer {
                 pass: "path_trace".into(),
                 problem: format!(
                     "{} samples per pixel per frame; 1 to {MAX_SAMPLES_PER_DISPATCH} are \
-                     supported (more samples come from accumulating frames, as references do)",
+                     supported (use `dvr reference` or the accum denoiser for more)",
                     settings.spp
                 ),
             });
