@@ -2,12 +2,14 @@
 //! render loop behind profile.
 
 use crate::profile::{self, Profile};
+use crate::progress::{FrameRate, Progress};
 use crate::setup::Setup;
+use crate::video::{self, Track, VideoArgs};
 use crate::SceneArgs;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png};
-use dvr_engine::renderer::{FrameRequest, FrameResult};
+use dvr_engine::renderer::{FrameRequest, FrameResult, MAX_SAMPLES_PER_DISPATCH};
 use std::path::Path;
 use std::time::Instant;
 
@@ -26,10 +28,21 @@ fn write_frame(out: &Path, setup: &Setup, r: &FrameResult) -> Result<()> {
     Ok(())
 }
 
-pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()> {
+pub fn capture(
+    args: &SceneArgs,
+    denoisers: &[String],
+    out: &Path,
+    video: &VideoArgs,
+) -> Result<()> {
+    if video.video {
+        // Before anything renders: minutes of frames are no use without the encoder.
+        video::require_ffmpeg()?;
+    }
+    let denoisers = crate::setup::denoiser_list(denoisers)?;
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut renderer = setup.renderer(&names)?;
+    crate::setup::create_out_dir(out)?;
     for m in renderer.denoiser_names() {
         std::fs::create_dir_all(out.join(&m))
             .with_context(|| format!("creating {}", out.join(&m).display()))?;
@@ -40,18 +53,21 @@ pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()>
         readback: true,
         reset: false,
     };
+    let mut progress = Progress::new(f64::from(setup.frames));
+    let mut rate = FrameRate::default();
     for f in 0..setup.frames {
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
             write_frame(out, &setup, &done)?;
             timings.push(done.timings);
+            rate.finished();
         }
-        progress("capture", f + 1, setup.frames, started);
+        progress.advance(1.0, &frame_status("capture", f + 1, setup.frames, &rate));
     }
     for done in renderer.flush()? {
         write_frame(out, &setup, &done)?;
         timings.push(done.timings);
     }
-    eprintln!();
+    progress.finish();
     profile::write_json(
         &out.join("timings.json"),
         &serde_json::json!({
@@ -65,7 +81,17 @@ pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()>
         }),
     )?;
     let (passes, total) = profile::aggregate(&timings);
-    crate::setup::write_capture_page(out, &setup, &renderer.denoiser_names(), &passes, &total)?;
+    let methods = renderer.denoiser_names();
+    let videos = if video.video {
+        let tracks: Vec<Track> = methods
+            .iter()
+            .map(|m| Track::from_folder(m, &out.join(m), setup.frames))
+            .collect();
+        video::write_videos(out, &tracks, video.video_fps)?
+    } else {
+        Vec::new()
+    };
+    crate::setup::write_capture_page(out, &setup, &methods, &passes, &total, &videos)?;
     println!(
         "wrote {} frames × {} method(s) to {} ({:.1} s)",
         setup.frames,
@@ -77,29 +103,37 @@ pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()>
 }
 
 pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
+    if let Some(n) = args.spp.filter(|&n| n > MAX_SAMPLES_PER_DISPATCH) {
+        bail!(
+            "`dvr reference` takes its samples per pixel from --ref-spp: use --ref-spp {n} \
+             (--spp is the noisy input's 1 to {MAX_SAMPLES_PER_DISPATCH} samples per frame and \
+             does not change a reference)"
+        );
+    }
     let setup = Setup::new(args)?;
     let mut renderer = setup.renderer(&["none"])?;
+    crate::setup::create_out_dir(out)?;
     let dir = out.join("reference");
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let started = Instant::now();
     // As few dispatches per frame as the device takes.
     let batch = renderer.samples_per_dispatch();
+    let mut progress = Progress::new(f64::from(setup.frames));
     for f in 0..setup.frames {
         let pixels = renderer.reference(&setup.inputs(f), spp, batch)?;
         let img = to_rgb(setup.width(), setup.height(), &pixels);
         write_exr(&dir.join(format!("{}.exr", frame_name(f as u64))), &img)?;
         write_png(&dir.join(format!("{}.png", frame_name(f as u64))), &img)?;
-        let secs = started.elapsed().as_secs_f64();
         let samples = (f + 1) as f64 * spp as f64 * setup.width() as f64 * setup.height() as f64;
-        eprint!(
-            "\rreference: frame {}/{} | {:.2} Msamples/s | {:.0} s left   ",
+        let status = format!(
+            "reference: frame {}/{} | {:.2} Msamples/s",
             f + 1,
             setup.frames,
-            samples / secs / 1e6,
-            secs / (f + 1) as f64 * (setup.frames - f - 1) as f64
+            samples / started.elapsed().as_secs_f64() / 1e6
         );
+        progress.advance(1.0, &status);
     }
-    eprintln!();
+    progress.finish();
     println!(
         "wrote {} reference frames to {}",
         setup.frames,
@@ -131,12 +165,12 @@ pub fn profile(
 /// Renders the profile's frames: the report (streaming statistics of every frame, the
 /// measured peak bandwidth) and the window of raw frames for the trace.
 pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, profile::Window)> {
+    let denoisers = crate::setup::denoiser_list(denoisers)?;
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut renderer = setup.renderer(&names)?;
     let peak = dvr_engine::passes::bandwidth::measure(renderer.ctx())
         .context("measuring the peak bandwidth")?;
-    let started = Instant::now();
     // Streaming statistics and a bounded window of raw frames: memory stays flat
     // however many frames run.
     let mut stats = profile::Stats::new();
@@ -146,16 +180,19 @@ pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, p
         window.push(timings);
     };
     let request = FrameRequest::default();
+    let mut progress = Progress::new(f64::from(setup.frames));
+    let mut rate = FrameRate::default();
     for f in 0..setup.frames {
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
             keep(done.timings);
+            rate.finished();
         }
-        progress("profile", f + 1, setup.frames, started);
+        progress.advance(1.0, &frame_status("profile", f + 1, setup.frames, &rate));
     }
     for done in renderer.flush()? {
         keep(done.timings);
     }
-    eprintln!();
+    progress.finish();
     let run = profile::RunInfo {
         device: renderer.ctx().info.name.clone(),
         scene: setup.name.clone(),
@@ -167,11 +204,7 @@ pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, p
     Ok((Profile::new(run, &stats, &window, Some(peak)), window))
 }
 
-fn progress(what: &str, done: u32, total: u32, started: Instant) {
-    let secs = started.elapsed().as_secs_f64();
-    let left = secs / done as f64 * (total - done) as f64;
-    eprint!(
-        "\r{what}: frame {done}/{total} | {:.1} fps | {left:.0} s left   ",
-        done as f64 / secs
-    );
+/// `capture: frame 12/60 | 3.4 fps`.
+fn frame_status(what: &str, submitted: u32, total: u32, rate: &FrameRate) -> String {
+    format!("{what}: frame {submitted}/{total} | {}", rate.text())
 }

@@ -1,15 +1,19 @@
 //! `dvr`: real-time Monte Carlo direct volume rendering with temporal denoising.
-//! Subcommands: explore (the interactive window), capture (offscreen sequences),
+//! Subcommands: demo (the main job: a small eval sized for the device), explore (the
+//! interactive window), capture (offscreen sequences),
 //! reference (high-sample references), eval (denoisers against references: metrics,
 //! plots, HTML), profile (per-pass GPU timing), bench (the one-call GPU benchmark), scenes
 //! (the built-in scenes).
 
 mod bench;
 mod capture;
+mod demo;
 mod eval;
 mod explore;
 mod profile;
+mod progress;
 mod setup;
+mod video;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -33,7 +37,7 @@ pub struct SceneArgs {
     #[arg(long, default_value = setup::DEFAULT_SCENE)]
     pub scene: String,
     /// Frames of the animation to render (default: the scene's own length).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::setup::parse_frames)]
     pub frames: Option<u32>,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256", value_parser = setup::parse_size)]
@@ -54,6 +58,10 @@ pub struct SceneArgs {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job (tools/run.sh): a small eval of the default scene sized for the
+    /// device (a discrete GPU: 1280x720 with 1024-spp references; otherwise about three
+    /// minutes on a 2-core CPU), with videos; opens nothing, prints the page's path.
+    Demo(demo::DemoArgs),
     /// Open a window: the path tracer and a denoiser live, with an orbit camera, a
     /// transfer-function editor, light and render controls and per-pass GPU timing.
     Explore(explore::ExploreArgs),
@@ -68,6 +76,8 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "out/capture")]
         out: PathBuf,
+        #[command(flatten)]
+        video: video::VideoArgs,
     },
     /// Render high-sample references of every frame: DIR/reference/NNNN.exr.
     Reference {
@@ -115,6 +125,7 @@ fn main() {
     let result = run(cli);
     let validation_messages = dvr_engine::gpu::validation::message_count();
     if let Err(e) = result {
+        progress::end_line();
         eprintln!("dvr: error: {}", error_chain(&e));
         std::process::exit(1);
     }
@@ -142,12 +153,14 @@ fn error_chain(e: &anyhow::Error) -> String {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
+        Command::Demo(args) => demo::run(&args),
         Command::Explore(args) => explore::run(args),
         Command::Capture {
             scene,
             denoiser,
             out,
-        } => capture::capture(&scene, &denoiser, &out),
+            video,
+        } => capture::capture(&scene, &denoiser, &out, &video),
         Command::Reference {
             scene,
             ref_spp,

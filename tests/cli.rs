@@ -259,6 +259,27 @@ fn bad_inputs_get_clear_errors() {
 }
 
 #[test]
+fn reference_samples_come_from_ref_spp() {
+    // `dvr reference --spp 512` means a 512-spp reference: the answer names --ref-spp
+    // (whether the command line or dvr rejects it).
+    let o = dvr(&[
+        "reference",
+        "--spp",
+        "512",
+        "--frames",
+        "1",
+        "--size",
+        "8x8",
+    ]);
+    let err = stderr(&o);
+    assert!(!o.status.success() && !err.contains("panicked"), "{err}");
+    assert!(
+        err.contains("--ref-spp"),
+        "should point to --ref-spp:\n{err}"
+    );
+}
+
+#[test]
 fn a_missing_device_is_reported_clearly() {
     let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
         .args([

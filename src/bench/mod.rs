@@ -174,6 +174,11 @@ fn run_eval<'a>(args: &'a BenchArgs, denoisers: &[String]) -> Result<EvalRecord<
         out: eval_out.clone(),
         volume_size: args.volume_size,
         motion: dvr_engine::denoise::MotionSource::Features,
+        video: crate::video::VideoArgs {
+            video: false,
+            video_fps: crate::video::DEFAULT_FPS,
+        },
+        note: None,
     };
     eprintln!(
         "bench: eval {} into {}",

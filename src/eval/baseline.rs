@@ -4,10 +4,10 @@
 //! axis as the denoisers (which pay path tracing at `--spp` plus their own passes).
 
 use super::overlap::Overlap;
-use super::progress::Progress;
 use super::reference::ReferenceCache;
 use super::score::{score, FrameReference};
 use super::timing::Timing;
+use crate::progress::Progress;
 use crate::setup::Setup;
 use anyhow::Result;
 use dvr_engine::image_io::to_rgb;

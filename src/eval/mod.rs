@@ -24,7 +24,8 @@
 //!
 //! One file per responsibility: [`scenes`] (which scenes, folder names, the event frame),
 //! [`reference`] (the cache), [`run`] (the frame loop), [`score`] (metrics of one frame),
-//! [`baseline`], [`csv`], [`plots`], [`html`], [`progress`].
+//! [`baseline`], [`csv`], [`plots`], [`html`]; progress lines come from
+//! [`crate::progress`].
 
 mod baseline;
 mod csv;
@@ -32,12 +33,14 @@ mod html;
 mod images;
 mod overlap;
 pub mod plots;
-mod progress;
 mod reference;
 pub mod run;
 mod scenes;
 mod score;
 pub mod timing;
+mod videos;
+
+pub use plots::init_font;
 
 use anyhow::{bail, Context, Result};
 use std::path::PathBuf;
@@ -62,7 +65,7 @@ pub struct EvalArgs {
     #[arg(long, default_value = "suite")]
     pub scene: String,
     /// Frames of each animation (default: each scene's own length).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::setup::parse_frames)]
     pub frames: Option<u32>,
     /// Samples per pixel per frame of the noisy input (default: the scene's, 2 for
     /// built-ins).
@@ -87,6 +90,11 @@ pub struct EvalArgs {
     /// for `dvr capture`; references do not depend on it).
     #[arg(long, default_value = "features", value_parser = crate::setup::parse_motion)]
     pub motion: dvr_engine::denoise::MotionSource,
+    #[command(flatten)]
+    pub video: crate::video::VideoArgs,
+    /// A paragraph shown at the top of the results page (what was run, and why).
+    #[arg(long)]
+    pub note: Option<String>,
 }
 
 /// Runs the eval; returns where its time went.
@@ -95,30 +103,16 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     if args.ref_spp == 0 {
         bail!("--ref-spp must be at least 1");
     }
-    let mut methods: Vec<String> = Vec::new();
-    for d in &args.denoiser {
-        let d = d.trim();
-        if d.is_empty() || methods.iter().any(|m| m == d) {
-            continue;
-        }
-        if !dvr_engine::denoise::NAMES.contains(&d) {
-            bail!(
-                "unknown denoiser {d:?}; available: {}",
-                dvr_engine::denoise::NAMES.join(", ")
-            );
-        }
-        methods.push(d.to_string());
-    }
-    if methods.is_empty() {
-        bail!("--denoiser names no method");
-    }
-    // Fail before hours of rendering, not after: the plots need a font.
+    let methods = crate::setup::denoiser_list(&args.denoiser)?;
+    // Fail before hours of rendering, not after: the plots need a font, videos ffmpeg.
     plots::init_font()?;
+    if args.video.video {
+        crate::video::require_ffmpeg()?;
+    }
     let names = scenes::select(&args.scene)?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    crate::setup::create_out_dir(&args.out)?;
     let plan = run::Plan::new(args, &names, &methods)?;
-    let mut progress = progress::Progress::new(plan.total_units());
+    let mut progress = crate::progress::Progress::new(plan.total_units());
     let timing = timing::Timing::shared();
     let mut results = Vec::new();
     let mut device = String::new();
@@ -129,6 +123,12 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
         device.clone_from(&r.device);
         timing.reports.time(|| -> Result<()> {
             plots::scene_plots(&args.out, &r)?;
+            if args.video.video {
+                progress.newline();
+                let dir = crate::video::dir(&args.out.join(&r.dir));
+                eprintln!("{label}: writing videos to {}", dir.display());
+                videos::write_scene_videos(&args.out, &r, args.video.video_fps)?;
+            }
             results.push(r);
             // Everything is rewritten after each scene, so an interrupted eval leaves a
             // consistent report of the scenes it finished.

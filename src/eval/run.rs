@@ -5,11 +5,11 @@
 use super::baseline::{self, BaselinePoint};
 use super::images::{write_display_png, write_flip_png};
 use super::overlap::Overlap;
-use super::progress::Progress;
 use super::reference::{frame_name, ReferenceCache, ReferenceKey};
 use super::score::{self, score, FrameReference};
 use super::timing::Timing;
 use super::{scenes, EvalArgs, GPU_WARMUP_FRAMES};
+use crate::progress::Progress;
 use crate::setup::Setup;
 use crate::SceneArgs;
 use anyhow::{Context, Result};
@@ -17,7 +17,6 @@ use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::image_io::{to_rgb, write_exr};
 use dvr_engine::metrics::Rgb32Image;
 use dvr_engine::renderer::{FrameRequest, FrameResult};
-use dvr_engine::scene::Scene;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -32,6 +31,11 @@ const UNCOUNTED_PREFIXES: [&str; 3] = ["upload_", "readback_", "host_read_"];
 
 /// One scene as planned before anything renders.
 pub struct PlannedScene {
+    /// What `--scene` named: a built-in name or a scene file's path (opened again for
+    /// rendering).
+    pub spec: String,
+    /// The label in tables, plots and the page: the scene's `name` (a file's own name or
+    /// its file stem, `dvr scenes`' name for a built-in), made unique within the eval.
     pub name: String,
     pub dir: PathBuf,
     pub frames: u32,
@@ -47,18 +51,23 @@ pub struct Plan {
 
 impl Plan {
     pub fn new(args: &EvalArgs, names: &[String], methods: &[String]) -> Result<Self> {
-        let mut scenes = Vec::new();
-        for name in names {
-            let mut scene = Scene::open(name).with_context(|| {
-                format!("opening scene {name:?} (built-in scenes: `dvr scenes`)")
-            })?;
+        let mut opened = Vec::new();
+        for spec in names {
+            let mut scene = crate::setup::open_scene(spec)?;
             if let Some(n) = args.frames {
                 scene = scene.with_frames(n)?;
             }
-            let dir = args.out.join(scenes::dir_name(name));
+            opened.push((spec, scene));
+        }
+        let labels: Vec<String> = opened.iter().map(|(_, s)| s.name.clone()).collect();
+        let mut scenes = Vec::new();
+        for ((spec, scene), (label, dir)) in opened.into_iter().zip(scenes::unique_labels(&labels))
+        {
+            let dir = args.out.join(dir);
             let key = ReferenceKey::new(&scene, args.size, args.ref_spp, args.volume_size)?;
             scenes.push(PlannedScene {
-                name: name.clone(),
+                spec: spec.clone(),
+                name: label,
                 frames: scene.frames,
                 spp: args.spp.unwrap_or(scene.render.spp),
                 references: ReferenceCache::new(&dir, key),
@@ -346,7 +355,7 @@ pub fn evaluate_scene(
     timing: &Arc<Timing>,
 ) -> Result<SceneResult> {
     progress.show(&format!("{label} | loading"));
-    let setup = Setup::new(&scene_args(args, &scene.name))?;
+    let setup = Setup::new(&scene_args(args, &scene.spec))?;
     timing
         .references
         .time(|| ensure_references(scene, &setup, args.ref_spp, progress, label, timing))?;
