@@ -6,7 +6,7 @@ use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
 use dvr_engine::denoise::MotionSource;
 use dvr_engine::gpu::GpuContext;
-use dvr_engine::passes::Extent;
+use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
 use dvr_engine::renderer::{FrameInputs, RenderSettings, Renderer};
 use dvr_engine::scene::Scene;

@@ -5,7 +5,8 @@
 mod common;
 
 use common::*;
-use dvr_engine::passes::path_trace::{Estimator, PathTraceFeatures};
+use dvr_engine::passes::path_trace::PathTraceFeatures;
+use dvr_engine::scene::{Estimator, Phase};
 
 /// Camera rays through a purely absorbing unit cube in front of a constant environment:
 /// every ray that crosses the cube along z sees exp(−μt·1).
@@ -114,7 +115,7 @@ fn henyey_greenstein_white_furnace_conserves_energy() {
     s.rr_depth = 4;
     s.hg_g = 0.7;
     s.features = PathTraceFeatures {
-        phase: dvr_engine::passes::path_trace::Phase::Hg,
+        phase: Phase::Hg,
         ..Default::default()
     };
     let volume = constant_volume(8, 1.0);
@@ -161,7 +162,7 @@ fn emissive_slab_matches_the_emission_absorption_solution() {
 #[test]
 fn environment_map_is_z_up_equirectangular() {
     use dvr_engine::renderer::scene_gpu::EnvironmentUpload;
-    use dvr_engine::renderer::uniforms::{ENV_MAP, LIGHT_ENV};
+    use dvr_engine::shaders::frame::{ENV_MAP, LIGHT_ENV};
     let (w, h) = (64u32, 32u32);
     // Radiance 1 − v: bright at the zenith (v = 0), dark at the nadir.
     let rgba: Vec<[f32; 4]> = (0..h)
@@ -191,7 +192,7 @@ fn environment_map_is_z_up_equirectangular() {
         LUT as u32,
     );
     let mut r = r.expect("renderer");
-    let light = dvr_engine::renderer::uniforms::GpuLight {
+    let light = dvr_engine::shaders::frame::GpuLight {
         position_kind: glam::Vec4::new(0.0, 0.0, 0.0, LIGHT_ENV),
         radiance: glam::Vec4::new(0.0, 0.0, 0.0, ENV_MAP),
         u_axis: glam::Vec4::new(0.0, 0.0, 0.0, 1.0), // w: intensity

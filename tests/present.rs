@@ -7,10 +7,10 @@ mod common;
 use ash::vk;
 use common::*;
 use dvr_engine::gpu::{validation, ImageDesc};
+use dvr_engine::graph::Extent;
 use dvr_engine::graph::{Frame, RenderGraph};
 use dvr_engine::metrics::{tonemap_srgb, Rgb32Image};
 use dvr_engine::passes::present::{Present, PresentLayout};
-use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::add_upload;
 
 /// Runs the present pass from `left`/`right` (w × h) into an rgba32f target.
@@ -61,8 +61,6 @@ fn present(
     ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
         .expect("submit");
     let out = read_image(&ctx, &mut graph, target);
-    let mut pass = pass;
-    pass.destroy(&ctx);
     graph.destroy(&ctx);
     assert_eq!(
         validation::message_count(),

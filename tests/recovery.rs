@@ -9,8 +9,8 @@
 mod common;
 
 use common::*;
+use dvr_engine::graph::Extent;
 use dvr_engine::metrics::{psnr, tonemap_srgb, Rgb32Image};
-use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
 use dvr_engine::renderer::FrameRequest;
 use dvr_engine::scene::Scene;

@@ -7,9 +7,9 @@ mod common;
 use ash::vk;
 use common::*;
 use dvr_engine::gpu::ImageDesc;
+use dvr_engine::graph::Extent;
 use dvr_engine::graph::{Bind, Frame, RenderGraph};
 use dvr_engine::passes::accumulate::Accumulate;
-use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::add_upload;
 
 const W: u32 = 8;
@@ -59,8 +59,6 @@ fn history_accumulates_across_frames_and_resets() {
         "running mean over frames 0..3"
     );
     assert_eq!(means[4..], [4.0, 4.5], "restarted at the reset");
-    let mut acc = acc;
-    acc.destroy(&ctx);
     graph.destroy(&ctx);
     assert_validation_clean();
 }
@@ -69,7 +67,6 @@ fn history_accumulates_across_frames_and_resets() {
 fn undeclared_resources_are_refused_naming_the_pass() {
     let ctx = context();
     let mut graph = RenderGraph::new(&ctx).expect("graph");
-    let mut acc = Accumulate::new(&ctx).expect("pipeline");
     let desc = ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT);
     let a = graph.image(&ctx, "a", desc).expect("image");
     let b = graph.image(&ctx, "b", desc).expect("image");
@@ -104,7 +101,6 @@ fn undeclared_resources_are_refused_naming_the_pass() {
         "message: {msg}"
     );
     pipeline.destroy(&ctx);
-    acc.destroy(&ctx);
     graph.destroy(&ctx);
 }
 
@@ -165,7 +161,7 @@ fn a_timed_pass_reports_the_bytes_of_what_it_declares() {
     use dvr_engine::gpu::timestamps::TimestampPool;
     let ctx = context();
     let mut graph = RenderGraph::new(&ctx).expect("graph");
-    let mut acc = Accumulate::new(&ctx).expect("pipeline");
+    let acc = Accumulate::new(&ctx).expect("pipeline");
     let mut timestamps = TimestampPool::new(&ctx).expect("timestamps");
     let input = graph
         .image(
@@ -195,7 +191,6 @@ fn a_timed_pass_reports_the_bytes_of_what_it_declares() {
     assert_eq!(timings[0].bytes, 4 * image_bytes);
     assert!(timings[0].ms >= 0.0);
     timestamps.destroy(&ctx);
-    acc.destroy(&ctx);
     graph.destroy(&ctx);
     assert_validation_clean();
 }

@@ -5,7 +5,7 @@ mod common;
 
 use common::*;
 use dvr_engine::denoise::NAMES;
-use dvr_engine::passes::Extent;
+use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
 use dvr_engine::renderer::FrameRequest;
 use dvr_engine::scene::Scene;

@@ -14,12 +14,12 @@ use common::*;
 use dvr_engine::denoise::svgf::{edge, Svgf, SvgfParams, ITERATIONS};
 use dvr_engine::denoise::{self, Changes, DenoiseInputs, Denoiser};
 use dvr_engine::gpu::{GpuContext, ImageDesc};
+use dvr_engine::graph::Extent;
 use dvr_engine::graph::{Frame, History, ImageHandle, RenderGraph};
 use dvr_engine::passes::surface_features::{FeatureImages, STEP_VOXELS};
-use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::add_upload;
-use dvr_engine::renderer::uniforms::FrameUniforms;
 use dvr_engine::renderer::FrameRequest;
+use dvr_engine::shaders::frame::FrameBlock;
 use glam::{IVec4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
@@ -174,11 +174,11 @@ impl Harness {
         let normal_img = image(g, "t.normal");
         let albedo_img = image(g, "t.albedo");
         let motion_img = image(g, "t.motion");
-        let size = std::mem::size_of::<FrameUniforms>() as u64;
+        let size = std::mem::size_of::<FrameBlock>() as u64;
         let ubo = g
             .buffer(ctx, "t.uniforms", size, MemoryLocation::CpuToGpu)
             .expect("buffer");
-        let mut u: FrameUniforms = bytemuck::Zeroable::zeroed();
+        let mut u: FrameBlock = bytemuck::Zeroable::zeroed();
         u.box_min = Vec4::new(-0.5, -0.5, -0.5, 1.0);
         u.box_max = Vec4::new(0.5, 0.5, 0.5, 1.0);
         u.dims = IVec4::new(DIMS, DIMS, DIMS, 8);

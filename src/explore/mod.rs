@@ -25,9 +25,9 @@ use ash::vk;
 use camera::OrbitCamera;
 use dvr_engine::denoise::MotionSource;
 use dvr_engine::gpu::{ContextOptions, GpuContext, Swapchain};
+use dvr_engine::graph::Extent;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png, PNG_EXPOSURE};
 use dvr_engine::passes::present::PresentLayout;
-use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_setup::{self, inputs_for, load_volume, SceneSetup};
 use dvr_engine::renderer::{
     FrameRequest, FrameResult, PresentTarget, RenderSettings, Renderer, Screenshot,

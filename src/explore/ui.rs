@@ -7,8 +7,8 @@
 use super::input::SHORTCUTS;
 use super::tf_editor::{self, TfEditor};
 use dvr_engine::gpu::timestamps::PassTiming;
-use dvr_engine::renderer::uniforms::MAX_LIGHTS;
 use dvr_engine::scene::{self, AreaLight, EnvSource, EnvironmentLight, Facing, Light, PointLight};
+use dvr_engine::shaders::frame::MAX_LIGHTS;
 use dvr_engine::transfer::TransferFunction;
 use egui::{Color32, RichText};
 use glam::{DVec2, DVec3};

@@ -5,12 +5,12 @@
 use ash::vk;
 use dvr_engine::denoise::{self, Changes, DenoiseInputs, Denoiser};
 use dvr_engine::gpu::{GpuContext, ImageDesc};
+use dvr_engine::graph::Extent;
 use dvr_engine::graph::{Frame, History, ImageHandle, RenderGraph};
 use dvr_engine::passes::surface_features::FeatureImages;
-use dvr_engine::passes::Extent;
 use dvr_engine::renderer::scene_gpu::add_upload;
-use dvr_engine::renderer::uniforms::FrameUniforms;
 use dvr_engine::renderer::CameraMatrices;
+use dvr_engine::shaders::frame::FrameBlock;
 use glam::Vec3;
 use gpu_allocator::MemoryLocation;
 
@@ -87,7 +87,7 @@ impl Harness {
                 [p.x, p.y, p.z, 1.0]
             })
             .collect();
-        let mut frame_uniforms: FrameUniforms = bytemuck::Zeroable::zeroed();
+        let mut frame_uniforms: FrameBlock = bytemuck::Zeroable::zeroed();
         frame_uniforms.view_proj = view_proj;
         frame_uniforms.inv_view_proj = inv;
         frame_uniforms.prev_view_proj = view_proj;
@@ -114,7 +114,7 @@ impl Harness {
             .buffer(
                 ctx,
                 "h.uniforms",
-                std::mem::size_of::<FrameUniforms>() as u64,
+                std::mem::size_of::<FrameBlock>() as u64,
                 MemoryLocation::CpuToGpu,
             )
             .expect("buffer");

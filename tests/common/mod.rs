@@ -4,10 +4,10 @@
 #![allow(dead_code)]
 
 use dvr_engine::gpu::{validation, GpuContext};
-use dvr_engine::passes::Extent;
+use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_gpu::{BrickRanges, LutUpload, VolumeFormat, VolumeUpload};
-use dvr_engine::renderer::uniforms::{GpuLight, ENV_CONSTANT, LIGHT_ENV, LIGHT_POINT};
 use dvr_engine::renderer::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
+use dvr_engine::shaders::frame::{GpuLight, ENV_CONSTANT, LIGHT_ENV, LIGHT_POINT};
 use glam::{Vec3, Vec4};
 
 pub const LUT: usize = 256;

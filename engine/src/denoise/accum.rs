@@ -44,8 +44,4 @@ impl Denoiser for Accum {
             input.size,
         )
     }
-
-    fn destroy(&mut self, ctx: &GpuContext) {
-        self.pass.destroy(ctx);
-    }
 }

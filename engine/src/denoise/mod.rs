@@ -18,10 +18,12 @@ pub use wrls::{Wrls, WrlsVariant};
 
 use crate::error::{EngineError, Result};
 use crate::gpu::GpuContext;
-use crate::graph::{Bind, BufferHandle, Frame, History, ImageHandle, PassBuilder, RenderGraph};
+use crate::graph::{
+    Bind, Bindings, BufferHandle, Extent, Frame, History, ImageHandle, PassBuilder, RenderGraph,
+};
 use crate::passes::path_trace::PathTraceFeatures;
 use crate::passes::surface_features::FeatureImages;
-use crate::passes::{Extent, SceneBindings};
+use crate::passes::SceneBindings;
 
 /// Disocclusion tolerance of the shared reprojection (include/reproject.glsl): how far,
 /// in pixels, last frame's surface may land from this pixel when projected back.
@@ -142,6 +144,16 @@ pub struct Reprojection {
 }
 
 impl Reprojection {
+    /// Binds the frame block, motion and positions to the variables include/frame.glsl
+    /// and include/reproject.glsl declare.
+    pub fn bind(&self, b: &mut Bindings) {
+        b.uniform("frame", self.uniforms)
+            .read("motion", self.motion)
+            .read("position_cur", self.position_cur)
+            .sampled_nearest("position_prev", self.position_prev);
+    }
+
+    /// Transitional (wrls.rs; others use [`Reprojection::bind`]).
     pub fn declare(&self, b: &mut PassBuilder) {
         b.uniform(self.uniforms)
             .read(self.motion)
@@ -149,7 +161,7 @@ impl Reprojection {
             .sampled(self.position_prev);
     }
 
-    /// Bindings named as in include/reproject.glsl and include/frame.glsl.
+    /// Transitional (wrls.rs): what [`Reprojection::declare`] binds to.
     pub fn binds(&self) -> Vec<(&'static str, Bind)> {
         vec![
             ("frame", Bind::Buffer(self.uniforms)),
@@ -171,7 +183,9 @@ pub trait Denoiser {
         frame: &mut Frame<'f>,
         input: &DenoiseInputs,
     ) -> Result<ImageHandle>;
-    fn destroy(&mut self, ctx: &GpuContext);
+    /// Transitional: pipelines live in the context's cache, so there is nothing to
+    /// release; wrls.rs still overrides this until it moves to the cache.
+    fn destroy(&mut self, _ctx: &GpuContext) {}
     /// Whether the frame must render the surface-features pass for this denoiser (it
     /// costs about as much as the path trace on lavapipe, so it runs only when used).
     fn uses_surface_features(&self) -> bool {

@@ -21,6 +21,4 @@ impl Denoiser for Passthrough {
     ) -> Result<ImageHandle> {
         Ok(input.noisy)
     }
-
-    fn destroy(&mut self, _ctx: &GpuContext) {}
 }

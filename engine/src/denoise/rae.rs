@@ -30,13 +30,51 @@
 
 use super::{DenoiseInputs, Denoiser};
 use crate::error::{EngineError, Result};
-use crate::gpu::{ComputePipeline, GpuContext, ImageDesc};
-use crate::graph::{Bind, BufferHandle, Frame, ImageHandle, RenderGraph};
-use crate::renderer::uniforms::{RaeConvPush, RaeIoPush, RaePoolPush};
+use crate::gpu::{GpuContext, ImageDesc, Pipeline};
+use crate::gpu_block;
+use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use std::cell::Cell;
 use std::path::{Path, PathBuf};
+
+gpu_block! {
+    /// `RaeConvPush` in include/rae_conv.glsl (rae_conv.comp and its fp16 variant).
+    pub struct RaeConvPush {
+        pub width: u32,
+        pub height: u32,
+        pub groups_a: u32,
+        pub groups_b: u32,
+        pub a_upsample: u32,
+        pub b_enabled: u32,
+        pub weights_offset: u32,
+        pub bias_offset: u32,
+        pub slope: f32,
+        pub pad0: u32,
+        pub pad1: u32,
+        pub pad2: u32,
+    }
+}
+
+gpu_block! {
+    /// `RaePoolPush` in include/rae_pool.glsl.
+    pub struct RaePoolPush {
+        pub width: u32,
+        pub height: u32,
+        pub groups: u32,
+        pub pad0: u32,
+    }
+}
+
+gpu_block! {
+    /// `RaeIoPush` in include/rae_io.glsl (the input and output transforms).
+    pub struct RaeIoPush {
+        pub width: u32,
+        pub height: u32,
+        pub src_width: u32,
+        pub src_height: u32,
+    }
+}
 
 /// Channels of the network's input and output (colour only).
 pub const IN_CHANNELS: u32 = 3;
@@ -290,10 +328,10 @@ pub struct Rae {
     name: String,
     pub weights: RaeWeights,
     precision: Precision,
-    conv: ComputePipeline,
-    pool: ComputePipeline,
-    input: ComputePipeline,
-    output: ComputePipeline,
+    conv: Pipeline<RaeConvPush>,
+    pool: Pipeline<RaePoolPush>,
+    input: Pipeline<RaeIoPush>,
+    output: Pipeline<RaeIoPush>,
     /// The weight buffer this instance last filled (filled once per graph buffer).
     uploaded: Cell<Option<BufferHandle>>,
 }
@@ -306,15 +344,14 @@ impl Rae {
         weights: RaeWeights,
         precision: Precision,
     ) -> Result<Self> {
-        let pipeline = |stem: &str| ComputePipeline::new(ctx, &precision.shader(stem), &[]);
         Ok(Self {
             name: name.to_string(),
             weights,
             precision,
-            conv: pipeline("rae_conv")?,
-            pool: pipeline("rae_pool")?,
-            input: pipeline("rae_input")?,
-            output: pipeline("rae_output")?,
+            conv: ctx.pipeline(&precision.shader("rae_conv"), &[])?,
+            pool: ctx.pipeline(&precision.shader("rae_pool"), &[])?,
+            input: ctx.pipeline(&precision.shader("rae_input"), &[])?,
+            output: ctx.pipeline(&precision.shader("rae_output"), &[])?,
             uploaded: Cell::new(None),
         })
     }
@@ -332,10 +369,10 @@ impl Rae {
 
 /// The input or output transform (rae_input / rae_output): reads `src` of `src_size`,
 /// writes all of `dst` of `dst_size` (padding by replication or cropping).
-fn add_io_pass<'f>(
-    frame: &mut Frame<'f>,
+fn add_io_pass(
+    frame: &mut Frame<'_>,
     name: String,
-    pipeline: &'f ComputePipeline,
+    pipeline: &Pipeline<RaeIoPush>,
     src: ImageHandle,
     src_size: (u32, u32),
     dst: ImageHandle,
@@ -347,21 +384,9 @@ fn add_io_pass<'f>(
         src_width: src_size.0,
         src_height: src_size.1,
     };
-    frame.add_pass(
-        name,
-        |b| {
-            b.read(src).write(dst);
-        },
-        move |pc| {
-            let binds = [("src", Bind::Image(src)), ("dst", Bind::Image(dst))];
-            pc.dispatch(
-                pipeline,
-                &binds,
-                &push,
-                pipeline.groups_2d(dst_size.0, dst_size.1),
-            )
-        },
-    );
+    frame.add_compute(name, pipeline, push, [dst_size.0, dst_size.1, 1], |b| {
+        b.read("src", src).write("dst", dst);
+    });
 }
 
 struct Conv<'a> {
@@ -522,18 +547,11 @@ impl Denoiser for Rae {
                     groups: g,
                     pad0: 0,
                 };
-                let pool = &self.pool;
-                frame.add_pass(
-                    format!("{n}.pool{}", p.level),
-                    |b| {
-                        b.read(src).write(dst);
-                    },
-                    move |pc| {
-                        let [gx, gy, _] = pool.groups_2d(w, h);
-                        let binds = [("src", Bind::Image(src)), ("dst", Bind::Image(dst))];
-                        pc.dispatch(pool, &binds, &push, [gx, gy, g])
-                    },
-                );
+                // One workgroup layer per channel group.
+                let name = format!("{n}.pool{}", p.level);
+                frame.add_compute(name, &self.pool, push, [w, h, g], |b| {
+                    b.read("src", src).write("dst", dst);
+                });
             }
             let layer = c.layer;
             let (w, h) = c.size;
@@ -554,24 +572,15 @@ impl Denoiser for Rae {
             let (a, dst) = (c.a, c.dst);
             // Without a second input the first is bound twice (the shader skips it).
             let b_img = c.b.unwrap_or(a);
-            let conv = &self.conv;
+            // One workgroup layer per output channel group.
             let g = groups(layer.out);
-            frame.add_pass(
-                format!("{n}.{}", layer.name),
-                |b| {
-                    b.read(a).read(b_img).write(dst).read(weights);
-                },
-                move |pc| {
-                    let [gx, gy, _] = conv.groups_2d(w, h);
-                    let binds = [
-                        ("in_a", Bind::Image(a)),
-                        ("in_b", Bind::Image(b_img)),
-                        ("dst", Bind::Image(dst)),
-                        ("weights", Bind::Buffer(weights)),
-                    ];
-                    pc.dispatch(conv, &binds, &push, [gx, gy, g])
-                },
-            );
+            let name = format!("{n}.{}", layer.name);
+            frame.add_compute(name, &self.conv, push, [w, h, g], |b| {
+                b.read("in_a", a)
+                    .read("in_b", b_img)
+                    .write("dst", dst)
+                    .read("weights", weights);
+            });
         }
 
         let out = graph.image(
@@ -589,12 +598,5 @@ impl Denoiser for Rae {
             (fw, fh),
         );
         Ok(out)
-    }
-
-    fn destroy(&mut self, ctx: &GpuContext) {
-        self.conv.destroy(ctx);
-        self.pool.destroy(ctx);
-        self.input.destroy(ctx);
-        self.output.destroy(ctx);
     }
 }

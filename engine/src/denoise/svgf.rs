@@ -29,11 +29,59 @@
 
 use super::{DenoiseInputs, Denoiser, MotionSource};
 use crate::error::Result;
-use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
-use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
+use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::gpu_block;
+use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::surface_features::STEP_VOXELS;
-use crate::renderer::uniforms::{SvgfAtrousPush, SvgfTemporalPush, SvgfVariancePush};
 use ash::vk;
+use glam::Vec4;
+
+gpu_block! {
+    /// `SvgfTemporalPush` in svgf_temporal.comp.
+    pub struct SvgfTemporalPush {
+        pub camera: Vec4,
+        pub width: u32,
+        pub height: u32,
+        pub history_valid: u32,
+        pub tolerance: f32,
+        pub color_alpha: f32,
+        pub moments_alpha: f32,
+        pub demod_eps: f32,
+        pub feature_step: f32,
+    }
+}
+
+gpu_block! {
+    /// `SvgfVariancePush` in svgf_variance.comp.
+    pub struct SvgfVariancePush {
+        pub width: u32,
+        pub height: u32,
+        pub min_history: f32,
+        pub sigma_z: f32,
+        pub sigma_n: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+        pub pad2: f32,
+    }
+}
+
+gpu_block! {
+    /// `SvgfAtrousPush` in svgf_atrous.comp.
+    pub struct SvgfAtrousPush {
+        pub width: u32,
+        pub height: u32,
+        pub step: i32,
+        pub modulate: u32,
+        pub sigma_z: f32,
+        pub sigma_n: f32,
+        pub sigma_l: f32,
+        pub luminance_eps: f32,
+        pub demod_eps: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+        pub pad2: f32,
+    }
+}
 
 /// Number of à-trous iterations (steps 1, 2, 4, 8, 16).
 pub const ITERATIONS: usize = 5;
@@ -76,9 +124,9 @@ impl Default for SvgfParams {
 }
 
 pub struct Svgf {
-    temporal: ComputePipeline,
-    variance: ComputePipeline,
-    atrous: ComputePipeline,
+    temporal: Pipeline<SvgfTemporalPush>,
+    variance: Pipeline<SvgfVariancePush>,
+    atrous: Pipeline<SvgfAtrousPush>,
     pub params: SvgfParams,
     /// 0: motion from the first real collision (the paper's, as `ours`), 1: from features.
     pub motion: MotionSource,
@@ -91,13 +139,12 @@ impl Svgf {
 
     pub fn new(ctx: &GpuContext, motion: MotionSource) -> Result<Self> {
         Ok(Self {
-            temporal: ComputePipeline::new(
-                ctx,
+            temporal: ctx.pipeline(
                 "svgf_temporal",
                 &[("MOTION_SOURCE", SpecValue::I32(motion.spec()))],
             )?,
-            variance: ComputePipeline::new(ctx, "svgf_variance", &[])?,
-            atrous: ComputePipeline::new(ctx, "svgf_atrous", &[])?,
+            variance: ctx.pipeline("svgf_variance", &[])?,
+            atrous: ctx.pipeline("svgf_atrous", &[])?,
             params: SvgfParams::default(),
             motion,
         })
@@ -146,35 +193,17 @@ impl Denoiser for Svgf {
             demod_eps: p.demod_eps,
             feature_step: STEP_VOXELS,
         };
-        frame.add_pass(
-            "svgf.temporal",
-            |b| {
-                reproj.declare(b);
-                b.read(noisy)
-                    .read(albedo)
-                    .read(normal)
-                    .sampled(color.prev)
-                    .sampled(moments.prev)
-                    .write(ping)
-                    .write(moments.cur)
-                    .write(geometry);
-            },
-            move |pc| {
-                let mut binds = reproj.binds();
-                binds.extend([
-                    ("noisy", Bind::Image(noisy)),
-                    ("feature_albedo", Bind::Image(albedo)),
-                    ("feature_normal", Bind::Image(normal)),
-                    ("color_prev", Bind::Image(color.prev)),
-                    ("moments_prev", Bind::Image(moments.prev)),
-                    ("integrated", Bind::Image(ping)),
-                    ("moments_cur", Bind::Image(moments.cur)),
-                    ("geometry", Bind::Image(geometry)),
-                ]);
-                let groups = self.temporal.groups_2d(size.width, size.height);
-                pc.dispatch(&self.temporal, &binds, &push, groups)
-            },
-        );
+        frame.add_compute("svgf.temporal", &self.temporal, push, size, |b| {
+            reproj.bind(b);
+            b.read("noisy", noisy)
+                .read("feature_albedo", albedo)
+                .read("feature_normal", normal)
+                .sampled("color_prev", color.prev)
+                .sampled("moments_prev", moments.prev)
+                .write("integrated", ping)
+                .write("moments_cur", moments.cur)
+                .write("geometry", geometry);
+        });
 
         let vpush = SvgfVariancePush {
             width: size.width,
@@ -186,22 +215,12 @@ impl Denoiser for Svgf {
             pad1: 0.0,
             pad2: 0.0,
         };
-        frame.add_pass(
-            "svgf.variance",
-            |b| {
-                b.read(ping).read(moments.cur).read(geometry).write(pong);
-            },
-            move |pc| {
-                let binds = [
-                    ("integrated", Bind::Image(ping)),
-                    ("moments", Bind::Image(moments.cur)),
-                    ("geometry", Bind::Image(geometry)),
-                    ("estimated", Bind::Image(pong)),
-                ];
-                let groups = self.variance.groups_2d(size.width, size.height);
-                pc.dispatch(&self.variance, &binds, &vpush, groups)
-            },
-        );
+        frame.add_compute("svgf.variance", &self.variance, vpush, size, |b| {
+            b.read("integrated", ping)
+                .read("moments", moments.cur)
+                .read("geometry", geometry)
+                .write("estimated", pong);
+        });
 
         // pong → colour history → ping → pong → ping → out.
         let mut src = pong;
@@ -227,31 +246,16 @@ impl Denoiser for Svgf {
                 pad1: 0.0,
                 pad2: 0.0,
             };
-            frame.add_pass(
-                format!("svgf.atrous{i}"),
-                |b| {
-                    b.read(src).read(geometry).read(albedo).write(dst);
-                },
-                move |pc| {
-                    let binds = [
-                        ("color_in", Bind::Image(src)),
-                        ("geometry", Bind::Image(geometry)),
-                        ("feature_albedo", Bind::Image(albedo)),
-                        ("color_out", Bind::Image(dst)),
-                    ];
-                    let groups = self.atrous.groups_2d(size.width, size.height);
-                    pc.dispatch(&self.atrous, &binds, &apush, groups)
-                },
-            );
+            let name = format!("svgf.atrous{i}");
+            frame.add_compute(name, &self.atrous, apush, size, |b| {
+                b.read("color_in", src)
+                    .read("geometry", geometry)
+                    .read("feature_albedo", albedo)
+                    .write("color_out", dst);
+            });
             src = dst;
         }
         Ok(out)
-    }
-
-    fn destroy(&mut self, ctx: &GpuContext) {
-        self.temporal.destroy(ctx);
-        self.variance.destroy(ctx);
-        self.atrous.destroy(ctx);
     }
 }
 

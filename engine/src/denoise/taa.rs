@@ -7,10 +7,26 @@
 
 use super::{DenoiseInputs, Denoiser, MotionSource};
 use crate::error::Result;
-use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
-use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
-use crate::renderer::uniforms::TaaPush;
+use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::gpu_block;
+use crate::graph::{Frame, ImageHandle, RenderGraph};
 use ash::vk;
+use glam::Vec4;
+
+gpu_block! {
+    /// `TaaPush` in taa.comp.
+    pub struct TaaPush {
+        pub camera: Vec4,
+        pub width: u32,
+        pub height: u32,
+        pub history_valid: u32,
+        pub alpha: f32,
+        pub gamma: f32,
+        pub tolerance: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+    }
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TaaParams {
@@ -33,7 +49,7 @@ impl Default for TaaParams {
 }
 
 pub struct Taa {
-    pipeline: ComputePipeline,
+    pipeline: Pipeline<TaaPush>,
     pub params: TaaParams,
     /// 0: motion from the first real collision (the paper's, as `ours`), 1: from features.
     pub motion: MotionSource,
@@ -45,11 +61,7 @@ impl Taa {
 
     pub fn new(ctx: &GpuContext, motion: MotionSource) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(
-                ctx,
-                "taa",
-                &[("MOTION_SOURCE", SpecValue::I32(motion.spec()))],
-            )?,
+            pipeline: ctx.pipeline("taa", &[("MOTION_SOURCE", SpecValue::I32(motion.spec()))])?,
             params: TaaParams::default(),
             motion,
         })
@@ -90,27 +102,12 @@ impl Denoiser for Taa {
             pad1: 0.0,
         };
         let noisy = input.noisy;
-        frame.add_pass(
-            "taa",
-            |b| {
-                reproj.declare(b);
-                b.read(noisy).sampled(color.prev).write(color.cur);
-            },
-            move |pc| {
-                let mut binds = reproj.binds();
-                binds.extend([
-                    ("noisy", Bind::Image(noisy)),
-                    ("history_prev", Bind::Image(color.prev)),
-                    ("history_cur", Bind::Image(color.cur)),
-                ]);
-                let groups = self.pipeline.groups_2d(size.width, size.height);
-                pc.dispatch(&self.pipeline, &binds, &push, groups)
-            },
-        );
+        frame.add_compute("taa", &self.pipeline, push, size, |b| {
+            reproj.bind(b);
+            b.read("noisy", noisy)
+                .sampled("history_prev", color.prev)
+                .write("history_cur", color.cur);
+        });
         Ok(color.cur)
-    }
-
-    fn destroy(&mut self, ctx: &GpuContext) {
-        self.pipeline.destroy(ctx);
     }
 }

@@ -49,6 +49,8 @@ pub struct GpuContext {
     pub validation_enabled: bool,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     one_shot_pool: vk::CommandPool,
+    /// Every pipeline built through [`GpuContext::pipeline`], destroyed with the device.
+    pub(crate) pipelines: super::pipeline::PipelineCache,
 }
 
 /// Options for [`GpuContext::new`].
@@ -200,6 +202,7 @@ impl GpuContext {
             validation_enabled,
             messenger,
             one_shot_pool,
+            pipelines: Default::default(),
         })
     }
 
@@ -248,6 +251,8 @@ impl Drop for GpuContext {
     fn drop(&mut self) {
         unsafe {
             let _ = self.device.device_wait_idle();
+            let pipelines = std::mem::take(&mut self.pipelines);
+            pipelines.destroy(self);
             self.device.destroy_command_pool(self.one_shot_pool, None);
             ManuallyDrop::drop(&mut self.allocator);
             self.device.destroy_device(None);

@@ -10,6 +10,6 @@ pub mod timestamps;
 pub mod validation;
 
 pub use context::{ContextOptions, DeviceInfo, GpuContext};
-pub use pipeline::{ComputePipeline, SpecValue};
+pub use pipeline::{ComputePipeline, Pipeline, SpecValue};
 pub use resources::{GpuBuffer, GpuImage, ImageDesc};
 pub use swapchain::{AcquiredImage, Swapchain};

@@ -1,13 +1,16 @@
 //! What a pass sees while it records: its declared resources and nothing else.
 
 use super::access::Access;
+use super::frame::Bound;
 use super::resources::{BufferHandle, ImageHandle, Res};
 use super::RenderGraph;
 use crate::error::{EngineError, Result};
-use crate::gpu::{ComputePipeline, GpuContext};
+use crate::gpu::{ComputePipeline, GpuContext, Pipeline};
+use crate::shaders::GpuBlock;
 use ash::vk;
 
-/// A resource bound to a shader variable.
+/// A resource bound to a shader variable, for [`PassContext::dispatch`] (the transitional
+/// API wrls.rs uses; other passes declare bindings with [`super::Bindings`]).
 #[derive(Clone, Copy, Debug)]
 pub enum Bind {
     /// Storage image, or sampled with the linear clamp sampler.
@@ -35,6 +38,7 @@ pub struct PassContext<'a> {
     graph: &'a RenderGraph,
     pass: &'a str,
     declared: &'a [(Res, Access)],
+    bound: &'a [Bound],
     samplers: [vk::Sampler; 2],
 }
 
@@ -45,6 +49,7 @@ impl<'a> PassContext<'a> {
         graph: &'a RenderGraph,
         pass: &'a str,
         declared: &'a [(Res, Access)],
+        bound: &'a [Bound],
         samplers: [vk::Sampler; 2],
     ) -> Self {
         Self {
@@ -53,6 +58,7 @@ impl<'a> PassContext<'a> {
             graph,
             pass,
             declared,
+            bound,
             samplers,
         }
     }
@@ -102,14 +108,51 @@ impl<'a> PassContext<'a> {
         Ok(self.graph.buffers[h.0 as usize].buffer.buffer)
     }
 
+    /// Binds what the pass declared with [`super::Bindings`] to the shader variables it
+    /// named, pushes `push` and dispatches `groups` workgroups.
+    pub(crate) fn dispatch_bound<P: GpuBlock>(
+        &mut self,
+        pipeline: &Pipeline<P>,
+        push: &P,
+        groups: [u32; 3],
+    ) -> Result<()> {
+        let bound: Vec<_> = self
+            .bound
+            .iter()
+            .map(|b| (b.var, b.res, b.nearest))
+            .collect();
+        self.bind_and_dispatch(pipeline, &bound, bytemuck::bytes_of(push), groups)
+    }
+
     /// Binds `bindings` to the shader variables of the same names, pushes `push` and
-    /// dispatches. Every reflected binding must be bound, every bound name must exist,
-    /// and each resource's declared access must suit the descriptor type.
+    /// dispatches. Transitional: wrls.rs binds this way; every other pass declares its
+    /// bindings once with [`super::Bindings`].
     pub fn dispatch<P: bytemuck::Pod>(
         &mut self,
         pipeline: &ComputePipeline,
         bindings: &[(&str, Bind)],
         push: &P,
+        groups: [u32; 3],
+    ) -> Result<()> {
+        let bound: Vec<_> = bindings
+            .iter()
+            .map(|&(var, bind)| match bind {
+                Bind::Image(h) => (var, Res::Image(h), false),
+                Bind::ImageNearest(h) => (var, Res::Image(h), true),
+                Bind::Buffer(h) => (var, Res::Buffer(h), false),
+            })
+            .collect();
+        self.bind_and_dispatch(pipeline, &bound, bytemuck::bytes_of(push), groups)
+    }
+
+    /// Binds (shader variable, resource, nearest sampler) triples and dispatches. Every
+    /// reflected binding must be bound, and each resource's declared access must suit
+    /// the descriptor type.
+    fn bind_and_dispatch(
+        &mut self,
+        pipeline: &ComputePipeline,
+        bindings: &[(&str, Res, bool)],
+        bytes: &[u8],
         groups: [u32; 3],
     ) -> Result<()> {
         // Names the shader does not reflect are skipped: the optimiser drops bindings a
@@ -119,16 +162,16 @@ impl<'a> PassContext<'a> {
         let mut buffer_infos = Vec::with_capacity(bindings.len());
         let mut plan = Vec::with_capacity(pipeline.reflection.bindings.len());
         for b in &pipeline.reflection.bindings {
-            let Some((_, bind)) = bindings.iter().find(|(n, _)| *n == b.name) else {
+            let Some(&(_, res, nearest)) = bindings.iter().find(|(n, ..)| *n == b.name) else {
                 return Err(self.err(format!(
                     "shader {} binding {:?} (binding {}) is not bound",
                     pipeline.name, b.name, b.binding
                 )));
             };
-            let (res, sampler) = match *bind {
-                Bind::Image(h) => (Res::Image(h), self.samplers[0]),
-                Bind::ImageNearest(h) => (Res::Image(h), self.samplers[1]),
-                Bind::Buffer(h) => (Res::Buffer(h), vk::Sampler::null()),
+            let sampler = match (res, nearest) {
+                (Res::Buffer(_), _) => vk::Sampler::null(),
+                (_, false) => self.samplers[0],
+                (_, true) => self.samplers[1],
             };
             let access = self.access_of(res)?;
             let ok = match b.ty {
@@ -187,7 +230,6 @@ impl<'a> PassContext<'a> {
                 }
             })
             .collect();
-        let bytes = bytemuck::bytes_of(push);
         if bytes.len() as u32 != pipeline.reflection.push_constant_size
             && pipeline.reflection.push_constant_size != 0
         {

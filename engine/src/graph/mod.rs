@@ -4,15 +4,17 @@
 //! else in the engine issues barriers), clears newly allocated resources, wraps each pass
 //! in a debug label and a timestamp pair keyed by the pass name, and swaps history
 //! resources at the end of the frame. A pass records commands through a [`PassContext`]
-//! that refuses resources the pass did not declare.
+//! that refuses resources the pass did not declare. How a frame is declared: [`Frame`].
 
 pub mod access;
 mod context;
+mod frame;
 mod resources;
 
 pub use access::{Access, Barrier, ResourceState};
 pub use context::{Bind, PassContext};
-pub use resources::{BufferHandle, History, ImageHandle, Res};
+pub use frame::{Bindings, Frame, PassBuilder};
+pub use resources::{BufferHandle, Extent, History, ImageHandle, Res};
 
 use crate::error::{EngineError, Result};
 use crate::gpu::resources::format_size;
@@ -22,128 +24,6 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 use resources::{BufferSlot, HistorySlot, ImageSlot};
 use std::collections::HashMap;
-
-type RecordFn<'f> = Box<dyn FnOnce(&mut PassContext) -> Result<()> + 'f>;
-
-/// One declared pass of the frame being built.
-pub struct Pass<'f> {
-    name: String,
-    accesses: Vec<(Res, Access)>,
-    record: Option<RecordFn<'f>>,
-}
-
-/// Declares a pass's accesses. Reads take the handle; so do writes, but they are
-/// listed separately so a reader sees at a glance what a pass produces.
-pub struct PassBuilder {
-    accesses: Vec<(Res, Access)>,
-}
-
-impl PassBuilder {
-    pub fn sampled(&mut self, h: ImageHandle) -> &mut Self {
-        self.accesses.push((Res::Image(h), Access::Sampled));
-        self
-    }
-    pub fn read(&mut self, h: impl Into<Res>) -> &mut Self {
-        self.accesses.push((h.into(), Access::StorageRead));
-        self
-    }
-    pub fn write(&mut self, h: impl Into<Res>) -> &mut Self {
-        self.accesses.push((h.into(), Access::StorageWrite));
-        self
-    }
-    pub fn read_write(&mut self, h: impl Into<Res>) -> &mut Self {
-        self.accesses.push((h.into(), Access::StorageReadWrite));
-        self
-    }
-    pub fn uniform(&mut self, h: BufferHandle) -> &mut Self {
-        self.accesses.push((Res::Buffer(h), Access::Uniform));
-        self
-    }
-    pub fn transfer_src(&mut self, h: impl Into<Res>) -> &mut Self {
-        self.accesses.push((h.into(), Access::TransferSrc));
-        self
-    }
-    pub fn transfer_dst(&mut self, h: impl Into<Res>) -> &mut Self {
-        self.accesses.push((h.into(), Access::TransferDst));
-        self
-    }
-    pub fn host_read(&mut self, h: BufferHandle) -> &mut Self {
-        self.accesses.push((Res::Buffer(h), Access::HostRead));
-        self
-    }
-    /// Drawn to by a graphics pipeline (the pass begins and ends its own rendering).
-    pub fn color_attachment(&mut self, h: ImageHandle) -> &mut Self {
-        self.accesses.push((Res::Image(h), Access::ColorAttachment));
-        self
-    }
-}
-
-/// The passes of one frame, in submission order.
-#[derive(Default)]
-pub struct Frame<'f> {
-    passes: Vec<Pass<'f>>,
-}
-
-impl<'f> Frame<'f> {
-    pub fn new() -> Self {
-        Self { passes: Vec::new() }
-    }
-
-    /// Adds a pass: `declare` lists its accesses, `record` records its commands.
-    pub fn add_pass(
-        &mut self,
-        name: impl Into<String>,
-        declare: impl FnOnce(&mut PassBuilder),
-        record: impl FnOnce(&mut PassContext) -> Result<()> + 'f,
-    ) {
-        let mut b = PassBuilder {
-            accesses: Vec::new(),
-        };
-        declare(&mut b);
-        self.passes.push(Pass {
-            name: name.into(),
-            accesses: b.accesses,
-            record: Some(Box::new(record)),
-        });
-    }
-
-    /// Copies `image` into the host-visible `buffer` and makes it readable by the host:
-    /// passes `readback_<label>` (the copy) and `host_read_<label>`.
-    pub fn add_readback(&mut self, label: &str, image: ImageHandle, buffer: BufferHandle) {
-        self.add_pass(
-            format!("readback_{label}"),
-            |b| {
-                b.transfer_src(image).transfer_dst(buffer);
-            },
-            move |pc| pc.copy_image_to_buffer(image, buffer),
-        );
-        self.add_host_read(format!("host_read_{label}"), buffer);
-    }
-
-    /// A pass with accesses but no commands: makes a readback visible to the host.
-    pub fn add_host_read(&mut self, name: impl Into<String>, buffer: BufferHandle) {
-        self.passes.push(Pass {
-            name: name.into(),
-            accesses: vec![(Res::Buffer(buffer), Access::HostRead)],
-            record: None,
-        });
-    }
-
-    /// A pass with no commands that hands `image` (an imported swapchain image) to the
-    /// presentation engine: the graph transitions it to `PRESENT_SRC_KHR`. It must be
-    /// the image's last access in the frame.
-    pub fn add_present(&mut self, name: impl Into<String>, image: ImageHandle) {
-        self.passes.push(Pass {
-            name: name.into(),
-            accesses: vec![(Res::Image(image), Access::Present)],
-            record: None,
-        });
-    }
-
-    pub fn pass_names(&self) -> Vec<&str> {
-        self.passes.iter().map(|p| p.name.as_str()).collect()
-    }
-}
 
 /// Persistent graph resources and their synchronisation state.
 pub struct RenderGraph {
@@ -483,6 +363,7 @@ impl RenderGraph {
                 self,
                 &pass.name,
                 &pass.accesses,
+                &pass.bound,
                 [self.linear_sampler, self.nearest_sampler],
             );
             record(&mut pc)?;

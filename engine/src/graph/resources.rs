@@ -29,6 +29,19 @@ impl From<BufferHandle> for Res {
     }
 }
 
+/// Image size of a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Extent {
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Extent {
+    pub fn pixels(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+}
+
 /// The two sides of a history resource for this frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct History {

@@ -1,32 +1,43 @@
 //! Progressive accumulation (shaders/glsl/accumulate.comp): a running sum in a history
 //! pair and its mean. The `accum` denoiser and reference rendering both use it.
 
-use super::Extent;
 use crate::error::Result;
-use crate::gpu::{ComputePipeline, GpuContext, ImageDesc};
-use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
-use crate::renderer::uniforms::AccumulatePush;
+use crate::gpu::{GpuContext, ImageDesc, Pipeline};
+use crate::gpu_block;
+use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
 use ash::vk;
 
+gpu_block! {
+    /// `AccumulatePush` in accumulate.comp.
+    pub struct AccumulatePush {
+        pub width: u32,
+        pub height: u32,
+        /// 0: start over.
+        pub history_valid: u32,
+        /// Samples in this frame's radiance.
+        pub weight: f32,
+    }
+}
+
 pub struct Accumulate {
-    pipeline: ComputePipeline,
+    pipeline: Pipeline<AccumulatePush>,
 }
 
 impl Accumulate {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(ctx, "accumulate", &[])?,
+            pipeline: ctx.pipeline("accumulate", &[])?,
         })
     }
 
     /// Adds `radiance` (carrying `weight` samples) to the running sum `name`; returns the
     /// running mean. The sum restarts when its history is invalid (reset or first frame).
     #[allow(clippy::too_many_arguments)]
-    pub fn add<'f>(
-        &'f self,
+    pub fn add(
+        &self,
         ctx: &GpuContext,
         graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
+        frame: &mut Frame<'_>,
         name: &str,
         radiance: ImageHandle,
         weight: f32,
@@ -41,26 +52,12 @@ impl Accumulate {
             history_valid: sum.valid as u32,
             weight,
         };
-        frame.add_pass(
-            name,
-            |b| {
-                b.read(radiance).read(sum.prev).write(sum.cur).write(mean);
-            },
-            move |pc| {
-                let binds = [
-                    ("radiance", Bind::Image(radiance)),
-                    ("sum_prev", Bind::Image(sum.prev)),
-                    ("sum_cur", Bind::Image(sum.cur)),
-                    ("mean", Bind::Image(mean)),
-                ];
-                let groups = self.pipeline.groups_2d(size.width, size.height);
-                pc.dispatch(&self.pipeline, &binds, &push, groups)
-            },
-        );
+        frame.add_compute(name, &self.pipeline, push, size, |b| {
+            b.read("radiance", radiance)
+                .read("sum_prev", sum.prev)
+                .write("sum_cur", sum.cur)
+                .write("mean", mean);
+        });
         Ok(mean)
-    }
-
-    pub fn destroy(&mut self, ctx: &GpuContext) {
-        self.pipeline.destroy(ctx);
     }
 }

@@ -1,5 +1,7 @@
 //! One GPU pass per file, each with the shader of the same name in shaders/glsl. A pass
-//! owns its pipeline and adds itself to a frame, declaring exactly what it touches.
+//! holds its pipeline (from the context's cache), declares its push-constant block beside
+//! itself, and adds itself to a frame, declaring exactly what it touches and the shader
+//! variable each resource binds to.
 
 pub mod accumulate;
 pub mod bandwidth;
@@ -8,7 +10,7 @@ pub mod path_trace;
 pub mod present;
 pub mod surface_features;
 
-use crate::graph::{Bind, BufferHandle, ImageHandle, PassBuilder};
+use crate::graph::{Bind, Bindings, BufferHandle, ImageHandle, PassBuilder};
 
 /// The scene's GPU resources that volume passes bind (declared in include/volume.glsl,
 /// include/lights.glsl and include/frame.glsl).
@@ -24,7 +26,19 @@ pub struct SceneBindings {
 }
 
 impl SceneBindings {
-    /// Declares the volume, LUTs, majorant grid and uniforms as read.
+    /// Binds the frame block, volume, LUTs and majorant grid to the variables
+    /// include/frame.glsl and include/volume.glsl declare.
+    pub fn bind_volume(&self, b: &mut Bindings) {
+        b.uniform("frame", self.uniforms)
+            .sampled("volume_density", self.volume)
+            .sampled("tf_diffuse_opacity", self.tf_diffuse_opacity)
+            .sampled("tf_specular_roughness", self.tf_specular_roughness)
+            .sampled("tf_emissive", self.tf_emissive)
+            .sampled_nearest("majorant_grid", self.majorant);
+    }
+
+    /// Transitional (wrls.rs; others use [`SceneBindings::bind_volume`]): declares the
+    /// volume, LUTs, majorant grid and uniforms as read.
     pub fn declare_volume(&self, b: &mut PassBuilder) {
         b.uniform(self.uniforms)
             .sampled(self.volume)
@@ -34,6 +48,7 @@ impl SceneBindings {
             .sampled(self.majorant);
     }
 
+    /// Transitional (wrls.rs): the names [`SceneBindings::declare_volume`] binds to.
     pub fn volume_binds(&self) -> Vec<(&'static str, Bind)> {
         vec![
             ("frame", Bind::Buffer(self.uniforms)),
@@ -46,18 +61,5 @@ impl SceneBindings {
             ("tf_emissive", Bind::Image(self.tf_emissive)),
             ("majorant_grid", Bind::ImageNearest(self.majorant)),
         ]
-    }
-}
-
-/// Image size of a frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Extent {
-    pub width: u32,
-    pub height: u32,
-}
-
-impl Extent {
-    pub fn pixels(&self) -> u64 {
-        u64::from(self.width) * u64::from(self.height)
     }
 }

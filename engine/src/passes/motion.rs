@@ -1,30 +1,39 @@
 //! Motion vectors (shaders/glsl/motion.comp): per-pixel offset to last frame's position,
 //! from the first real collision (xy) and from the opacity-threshold features (zw).
 
-use super::Extent;
 use crate::error::Result;
-use crate::gpu::{ComputePipeline, GpuContext, ImageDesc};
-use crate::graph::{Bind, BufferHandle, Frame, ImageHandle, RenderGraph};
-use crate::renderer::uniforms::MotionPush;
+use crate::gpu::{GpuContext, ImageDesc, Pipeline};
+use crate::gpu_block;
+use crate::graph::{BufferHandle, Extent, Frame, ImageHandle, RenderGraph};
 use ash::vk;
 
+gpu_block! {
+    /// `MotionPush` in motion.comp.
+    pub struct MotionPush {
+        pub width: u32,
+        pub height: u32,
+        pub pad0: u32,
+        pub pad1: u32,
+    }
+}
+
 pub struct Motion {
-    pipeline: ComputePipeline,
+    pipeline: Pipeline<MotionPush>,
 }
 
 impl Motion {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(ctx, "motion", &[])?,
+            pipeline: ctx.pipeline("motion", &[])?,
         })
     }
 
     #[allow(clippy::too_many_arguments)]
-    pub fn add<'f>(
-        &'f self,
+    pub fn add(
+        &self,
         ctx: &GpuContext,
         graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
+        frame: &mut Frame<'_>,
         uniforms: BufferHandle,
         first_hit: ImageHandle,
         feature_position: Option<ImageHandle>,
@@ -39,29 +48,12 @@ impl Motion {
             height: size.height,
             ..Default::default()
         };
-        frame.add_pass(
-            "motion",
-            |b| {
-                b.uniform(uniforms)
-                    .read(first_hit)
-                    .read(feature_position)
-                    .write(motion);
-            },
-            move |pc| {
-                let binds = [
-                    ("frame", Bind::Buffer(uniforms)),
-                    ("first_hit", Bind::Image(first_hit)),
-                    ("feature_position", Bind::Image(feature_position)),
-                    ("motion", Bind::Image(motion)),
-                ];
-                let groups = self.pipeline.groups_2d(size.width, size.height);
-                pc.dispatch(&self.pipeline, &binds, &push, groups)
-            },
-        );
+        frame.add_compute("motion", &self.pipeline, push, size, |b| {
+            b.uniform("frame", uniforms)
+                .read("first_hit", first_hit)
+                .read("feature_position", feature_position)
+                .write("motion", motion);
+        });
         Ok(motion)
-    }
-
-    pub fn destroy(&mut self, ctx: &GpuContext) {
-        self.pipeline.destroy(ctx);
     }
 }

@@ -1,15 +1,27 @@
 //! The path-tracing pass (shaders/glsl/path_trace.comp): this frame's noisy radiance, its
 //! luminance moments and the closest first real collision per pixel.
 
-use super::{Extent, SceneBindings};
+use super::SceneBindings;
 use crate::error::Result;
-use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
-use crate::graph::{Bind, Frame, History, ImageHandle, RenderGraph};
-use crate::renderer::uniforms::PathTracePush;
+use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::gpu_block;
+use crate::graph::{Extent, Frame, History, ImageHandle, RenderGraph};
+use crate::scene::{Estimator, Phase};
+use crate::shaders::frame::{
+    ESTIMATOR_DELTA, ESTIMATOR_RAY_MARCH, PHASE_HG, PHASE_HYBRID, PHASE_ISOTROPIC,
+};
 use ash::vk;
 
-// The estimator and phase function are scene settings; one definition, in `scene`.
-pub use crate::scene::{Estimator, Phase};
+gpu_block! {
+    /// `PathTracePush` in path_trace.comp.
+    pub struct PathTracePush {
+        /// Index of this dispatch's first sample (references accumulate batches).
+        pub sample_offset: u32,
+        pub spp: u32,
+        pub width: u32,
+        pub height: u32,
+    }
+}
 
 /// What the pipeline is specialised for (what the scene uses).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -24,13 +36,13 @@ pub struct PathTraceFeatures {
 /// the path tracer's, and ours' temporal-gradient pass, which must trace the same paths.
 pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue); 4] {
     let estimator = match features.estimator {
-        Estimator::Delta => 0,
-        Estimator::RayMarch => 1,
+        Estimator::Delta => ESTIMATOR_DELTA,
+        Estimator::RayMarch => ESTIMATOR_RAY_MARCH,
     };
     let phase = match features.phase {
-        Phase::Isotropic => 0,
-        Phase::Hg => 1,
-        Phase::Hybrid => 2,
+        Phase::Isotropic => PHASE_ISOTROPIC,
+        Phase::Hg => PHASE_HG,
+        Phase::Hybrid => PHASE_HYBRID,
     };
     [
         ("ESTIMATOR", SpecValue::I32(estimator)),
@@ -41,7 +53,7 @@ pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue)
 }
 
 pub struct PathTrace {
-    pipeline: ComputePipeline,
+    pipeline: Pipeline<PathTracePush>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -59,17 +71,18 @@ pub struct PathTraceOutputs {
 
 impl PathTrace {
     pub fn new(ctx: &GpuContext, features: PathTraceFeatures) -> Result<Self> {
-        let pipeline = ComputePipeline::new(ctx, "path_trace", &specialization(features))?;
-        Ok(Self { pipeline })
+        Ok(Self {
+            pipeline: ctx.pipeline("path_trace", &specialization(features))?,
+        })
     }
 
     /// Adds the pass as `name`, writing images `<name>.radiance` etc.
     #[allow(clippy::too_many_arguments)]
-    pub fn add<'f>(
-        &'f self,
+    pub fn add(
+        &self,
         ctx: &GpuContext,
         graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
+        frame: &mut Frame<'_>,
         name: &str,
         scene: &SceneBindings,
         size: Extent,
@@ -84,38 +97,19 @@ impl PathTrace {
             moments: graph.image(ctx, &format!("{name}.moments"), desc)?,
             first_hit: graph.history(ctx, &format!("{name}.first_hit"), desc)?,
         };
-        let scene = *scene;
         let push = PathTracePush {
             sample_offset,
             spp,
             width: size.width,
             height: size.height,
         };
-        frame.add_pass(
-            name,
-            |b| {
-                scene.declare_volume(b);
-                b.sampled(scene.environment)
-                    .write(out.radiance)
-                    .write(out.moments)
-                    .write(out.first_hit.cur);
-            },
-            move |pc| {
-                let mut binds = scene.volume_binds();
-                binds.extend([
-                    ("environment_map", Bind::Image(scene.environment)),
-                    ("radiance", Bind::Image(out.radiance)),
-                    ("moments", Bind::Image(out.moments)),
-                    ("first_hit", Bind::Image(out.first_hit.cur)),
-                ]);
-                let groups = self.pipeline.groups_2d(size.width, size.height);
-                pc.dispatch(&self.pipeline, &binds, &push, groups)
-            },
-        );
+        frame.add_compute(name, &self.pipeline, push, size, |b| {
+            scene.bind_volume(b);
+            b.sampled("environment_map", scene.environment)
+                .write("radiance", out.radiance)
+                .write("moments", out.moments)
+                .write("first_hit", out.first_hit.cur);
+        });
         Ok(out)
-    }
-
-    pub fn destroy(&mut self, ctx: &GpuContext) {
-        self.pipeline.destroy(ctx);
     }
 }

@@ -4,12 +4,26 @@
 //! side (a split view) and places the frame at an offset, filling the rest with a
 //! background colour.
 
-use super::Extent;
 use crate::error::Result;
-use crate::gpu::{ComputePipeline, GpuContext};
-use crate::graph::{Bind, Frame, ImageHandle};
-use crate::renderer::uniforms::PresentPush;
+use crate::gpu::{GpuContext, Pipeline};
+use crate::gpu_block;
+use crate::graph::{Extent, Frame, ImageHandle};
 use glam::Vec4;
+
+gpu_block! {
+    /// `PresentPush` in present.comp.
+    pub struct PresentPush {
+        pub target_width: u32,
+        pub target_height: u32,
+        pub offset_x: i32,
+        pub offset_y: i32,
+        pub source_width: u32,
+        pub source_height: u32,
+        pub split_x: i32,
+        pub exposure: f32,
+        pub background: Vec4,
+    }
+}
 
 /// Where and how the frame lands in the target.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,22 +51,22 @@ impl Default for PresentLayout {
 }
 
 pub struct Present {
-    pipeline: ComputePipeline,
+    pipeline: Pipeline<PresentPush>,
 }
 
 impl Present {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(ctx, "present", &[])?,
+            pipeline: ctx.pipeline("present", &[])?,
         })
     }
 
     /// Tone-maps `left` (and `right` right of the split) of size `source` into `target`
     /// of size `target_size`. `target` may have any storage-capable format.
     #[allow(clippy::too_many_arguments)]
-    pub fn add<'f>(
-        &'f self,
-        frame: &mut Frame<'f>,
+    pub fn add(
+        &self,
+        frame: &mut Frame<'_>,
         left: ImageHandle,
         right: ImageHandle,
         source: Extent,
@@ -78,26 +92,10 @@ impl Present {
                 1.0,
             ),
         };
-        frame.add_pass(
-            "present",
-            |b| {
-                b.read(left).read(right).write(target);
-            },
-            move |pc| {
-                let binds = [
-                    ("left_image", Bind::Image(left)),
-                    ("right_image", Bind::Image(right)),
-                    ("target", Bind::Image(target)),
-                ];
-                let groups = self
-                    .pipeline
-                    .groups_2d(target_size.width, target_size.height);
-                pc.dispatch(&self.pipeline, &binds, &push, groups)
-            },
-        );
-    }
-
-    pub fn destroy(&mut self, ctx: &GpuContext) {
-        self.pipeline.destroy(ctx);
+        frame.add_compute("present", &self.pipeline, push, target_size, |b| {
+            b.read("left_image", left)
+                .read("right_image", right)
+                .write("target", target);
+        });
     }
 }

@@ -1,18 +1,29 @@
 //! Deterministic surface features (shaders/glsl/surface_features.comp): position, normal,
 //! depth and albedo where accumulated opacity crosses a threshold.
 
-use super::{Extent, SceneBindings};
+use super::SceneBindings;
 use crate::error::Result;
-use crate::gpu::{ComputePipeline, GpuContext, ImageDesc};
-use crate::graph::{Bind, Frame, History, ImageHandle, RenderGraph};
-use crate::renderer::uniforms::FeaturesPush;
+use crate::gpu::{GpuContext, ImageDesc, Pipeline};
+use crate::gpu_block;
+use crate::graph::{Extent, Frame, History, ImageHandle, RenderGraph};
 use ash::vk;
+
+gpu_block! {
+    /// `FeaturesPush` in surface_features.comp.
+    pub struct FeaturesPush {
+        pub width: u32,
+        pub height: u32,
+        /// March step in voxels.
+        pub step_voxels: f32,
+        pub pad: f32,
+    }
+}
 
 /// March step in voxels: fine enough that one-voxel vessels are not skipped.
 pub const STEP_VOXELS: f32 = 0.5;
 
 pub struct SurfaceFeatures {
-    pipeline: ComputePipeline,
+    pipeline: Pipeline<FeaturesPush>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -28,15 +39,15 @@ pub struct FeatureImages {
 impl SurfaceFeatures {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(ctx, "surface_features", &[])?,
+            pipeline: ctx.pipeline("surface_features", &[])?,
         })
     }
 
-    pub fn add<'f>(
-        &'f self,
+    pub fn add(
+        &self,
         ctx: &GpuContext,
         graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
+        frame: &mut Frame<'_>,
         scene: &SceneBindings,
         size: Extent,
     ) -> Result<FeatureImages> {
@@ -46,36 +57,18 @@ impl SurfaceFeatures {
             normal: graph.image(ctx, "features.normal", desc)?,
             albedo: graph.image(ctx, "features.albedo", desc)?,
         };
-        let scene = *scene;
         let push = FeaturesPush {
             width: size.width,
             height: size.height,
             step_voxels: STEP_VOXELS,
             pad: 0.0,
         };
-        frame.add_pass(
-            "surface_features",
-            |b| {
-                scene.declare_volume(b);
-                b.write(out.position.cur)
-                    .write(out.normal)
-                    .write(out.albedo);
-            },
-            move |pc| {
-                let mut binds = scene.volume_binds();
-                binds.extend([
-                    ("feature_position", Bind::Image(out.position.cur)),
-                    ("feature_normal", Bind::Image(out.normal)),
-                    ("feature_albedo", Bind::Image(out.albedo)),
-                ]);
-                let groups = self.pipeline.groups_2d(size.width, size.height);
-                pc.dispatch(&self.pipeline, &binds, &push, groups)
-            },
-        );
+        frame.add_compute("surface_features", &self.pipeline, push, size, |b| {
+            scene.bind_volume(b);
+            b.write("feature_position", out.position.cur)
+                .write("feature_normal", out.normal)
+                .write("feature_albedo", out.albedo);
+        });
         Ok(out)
-    }
-
-    pub fn destroy(&mut self, ctx: &GpuContext) {
-        self.pipeline.destroy(ctx);
     }
 }

@@ -12,20 +12,20 @@ use crate::denoise::{self, Changes, DenoiseInputs, Denoiser, Retrace};
 use crate::error::{EngineError, Result, VkContext};
 use crate::gpu::timestamps::{PassTiming, TimestampPool};
 use crate::gpu::GpuContext;
-use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
+use crate::graph::{BufferHandle, Extent, Frame, ImageHandle, RenderGraph};
 use crate::passes::accumulate::Accumulate;
 use crate::passes::motion::Motion;
 use crate::passes::path_trace::{PathTrace, PathTraceFeatures};
 use crate::passes::present::Present;
 use crate::passes::surface_features::SurfaceFeatures;
-use crate::passes::{Extent, SceneBindings};
+use crate::passes::SceneBindings;
+use crate::shaders::frame::{FrameBlock, FrameParams, GpuLight, SampleStream};
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 pub use present::{Overlay, PresentTarget, Screenshot};
 use scene_gpu::{EnvironmentUpload, LutUpload, SceneImages, VolumeUpload};
 use std::sync::Arc;
-use uniforms::{FrameUniforms, GpuLight, MAX_LIGHTS};
 
 const SLOTS: usize = 2;
 
@@ -295,7 +295,7 @@ impl Renderer {
             let uniforms = graph.buffer(
                 &ctx,
                 &format!("frame_uniforms.{i}"),
-                std::mem::size_of::<FrameUniforms>() as u64,
+                std::mem::size_of::<FrameBlock>() as u64,
                 MemoryLocation::CpuToGpu,
             )?;
             slots.push(Slot {
@@ -386,49 +386,41 @@ impl Renderer {
         Ok(done)
     }
 
-    fn uniforms(&self, inputs: &FrameInputs, majorant_max: f32) -> FrameUniforms {
+    /// This frame's uniform block, drawing random numbers from `stream`.
+    fn frame_block(
+        &self,
+        inputs: &FrameInputs,
+        majorant_max: f32,
+        stream: SampleStream,
+    ) -> FrameBlock {
         let s = &self.settings;
-        let aspect_view_proj = inputs.camera.proj * inputs.camera.view;
-        let prev = self
+        let view_proj = inputs.camera.proj * inputs.camera.view;
+        let prev_view_proj = self
             .last_inputs
             .as_ref()
             .map(|p| p.camera.proj * p.camera.view)
-            .unwrap_or(aspect_view_proj);
-        let half = Vec3::from(self.world_size) * 0.5;
-        let mut lights = [GpuLight::default(); MAX_LIGHTS];
-        for (dst, src) in lights.iter_mut().zip(&inputs.lights) {
-            *dst = *src;
-        }
-        let voxel = (Vec3::from(self.world_size) / Vec3::from(self.volume_dims.map(|d| d as f32)))
-            .min_element();
-        FrameUniforms {
-            view_proj: aspect_view_proj,
-            inv_view_proj: aspect_view_proj.inverse(),
-            prev_view_proj: prev,
-            camera_pos: inputs.camera.position.extend(1.0),
-            box_min: (-half).extend(s.density_scale),
-            box_max: half.extend(majorant_max),
-            dims: glam::IVec4::new(
-                self.volume_dims[0] as i32,
-                self.volume_dims[1] as i32,
-                self.volume_dims[2] as i32,
-                self.bricks.brick as i32,
-            ),
-            counts: glam::IVec4::new(
-                inputs.lights.len().min(MAX_LIGHTS) as i32,
-                self.frame_index as i32,
-                s.spp as i32,
-                s.max_bounces as i32,
-            ),
-            params: Vec4::new(
-                voxel * s.step_voxels,
-                s.hg_g,
-                s.feature_threshold,
-                s.filter_sigma,
-            ),
-            seeds: glam::UVec4::new(s.seed, 0, s.rr_depth, s.size.width),
-            lights,
-        }
+            .unwrap_or(view_proj);
+        let world = Vec3::from(self.world_size);
+        let voxel = (world / Vec3::from(self.volume_dims.map(|d| d as f32))).min_element();
+        FrameBlock::new(&FrameParams {
+            view_proj,
+            prev_view_proj,
+            camera: inputs.camera.position,
+            half_size: world * 0.5,
+            density_scale: s.density_scale,
+            majorant_max,
+            volume_dims: self.volume_dims,
+            brick: self.bricks.brick,
+            lights: &inputs.lights,
+            stream,
+            max_bounces: s.max_bounces,
+            rr_depth: s.rr_depth,
+            step: voxel * s.step_voxels,
+            hg_g: s.hg_g,
+            feature_threshold: s.feature_threshold,
+            filter_sigma: s.filter_sigma,
+            seed: s.seed,
+        })
     }
 
     /// Renders one frame of the animation: the noisy path-traced frame once, then every
@@ -464,8 +456,8 @@ impl Renderer {
 
         // Scene state: the TF (only when it changed) and this frame's uniforms.
         let majorant_max = self.upload_transfer_function(&mut frame, &inputs.lut)?;
-        let uniforms = self.uniforms(inputs, majorant_max);
-        let scene = self.write_uniforms(slot, &uniforms)?;
+        let block = self.frame_block(inputs, majorant_max, SampleStream::Frame(self.frame_index));
+        let scene = self.write_uniforms(slot, &block)?;
         let (ctx, graph, passes, size) =
             (&self.ctx, &mut self.graph, &self.passes, self.settings.size);
 
@@ -597,7 +589,7 @@ impl Renderer {
     }
 
     /// Writes `uniforms` into slot `slot`'s uniform buffer; returns the scene bindings.
-    fn write_uniforms(&mut self, slot: usize, uniforms: &FrameUniforms) -> Result<SceneBindings> {
+    fn write_uniforms(&mut self, slot: usize, uniforms: &FrameBlock) -> Result<SceneBindings> {
         let ubo = self.slots[slot].uniforms;
         self.graph
             .buffer_mut(ubo)
@@ -686,9 +678,11 @@ impl Renderer {
             let n = batch.min(spp - done);
             let mut frame = Frame::new();
             let majorant_max = self.upload_transfer_function(&mut frame, &inputs.lut)?;
-            let mut uniforms = self.uniforms(inputs, majorant_max);
-            uniforms.counts.y = i32::MAX - self.frame_index as i32;
-            let scene = self.write_uniforms(0, &uniforms)?;
+            let stream = SampleStream::Reference {
+                after_frames: self.frame_index,
+            };
+            let block = self.frame_block(inputs, majorant_max, stream);
+            let scene = self.write_uniforms(0, &block)?;
             let (ctx, graph, passes, size) =
                 (&self.ctx, &mut self.graph, &self.passes, self.settings.size);
             let batch_out = passes.path_trace.add(
@@ -833,13 +827,6 @@ impl Drop for Renderer {
         unsafe { ctx.device.destroy_command_pool(self.pool, None) };
         for d in &mut self.denoisers {
             d.destroy(ctx);
-        }
-        self.passes.features.destroy(ctx);
-        self.passes.path_trace.destroy(ctx);
-        self.passes.motion.destroy(ctx);
-        self.passes.accumulate.destroy(ctx);
-        if let Some(p) = &mut self.passes.present {
-            p.destroy(ctx);
         }
         self.graph.destroy(ctx);
     }

@@ -8,9 +8,9 @@
 use crate::error::{EngineError, Result};
 use crate::gpu::swapchain::{AcquiredImage, ACQUIRE_WAIT_STAGE};
 use crate::gpu::{GpuContext, ImageDesc};
+use crate::graph::Extent;
 use crate::graph::{BufferHandle, Frame, ImageHandle, PassContext, RenderGraph};
 use crate::passes::present::{Present, PresentLayout};
-use crate::passes::Extent;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 

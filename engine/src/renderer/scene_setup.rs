@@ -5,14 +5,14 @@
 //! all go through here.
 
 use super::scene_gpu::{EnvironmentUpload, LutUpload, VolumeUpload};
-use super::uniforms::{self, GpuLight};
 use super::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
 use crate::error::Result as EngineResult;
 use crate::gpu::GpuContext;
+use crate::graph::Extent;
 use crate::image_io::ImageIoError;
 use crate::passes::path_trace::PathTraceFeatures;
-use crate::passes::Extent;
 use crate::scene::{self, Camera, EnvSource, Light, Scene, VolumeSource};
+use crate::shaders::frame::{self, GpuLight};
 use crate::transfer::{TfLut, LUT_SIZE};
 use crate::volume::{RawFormat, RawParams, Volume, VolumeError};
 use glam::{Vec3, Vec4};
@@ -187,14 +187,14 @@ fn v3(d: glam::DVec3) -> Vec3 {
 pub fn gpu_light(l: &Light) -> GpuLight {
     match l {
         Light::Point(p) => GpuLight {
-            position_kind: v3(p.position).extend(uniforms::LIGHT_POINT),
+            position_kind: v3(p.position).extend(frame::LIGHT_POINT),
             radiance: (v3(p.colour) * p.intensity as f32).extend(0.0),
             ..Default::default()
         },
         Light::Area(a) => {
             let (u, v) = a.half_axes();
             GpuLight {
-                position_kind: v3(a.position).extend(uniforms::LIGHT_AREA),
+                position_kind: v3(a.position).extend(frame::LIGHT_AREA),
                 radiance: (v3(a.colour) * a.intensity as f32).extend(0.0),
                 u_axis: v3(u).extend(0.0),
                 v_axis: v3(v).extend(0.0),
@@ -204,15 +204,15 @@ pub fn gpu_light(l: &Light) -> GpuLight {
             let k = e.intensity as f32;
             let (top, bottom, mode) = match &e.source {
                 EnvSource::Constant { colour } => {
-                    (v3(*colour) * k, Vec3::ZERO, uniforms::ENV_CONSTANT)
+                    (v3(*colour) * k, Vec3::ZERO, frame::ENV_CONSTANT)
                 }
                 EnvSource::Gradient { top, bottom } => {
-                    (v3(*top) * k, v3(*bottom) * k, uniforms::ENV_GRADIENT)
+                    (v3(*top) * k, v3(*bottom) * k, frame::ENV_GRADIENT)
                 }
-                EnvSource::Map { .. } => (Vec3::ZERO, Vec3::ZERO, uniforms::ENV_MAP),
+                EnvSource::Map { .. } => (Vec3::ZERO, Vec3::ZERO, frame::ENV_MAP),
             };
             GpuLight {
-                position_kind: Vec4::new(0.0, 0.0, 0.0, uniforms::LIGHT_ENV),
+                position_kind: Vec4::new(0.0, 0.0, 0.0, frame::LIGHT_ENV),
                 radiance: top.extend(mode),
                 u_axis: bottom.extend(k),
                 v_axis: Vec4::ZERO,
