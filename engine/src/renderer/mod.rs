@@ -455,7 +455,7 @@ impl Renderer {
         let mut frame = Frame::new();
 
         // Scene state: the TF (only when it changed) and this frame's uniforms.
-        let majorant_max = self.upload_transfer_function(&mut frame, &inputs.lut)?;
+        let majorant_max = self.upload_transfer_function(&mut frame, slot, &inputs.lut)?;
         let block = self.frame_block(inputs, majorant_max, SampleStream::Frame(self.frame_index));
         let scene = self.write_uniforms(slot, &block)?;
         let (ctx, graph, passes, size) =
@@ -546,7 +546,12 @@ impl Renderer {
 
     /// Adds uploads of the TF LUTs and the majorant grid when the TF differs from the one
     /// on the device; returns the largest extinction (the global majorant).
-    fn upload_transfer_function(&mut self, frame: &mut Frame, lut: &LutUpload) -> Result<f32> {
+    fn upload_transfer_function(
+        &mut self,
+        frame: &mut Frame,
+        slot: usize,
+        lut: &LutUpload,
+    ) -> Result<f32> {
         if lut.diffuse_opacity.len() != self.lut_size as usize {
             return Err(EngineError::Resource {
                 resource: "transfer function".into(),
@@ -581,7 +586,7 @@ impl Renderer {
                     bytemuck::cast_slice(&majorants),
                 ),
             ] {
-                scene_gpu::add_upload(ctx, graph, frame, name, image, bytes)?;
+                scene_gpu::add_frame_upload(ctx, graph, frame, name, slot, image, bytes)?;
             }
             self.current_lut = Some(lut.clone());
         }
@@ -677,7 +682,7 @@ impl Renderer {
         while done < spp {
             let n = batch.min(spp - done);
             let mut frame = Frame::new();
-            let majorant_max = self.upload_transfer_function(&mut frame, &inputs.lut)?;
+            let majorant_max = self.upload_transfer_function(&mut frame, 0, &inputs.lut)?;
             let stream = SampleStream::Reference {
                 after_frames: self.frame_index,
             };

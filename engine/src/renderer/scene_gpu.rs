@@ -122,21 +122,53 @@ pub struct SceneImages {
     pub environment: ImageHandle,
 }
 
-/// Adds a pass that copies `bytes` into `image` through a staging buffer.
-pub fn add_upload<'f>(
+/// Adds a pass that copies `bytes` into `image` through a staging buffer of its own
+/// (`<name>.staging`): for set-up work that waits for its submission.
+pub fn add_upload(
     ctx: &GpuContext,
     graph: &mut RenderGraph,
-    frame: &mut Frame<'f>,
+    frame: &mut Frame<'_>,
     name: &str,
     image: ImageHandle,
     bytes: &[u8],
 ) -> Result<()> {
-    let staging = graph.buffer(
+    add_upload_via(
         ctx,
+        graph,
+        frame,
+        name,
         &format!("{name}.staging"),
-        bytes.len() as u64,
-        MemoryLocation::CpuToGpu,
-    )?;
+        image,
+        bytes,
+    )
+}
+
+/// [`add_upload`] for a frame in flight in slot `slot`: the staging buffer is the slot's
+/// own, since the host writes it while recording, and the other slot's frame may not
+/// have copied from its buffer yet.
+pub fn add_frame_upload(
+    ctx: &GpuContext,
+    graph: &mut RenderGraph,
+    frame: &mut Frame<'_>,
+    name: &str,
+    slot: usize,
+    image: ImageHandle,
+    bytes: &[u8],
+) -> Result<()> {
+    let staging = format!("{name}.staging.{slot}");
+    add_upload_via(ctx, graph, frame, name, &staging, image, bytes)
+}
+
+fn add_upload_via(
+    ctx: &GpuContext,
+    graph: &mut RenderGraph,
+    frame: &mut Frame<'_>,
+    name: &str,
+    staging: &str,
+    image: ImageHandle,
+    bytes: &[u8],
+) -> Result<()> {
+    let staging = graph.buffer(ctx, staging, bytes.len() as u64, MemoryLocation::CpuToGpu)?;
     graph.buffer_mut(staging).write(bytes)?;
     frame.add_pass(
         name.to_string(),
