@@ -4,7 +4,7 @@
 use crate::profile::PassStats;
 use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
-use dvr_engine::denoise::MotionSource;
+use dvr_engine::denoise::{registry, MotionSource};
 use dvr_engine::gpu::GpuContext;
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
@@ -90,13 +90,7 @@ pub fn denoiser_list(names: &[String]) -> Result<Vec<String>> {
         if d.is_empty() || methods.iter().any(|m| m == d) {
             continue;
         }
-        if !dvr_engine::denoise::NAMES.contains(&d) {
-            bail!(
-                "unknown denoiser {d:?}; available: {}",
-                dvr_engine::denoise::NAMES.join(", ")
-            );
-        }
-        methods.push(d.to_string());
+        methods.push(registry::find(d)?.name.to_string());
     }
     if methods.is_empty() {
         bail!("--denoiser names no method");

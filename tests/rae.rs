@@ -9,7 +9,8 @@ mod common;
 
 use common::harness::Harness;
 use common::*;
-use dvr_engine::denoise::rae::{network_for, resolve, Precision, RaeWeights, NETS};
+use dvr_engine::denoise::rae::{network_for, Precision, RaeWeights};
+use dvr_engine::denoise::{registry, DENOISERS};
 use std::path::{Path, PathBuf};
 
 /// Agreement bound between the shaders and torch, in HDR units (fixture outputs reach
@@ -88,10 +89,11 @@ fn difference_from_torch(name: &str, net: &str) -> (f32, f32) {
 #[test]
 fn shaders_match_torch_on_a_clip() {
     for net in ["phantom", "mri"] {
-        let name = NETS
+        let name = DENOISERS
             .iter()
-            .find(|(_, n, p)| *n == net && *p == Precision::F32)
-            .map(|(d, ..)| *d)
+            // The harness builds denoisers for no dataset: the entry that runs `net` then.
+            .find(|d| d.rae_network(None) == Some((net, Precision::F32)))
+            .map(|d| d.name)
             .unwrap();
         let (worst, _) = difference_from_torch(name, net);
         assert!(
@@ -106,7 +108,8 @@ fn shaders_match_torch_on_a_clip() {
 /// each of the 16 layers' outputs and the recurrent state are rounded to half precision.
 #[test]
 fn fp16_tensors_stay_close_to_torch() {
-    assert_eq!(resolve("rae-fp16", None), Some(("mri", Precision::F16)));
+    let fp16 = registry::find("rae-fp16").expect("in the registry");
+    assert_eq!(fp16.rae_network(None), Some(("mri", Precision::F16)));
     let (worst, peak) = difference_from_torch("rae-fp16", "mri");
     assert!(
         worst < F16_TOLERANCE * peak.max(1.0),
@@ -121,10 +124,10 @@ fn fp16_tensors_stay_close_to_torch() {
 fn shipped_weights_load() {
     let picked = [Some("phantom"), Some("mri"), Some("cloud"), None].map(network_for);
     assert_eq!(picked, ["phantom", "mri", "mri", "mri"]);
-    let named = NETS
+    let named = DENOISERS
         .iter()
-        .map(|(_, net, _)| *net)
-        .filter(|net| *net != "auto");
+        .filter_map(|d| d.rae_network(None))
+        .map(|(net, _)| net);
     for net in named.chain(picked) {
         let w = RaeWeights::builtin(net).unwrap_or_else(|e| panic!("{net}: {e}"));
         assert!(w.levels() >= 2);

@@ -41,3 +41,23 @@ fn every_shader_reflects_named_bindings_in_set_zero() {
         assert!(r.local_size.iter().product::<u32>() > 0);
     }
 }
+
+/// Every denoiser in the registry builds, for both motion sources: each pipeline checks
+/// its push-constant struct and the frame block against the shader's reflection as it
+/// is built, so a struct that disagrees with its GLSL block fails here.
+#[test]
+fn every_registered_denoiser_builds() {
+    use dvr_engine::denoise::{DenoiserConfig, MotionSource, DENOISERS};
+    let ctx = dvr_engine::gpu::GpuContext::headless().expect("device");
+    for motion in [MotionSource::FirstHit, MotionSource::Features] {
+        let config = DenoiserConfig {
+            motion,
+            ..Default::default()
+        };
+        for d in DENOISERS {
+            d.create(&ctx, &config)
+                .unwrap_or_else(|e| panic!("{}: {e}", d.name))
+                .destroy(&ctx);
+        }
+    }
+}

@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use dvr_engine::denoise::NAMES;
+use dvr_engine::denoise::registry;
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
 use dvr_engine::renderer::FrameRequest;
@@ -22,7 +22,9 @@ fn every_denoiser_stays_finite_and_bounded_on_every_built_in_animation() {
             .with_frames(8)
             .expect("frames");
         let setup = SceneSetup::new(scene, size, None, 24).expect("setup");
-        let mut r = setup.renderer(context(), NAMES).expect("renderer");
+        let mut r = setup
+            .renderer(context(), &registry::names().collect::<Vec<_>>())
+            .expect("renderer");
         let request = FrameRequest {
             readback: true,
             reset: false,

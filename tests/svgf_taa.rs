@@ -111,8 +111,8 @@ impl Harness {
     fn new(name: &str) -> Self {
         let ctx = context();
         let graph = RenderGraph::new(&ctx).expect("graph");
-        let denoiser = denoise::create(&ctx, name, Default::default(), None, Default::default())
-            .expect("denoiser");
+        let denoiser =
+            denoise::registry::create(&ctx, name, &Default::default()).expect("denoiser");
         Self {
             ctx,
             graph,

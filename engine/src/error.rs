@@ -32,6 +32,14 @@ pub enum EngineError {
     UnknownShader(String),
     #[error("shader {shader}: {problem}")]
     Reflection { shader: String, problem: String },
+    #[error("unknown denoiser {name:?}; available: {available}")]
+    UnknownDenoiser { name: String, available: String },
+    #[error("{name} = {value} is not allowed; {allowed}")]
+    InvalidSetting {
+        name: &'static str,
+        value: String,
+        allowed: String,
+    },
     #[error("pass {pass:?}: {problem}")]
     Pass { pass: String, problem: String },
     #[error("render graph: resource {resource:?}: {problem}")]

@@ -98,9 +98,8 @@ fn size_name((w, h): (u32, u32)) -> String {
 
 pub fn run(args: &BenchArgs) -> Result<()> {
     let denoisers: Vec<String> = if args.denoiser.is_empty() {
-        dvr_engine::denoise::NAMES
-            .iter()
-            .map(|s| s.to_string())
+        dvr_engine::denoise::registry::names()
+            .map(String::from)
             .collect()
     } else {
         args.denoiser.clone()
@@ -261,6 +260,7 @@ pub fn method_rows(p: &Profile) -> Vec<MethodRow> {
         .iter()
         .map(|r| PassTiming {
             pass: r.pass.clone(),
+            owner: r.owner.clone(),
             start_ms: 0.0,
             ms: r.mean_ms,
             bytes: r.bytes as u64,
@@ -271,7 +271,7 @@ pub fn method_rows(p: &Profile) -> Vec<MethodRow> {
         .denoisers
         .iter()
         .map(|m| {
-            let own: Vec<&PassTiming> = means.iter().filter(|t| owned_by(&t.pass, m)).collect();
+            let own: Vec<&PassTiming> = means.iter().filter(|t| owned_by(t, m)).collect();
             // `+ 0.0`: an empty sum is -0.0, which would print as "-0.0000".
             let own_ms = own.iter().map(|t| t.ms).sum::<f64>() + 0.0;
             let own_bytes = own.iter().map(|t| t.bytes as f64).sum::<f64>() + 0.0;
@@ -283,7 +283,7 @@ pub fn method_rows(p: &Profile) -> Vec<MethodRow> {
                 own_percent_of_peak: peak
                     .filter(|&b| b > 0.0 && own_ms > 0.0)
                     .map(|b| 100.0 * rate / b),
-                frame_ms: method_gpu_ms(&means, m, &p.run.denoisers),
+                frame_ms: method_gpu_ms(&means, m),
             }
         })
         .collect()
@@ -313,12 +313,17 @@ fn methods_csv(profiles: &[Profile]) -> String {
 mod tests {
     use super::*;
     use crate::profile::{RunInfo, Stats, Window};
+    use dvr_engine::gpu::timestamps::PassOwner;
     use dvr_engine::passes::bandwidth::PeakBandwidth;
 
     #[test]
     fn method_rows_split_own_and_shared_passes() {
         let t = |pass: &str, ms: f64, bytes: u64| PassTiming {
             pass: pass.into(),
+            owner: match pass.split_once('.') {
+                Some((m, _)) => PassOwner::Method(m.into()),
+                None => PassOwner::Shared,
+            },
             start_ms: 0.0,
             ms,
             bytes,

@@ -13,7 +13,7 @@ use crate::progress::Progress;
 use crate::setup::Setup;
 use crate::SceneArgs;
 use anyhow::{Context, Result};
-use dvr_engine::gpu::timestamps::PassTiming;
+use dvr_engine::gpu::timestamps::{PassOwner, PassTiming};
 use dvr_engine::image_io::{to_rgb, write_exr};
 use dvr_engine::metrics::Rgb32Image;
 use dvr_engine::renderer::{FrameRequest, FrameResult};
@@ -24,10 +24,6 @@ use std::sync::Arc;
 /// The method whose frames are also kept as EXR: the noisy input, for external
 /// denoisers (`tools/oidn_eval.py`).
 pub const NOISY_METHOD: &str = "none";
-
-/// Passes of a frame that belong to no method and are not part of its cost: uploads
-/// (only when the TF changes) and the readbacks an eval adds.
-const UNCOUNTED_PREFIXES: [&str; 3] = ["upload_", "readback_", "host_read_"];
 
 /// One scene as planned before anything renders.
 pub struct PlannedScene {
@@ -132,23 +128,18 @@ impl SceneResult {
     }
 }
 
-/// Whether `pass` is one of `method`'s own passes (named `<method>` or
-/// `<method>.<step>`).
-pub fn owned_by(pass: &str, method: &str) -> bool {
-    pass == method
-        || pass
-            .strip_prefix(method)
-            .is_some_and(|r| r.starts_with('.'))
+/// Whether a pass is one of `method`'s own (the graph records who each pass works for).
+pub fn owned_by(t: &PassTiming, method: &str) -> bool {
+    matches!(&t.owner, PassOwner::Method(m) if m == method)
 }
 
-/// GPU time of `method` in one frame: every pass no method owns (surface features,
-/// path trace, motion, …) plus the method's own passes, which are named after it
-/// (`accum`, `ours.update`, `ours.spatial`; `none` has none).
-pub fn method_gpu_ms(timings: &[PassTiming], method: &str, methods: &[String]) -> f64 {
+/// GPU time of `method` in one frame: the passes every method shares (surface
+/// features, path trace, motion, …) plus the method's own; uploads and readbacks are no
+/// method's cost.
+pub fn method_gpu_ms(timings: &[PassTiming], method: &str) -> f64 {
     timings
         .iter()
-        .filter(|t| !UNCOUNTED_PREFIXES.iter().any(|p| t.pass.starts_with(p)))
-        .filter(|t| owned_by(&t.pass, method) || !methods.iter().any(|m| owned_by(&t.pass, m)))
+        .filter(|t| t.owner == PassOwner::Shared || owned_by(t, method))
         .map(|t| t.ms)
         .sum()
 }
@@ -252,7 +243,6 @@ impl ScoreJob {
 struct FrameState<'a> {
     scene: &'a PlannedScene,
     setup: &'a Setup,
-    methods: &'a [String],
     previous: Option<(Images, Arc<Rgb32Image>)>,
     jobs: Overlap<Vec<MetricRow>>,
     timings: Vec<Vec<PassTiming>>,
@@ -267,7 +257,7 @@ impl FrameState<'_> {
         let gpu_ms = done
             .images
             .iter()
-            .map(|(m, _)| method_gpu_ms(&done.timings, m, self.methods))
+            .map(|(m, _)| method_gpu_ms(&done.timings, m))
             .collect();
         let images: Images = Arc::new(done.images);
         let job = ScoreJob {
@@ -369,7 +359,6 @@ pub fn evaluate_scene(
     let mut state = FrameState {
         scene,
         setup: &setup,
-        methods,
         previous: None,
         jobs: Overlap::new(timing),
         timings: Vec::new(),
@@ -454,8 +443,15 @@ mod tests {
     use super::*;
 
     fn t(pass: &str, ms: f64) -> PassTiming {
+        let owner = match pass.split_once('.') {
+            _ if pass.starts_with("upload") || pass.starts_with("readback") => PassOwner::Transfer,
+            Some((method, _)) => PassOwner::Method(method.into()),
+            None if pass == "accum" => PassOwner::Method(pass.into()),
+            None => PassOwner::Shared,
+        };
         PassTiming {
             pass: pass.into(),
+            owner,
             start_ms: 0.0,
             ms,
             bytes: 0,
@@ -475,14 +471,10 @@ mod tests {
             t("rls-nf.update", 40.0),
             t("readback_ours", 7.0),
         ];
-        let methods: Vec<String> = ["none", "accum", "ours", "rls-nf"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
-        assert_eq!(method_gpu_ms(&frame, "none", &methods), 11.5);
-        assert_eq!(method_gpu_ms(&frame, "accum", &methods), 11.75);
-        assert_eq!(method_gpu_ms(&frame, "ours", &methods), 16.5);
-        assert_eq!(method_gpu_ms(&frame, "rls-nf", &methods), 51.5);
+        assert_eq!(method_gpu_ms(&frame, "none"), 11.5);
+        assert_eq!(method_gpu_ms(&frame, "accum"), 11.75);
+        assert_eq!(method_gpu_ms(&frame, "ours"), 16.5);
+        assert_eq!(method_gpu_ms(&frame, "rls-nf"), 51.5);
     }
 
     #[test]

@@ -23,7 +23,7 @@ use crate::setup;
 use anyhow::{bail, Context, Result};
 use ash::vk;
 use camera::OrbitCamera;
-use dvr_engine::denoise::MotionSource;
+use dvr_engine::denoise::{registry, MotionSource};
 use dvr_engine::gpu::{ContextOptions, GpuContext, Swapchain};
 use dvr_engine::graph::Extent;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png, PNG_EXPOSURE};
@@ -118,12 +118,7 @@ pub fn run(args: ExploreArgs) -> Result<()> {
         bail!("--denoiser takes one denoiser or two for a split view (A,B)");
     }
     for n in &names {
-        if !dvr_engine::denoise::NAMES.contains(&n.as_str()) {
-            bail!(
-                "unknown denoiser {n:?}; available: {}",
-                dvr_engine::denoise::NAMES.join(", ")
-            );
-        }
+        registry::find(n)?;
     }
     let script = match &args.script {
         Some(s) => Script::parse(s).context("--script")?,
@@ -464,13 +459,10 @@ impl Explorer {
             Command::Key(Key::Help) => self.ui.show_help = !self.ui.show_help,
             Command::Key(Key::ToggleUi) => self.ui.show_panel = !self.ui.show_panel,
             Command::Key(Key::Screenshot) => self.shots.push(self.frame),
-            Command::Denoiser(name) => {
-                if dvr_engine::denoise::NAMES.contains(&name.as_str()) {
-                    self.model.left = name.clone();
-                } else {
-                    self.ui.set_status(format!("unknown denoiser {name:?}"));
-                }
-            }
+            Command::Denoiser(name) => match registry::find(name) {
+                Ok(d) => self.model.left = d.name.to_string(),
+                Err(e) => self.ui.set_status(e.to_string()),
+            },
             Command::Split(right) => self.model.right = right.clone(),
             _ => {}
         }

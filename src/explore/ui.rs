@@ -6,6 +6,7 @@
 
 use super::input::SHORTCUTS;
 use super::tf_editor::{self, TfEditor};
+use dvr_engine::denoise::DENOISERS;
 use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::scene::{self, AreaLight, EnvSource, EnvironmentLight, Facing, Light, PointLight};
 use dvr_engine::shaders::frame::MAX_LIGHTS;
@@ -90,7 +91,6 @@ pub struct UiState {
     pub status: Option<(String, std::time::Instant)>,
     /// Recording: light kinds and counts are locked (a scene cannot animate them).
     pub recording: bool,
-    pub denoisers: Vec<&'static str>,
 }
 
 /// What the UI asks the frame loop to do besides editing the model.
@@ -109,7 +109,6 @@ impl UiState {
             stats: Stats::default(),
             status: None,
             recording: false,
-            denoisers: dvr_engine::denoise::NAMES.to_vec(),
         }
     }
 
@@ -202,7 +201,7 @@ fn panel(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model, requests: &m
         });
     egui::CollapsingHeader::new("Denoiser")
         .default_open(true)
-        .show(ui, |ui| denoiser_controls(ui, &state.denoisers, model));
+        .show(ui, |ui| denoiser_controls(ui, model));
     egui::CollapsingHeader::new("Lights")
         .default_open(true)
         .show(ui, |ui| lights(ui, state, &mut model.lights));
@@ -214,13 +213,14 @@ fn panel(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model, requests: &m
         .show(ui, |ui| timing(ui, &state.stats));
 }
 
-fn denoiser_controls(ui: &mut egui::Ui, names: &[&'static str], model: &mut Model) {
+fn denoiser_controls(ui: &mut egui::Ui, model: &mut Model) {
     let pick = |ui: &mut egui::Ui, id: &str, value: &mut String| {
         egui::ComboBox::from_id_salt(id)
             .selected_text(value.as_str())
             .show_ui(ui, |ui| {
-                for n in names {
-                    ui.selectable_value(value, n.to_string(), *n);
+                for d in DENOISERS {
+                    ui.selectable_value(value, d.name.to_string(), d.name)
+                        .on_hover_text(d.description);
                 }
             });
     };
@@ -233,10 +233,10 @@ fn denoiser_controls(ui: &mut egui::Ui, names: &[&'static str], model: &mut Mode
         ui.checkbox(&mut split, "split view, right:");
         if split {
             let mut right = model.right.clone().unwrap_or_else(|| {
-                names
+                DENOISERS
                     .iter()
-                    .find(|n| **n != model.left)
-                    .map_or_else(|| model.left.clone(), |n| n.to_string())
+                    .find(|d| d.name != model.left)
+                    .map_or_else(|| model.left.clone(), |d| d.name.to_string())
             });
             pick(ui, "right", &mut right);
             model.right = Some(right);
@@ -557,6 +557,7 @@ mod tests {
     fn gpu_span_runs_from_the_first_start_to_the_last_end() {
         let t = |pass: &str, start_ms, ms| PassTiming {
             pass: pass.into(),
+            owner: Default::default(),
             start_ms,
             ms,
             bytes: 0,

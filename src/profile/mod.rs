@@ -216,6 +216,7 @@ mod tests {
     fn t(pass: &str, start: f64, ms: f64) -> PassTiming {
         PassTiming {
             pass: pass.into(),
+            owner: Default::default(),
             start_ms: start,
             ms,
             bytes: 2_000_000,

@@ -3,7 +3,7 @@
 //! instead of every frame's timings, so a 10,000-frame or overnight run stays flat in
 //! memory.
 
-use dvr_engine::gpu::timestamps::{gb_per_s, PassTiming};
+use dvr_engine::gpu::timestamps::{gb_per_s, PassOwner, PassTiming};
 use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
 
@@ -21,6 +21,8 @@ const MIN_MS: f64 = 1e-6;
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct PassStats {
     pub pass: String,
+    /// Whom the pass works for (shared, a method, or a transfer).
+    pub owner: PassOwner,
     pub frames: usize,
     pub mean_ms: f64,
     pub median_ms: f64,
@@ -90,11 +92,12 @@ impl Series {
         self.max_ms
     }
 
-    fn stats(&self, pass: &str, peak_gb_per_s: Option<f64>) -> PassStats {
+    fn stats(&self, pass: &str, owner: &PassOwner, peak_gb_per_s: Option<f64>) -> PassStats {
         let n = self.count.max(1) as f64;
         let rate = gb_per_s(self.sum_bytes, self.sum_ms);
         PassStats {
             pass: pass.to_string(),
+            owner: owner.clone(),
             frames: self.count,
             mean_ms: self.sum_ms / n,
             median_ms: self.percentile(0.5),
@@ -110,7 +113,8 @@ impl Series {
 /// run has no other frames).
 #[derive(Clone, Debug, Default)]
 pub struct Stats {
-    order: Vec<String>,
+    /// Passes in first-seen order, with their owners.
+    order: Vec<(String, PassOwner)>,
     by_pass: HashMap<String, Series>,
     total: Series,
     /// The warm-up frames, kept until a measured frame arrives.
@@ -142,7 +146,7 @@ impl Stats {
         let (mut ms, mut bytes) = (0.0, 0);
         for t in frame {
             if !self.by_pass.contains_key(&t.pass) {
-                self.order.push(t.pass.clone());
+                self.order.push((t.pass.clone(), t.owner.clone()));
             }
             self.by_pass
                 .entry(t.pass.clone())
@@ -168,9 +172,10 @@ impl Stats {
         let passes = self
             .order
             .iter()
-            .map(|p| self.by_pass[p].stats(p, peak_gb_per_s))
+            .map(|(p, owner)| self.by_pass[p].stats(p, owner, peak_gb_per_s))
             .collect();
-        (passes, self.total.stats("total", peak_gb_per_s))
+        let total = self.total.stats("total", &PassOwner::Shared, peak_gb_per_s);
+        (passes, total)
     }
 }
 
@@ -190,6 +195,7 @@ mod tests {
     fn t(pass: &str, ms: f64, bytes: u64) -> PassTiming {
         PassTiming {
             pass: pass.into(),
+            owner: Default::default(),
             start_ms: 0.0,
             ms,
             bytes,

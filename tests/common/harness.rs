@@ -27,8 +27,8 @@ impl Harness {
     pub fn new(name: &str, width: u32, height: u32) -> Self {
         let ctx = super::context();
         let graph = RenderGraph::new(&ctx).expect("graph");
-        let denoiser = denoise::create(&ctx, name, Default::default(), None, Default::default())
-            .expect("denoiser");
+        let denoiser =
+            denoise::registry::create(&ctx, name, &Default::default()).expect("denoiser");
         Self {
             ctx,
             graph,

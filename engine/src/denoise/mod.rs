@@ -5,6 +5,7 @@
 mod accum;
 mod passthrough;
 pub mod rae;
+pub mod registry;
 pub mod svgf;
 pub mod taa;
 pub mod wrls;
@@ -12,6 +13,7 @@ pub mod wrls;
 pub use accum::Accum;
 pub use passthrough::Passthrough;
 pub use rae::{Rae, RaeWeights};
+pub use registry::{DenoiserConfig, DenoiserInfo, FeatureUse, DENOISERS};
 pub use svgf::Svgf;
 pub use taa::Taa;
 pub use wrls::{Wrls, WrlsVariant};
@@ -21,7 +23,6 @@ use crate::gpu::GpuContext;
 use crate::graph::{
     Bind, Bindings, BufferHandle, Extent, Frame, History, ImageHandle, PassBuilder, RenderGraph,
 };
-use crate::passes::path_trace::PathTraceFeatures;
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::SceneBindings;
 
@@ -108,8 +109,8 @@ impl DenoiseInputs {
     pub fn features(&self, denoiser: &str) -> Result<FeatureImages> {
         self.features.ok_or_else(|| EngineError::Pass {
             pass: denoiser.to_string(),
-            problem: "surface features were not rendered: the denoiser must return true \
-                      from uses_surface_features"
+            problem: "surface features were not rendered: its registry entry \
+                      (denoise/registry.rs) must say it reads them"
                 .into(),
         })
     }
@@ -186,69 +187,9 @@ pub trait Denoiser {
     /// Transitional: pipelines live in the context's cache, so there is nothing to
     /// release; wrls.rs still overrides this until it moves to the cache.
     fn destroy(&mut self, _ctx: &GpuContext) {}
-    /// Whether the frame must render the surface-features pass for this denoiser (it
-    /// costs about as much as the path trace on lavapipe, so it runs only when used).
+    /// Transitional (wrls.rs overrides it): whether the frame renders the surface
+    /// features is the registry's [`DenoiserInfo::features`]; nothing calls this.
     fn uses_surface_features(&self) -> bool {
         false
     }
-}
-
-/// Names accepted by `--denoiser`.
-pub const NAMES: &[&str] = &[
-    "none",
-    "accum",
-    "taa",
-    "svgf",
-    "ours",
-    "ours-feature",
-    "ours-no-gradient",
-    "ours-no-atrous",
-    "ours-no-drift",
-    "ours-fixed-lambda",
-    "wrls-paper",
-    "rls",
-    "wrls-nf",
-    "rls-nf",
-    "rae",
-    "rae-phantom",
-    "rae-mri",
-    "rae-fp16",
-];
-
-/// Builds a denoiser by name. `dataset` is the built-in dataset the scene's volume is, if
-/// any (learned denoisers pick their network by it); `features` what the path tracer is
-/// specialised for (denoisers that trace paths again must trace the same ones).
-pub fn create(
-    ctx: &GpuContext,
-    name: &str,
-    motion: MotionSource,
-    dataset: Option<&str>,
-    features: PathTraceFeatures,
-) -> Result<Box<dyn Denoiser>> {
-    if let Some((net, precision)) = rae::resolve(name, dataset) {
-        return Ok(Box::new(Rae::new(
-            ctx,
-            name,
-            RaeWeights::builtin(net)?,
-            precision,
-        )?));
-    }
-    if let Some(variant) = WrlsVariant::from_name(name) {
-        return Ok(Box::new(Wrls::new(ctx, name, variant, motion, features)?));
-    }
-    Ok(match name {
-        "none" => Box::new(Passthrough),
-        "accum" => Box::new(Accum::new(ctx)?),
-        "taa" => Box::new(Taa::new(ctx, motion)?),
-        "svgf" => Box::new(Svgf::new(ctx, motion)?),
-        other => {
-            return Err(EngineError::Pass {
-                pass: "denoise".into(),
-                problem: format!(
-                    "unknown denoiser {other:?}; available: {}",
-                    NAMES.join(", ")
-                ),
-            })
-        }
-    })
 }

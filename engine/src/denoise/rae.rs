@@ -105,29 +105,6 @@ impl Precision {
     }
 }
 
-/// Denoiser names, the shipped network each runs (`auto`: by dataset, [`network_for`])
-/// and the tensors' precision.
-pub const NETS: &[(&str, &str, Precision)] = &[
-    ("rae", "auto", Precision::F32),
-    ("rae-phantom", "phantom", Precision::F32),
-    ("rae-mri", "mri", Precision::F32),
-    ("rae-fp16", "auto", Precision::F16),
-];
-
-/// The network and precision denoiser `name` runs on a scene of built-in `dataset`, or
-/// None if `name` is not a RAE.
-pub fn resolve(name: &str, dataset: Option<&str>) -> Option<(&'static str, Precision)> {
-    let (_, net, precision) = NETS.iter().find(|(n, ..)| *n == name)?;
-    Some((
-        if *net == "auto" {
-            network_for(dataset)
-        } else {
-            net
-        },
-        *precision,
-    ))
-}
-
 /// The network `rae` runs: the one trained on the scene's built-in dataset, else the mri
 /// network, which generalised best to the never-trained cloud (suite eval, 1024-spp
 /// references: cloud/orbit 32.0 dB against 30.0 for the phantom network).

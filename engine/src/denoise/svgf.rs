@@ -152,10 +152,6 @@ impl Svgf {
 }
 
 impl Denoiser for Svgf {
-    fn uses_surface_features(&self) -> bool {
-        true // edge-stopping on depth, normal; albedo demodulation
-    }
-
     fn name(&self) -> &str {
         "svgf"
     }

@@ -69,10 +69,6 @@ impl Taa {
 }
 
 impl Denoiser for Taa {
-    fn uses_surface_features(&self) -> bool {
-        self.motion == MotionSource::Features
-    }
-
     fn name(&self) -> &str {
         "taa"
     }

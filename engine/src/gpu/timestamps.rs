@@ -19,10 +19,28 @@ pub const MAX_TIMED_PASSES: u32 = 128;
 /// Queries per pass: begin, its follower, end, its follower.
 const QUERIES_PER_PASS: u32 = 4;
 
+/// Whom a pass works for, recorded with its time so that reports add GPU time up per
+/// method from the graph's own record rather than from pass names.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PassOwner {
+    /// Work every method of the frame shares (surface features, path trace, motion,
+    /// presentation).
+    #[default]
+    Shared,
+    /// One method's own pass (a denoiser, by its name).
+    Method(String),
+    /// Moves data into or out of the frame (uploads, readbacks): part of no method's
+    /// rendering cost.
+    Transfer,
+}
+
 /// GPU time of one pass in one frame.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PassTiming {
     pub pass: String,
+    #[serde(default)]
+    pub owner: PassOwner,
     /// Start, relative to the first timestamp of the frame, in milliseconds.
     pub start_ms: f64,
     pub ms: f64,
@@ -50,8 +68,8 @@ pub fn gb_per_s(bytes: f64, ms: f64) -> f64 {
 
 pub struct TimestampPool {
     pool: vk::QueryPool,
-    /// Name and declared bytes of each pass timed in the recorded frame.
-    names: Vec<(String, u64)>,
+    /// Name, owner and declared bytes of each pass timed in the recorded frame.
+    names: Vec<(String, PassOwner, u64)>,
     period_ns: f64,
 }
 
@@ -77,20 +95,21 @@ impl TimestampPool {
         };
     }
 
-    /// Writes the opening timestamp of `pass`, which touches `bytes` (reported with its
-    /// time); returns false when the pool is full (the pass then runs untimed).
+    /// Writes the opening timestamp of `pass`, done for `owner`, which touches `bytes`
+    /// (reported with its time); returns false when the pool is full (the pass then runs untimed).
     pub fn begin(
         &mut self,
         ctx: &GpuContext,
         cmd: vk::CommandBuffer,
         pass: &str,
+        owner: &PassOwner,
         bytes: u64,
     ) -> bool {
         let index = self.names.len() as u32;
         if index >= MAX_TIMED_PASSES {
             return false;
         }
-        self.names.push((pass.to_string(), bytes));
+        self.names.push((pass.to_string(), owner.clone(), bytes));
         self.write(ctx, cmd, index * QUERIES_PER_PASS);
         true
     }
@@ -136,8 +155,9 @@ impl TimestampPool {
             .names
             .iter()
             .enumerate()
-            .map(|(i, (name, bytes))| PassTiming {
+            .map(|(i, (name, owner, bytes))| PassTiming {
                 pass: name.clone(),
+                owner: owner.clone(),
                 start_ms: to_ms(raw[n * i].saturating_sub(t0)),
                 ms: to_ms(raw[n * i + 2].saturating_sub(raw[n * i])),
                 bytes: *bytes,

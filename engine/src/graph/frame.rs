@@ -12,6 +12,7 @@ use super::access::Access;
 use super::context::PassContext;
 use super::resources::{BufferHandle, Extent, ImageHandle, Res};
 use crate::error::Result;
+use crate::gpu::timestamps::PassOwner;
 use crate::gpu::Pipeline;
 use crate::shaders::GpuBlock;
 
@@ -30,6 +31,7 @@ pub(crate) struct Bound {
 /// One declared pass of the frame being built.
 pub(crate) struct Pass<'f> {
     pub name: String,
+    pub owner: PassOwner,
     pub accesses: Vec<(Res, Access)>,
     /// What the shader variables bind to (passes made by [`Frame::add_compute`]).
     pub bound: Vec<Bound>,
@@ -119,11 +121,50 @@ impl Bindings {
 #[derive(Default)]
 pub struct Frame<'f> {
     pub(crate) passes: Vec<Pass<'f>>,
+    /// Whom the passes added now work for (see [`Frame::add_owned`]).
+    owner: PassOwner,
 }
 
 impl<'f> Frame<'f> {
     pub fn new() -> Self {
-        Self { passes: Vec::new() }
+        Self::default()
+    }
+
+    /// Runs `add`, recording every pass it adds as `method`'s own (its timings carry the
+    /// owner, so reports total a method's GPU time without reading pass names).
+    pub fn add_owned<T>(&mut self, method: &str, add: impl FnOnce(&mut Self) -> T) -> T {
+        let outer = std::mem::replace(&mut self.owner, PassOwner::Method(method.to_string()));
+        let result = add(self);
+        self.owner = outer;
+        result
+    }
+
+    fn push(
+        &mut self,
+        name: String,
+        accesses: Vec<(Res, Access)>,
+        bound: Vec<Bound>,
+        record: Option<RecordFn<'f>>,
+    ) {
+        // A pass that only copies or hands over data is nobody's rendering work.
+        let transfer = accesses.iter().all(|(_, a)| {
+            matches!(
+                a,
+                Access::TransferSrc | Access::TransferDst | Access::HostRead | Access::Present
+            )
+        });
+        let owner = if transfer {
+            PassOwner::Transfer
+        } else {
+            self.owner.clone()
+        };
+        self.passes.push(Pass {
+            name,
+            owner,
+            accesses,
+            bound,
+            record,
+        });
     }
 
     /// Adds a pass: `declare` lists its accesses, `record` records its commands.
@@ -137,12 +178,7 @@ impl<'f> Frame<'f> {
             accesses: Vec::new(),
         };
         declare(&mut b);
-        self.passes.push(Pass {
-            name: name.into(),
-            accesses: b.accesses,
-            bound: Vec::new(),
-            record: Some(Box::new(record)),
-        });
+        self.push(name.into(), b.accesses, Vec::new(), Some(Box::new(record)));
     }
 
     /// Adds a compute pass: one dispatch of `pipeline` over `grid` invocations (an
@@ -160,14 +196,8 @@ impl<'f> Frame<'f> {
         declare(&mut b);
         let pipeline = pipeline.clone();
         let groups = pipeline.groups(grid.into());
-        self.passes.push(Pass {
-            name: name.into(),
-            accesses: b.accesses,
-            bound: b.bound,
-            record: Some(Box::new(move |pc: &mut PassContext| {
-                pc.dispatch_bound(&pipeline, &push, groups)
-            })),
-        });
+        let record = move |pc: &mut PassContext| pc.dispatch_bound(&pipeline, &push, groups);
+        self.push(name.into(), b.accesses, b.bound, Some(Box::new(record)));
     }
 
     /// Copies `image` into the host-visible `buffer` and makes it readable by the host:
@@ -185,24 +215,16 @@ impl<'f> Frame<'f> {
 
     /// A pass with accesses but no commands: makes a readback visible to the host.
     pub fn add_host_read(&mut self, name: impl Into<String>, buffer: BufferHandle) {
-        self.passes.push(Pass {
-            name: name.into(),
-            accesses: vec![(Res::Buffer(buffer), Access::HostRead)],
-            bound: Vec::new(),
-            record: None,
-        });
+        let accesses = vec![(Res::Buffer(buffer), Access::HostRead)];
+        self.push(name.into(), accesses, Vec::new(), None);
     }
 
     /// A pass with no commands that hands `image` (an imported swapchain image) to the
     /// presentation engine: the graph transitions it to `PRESENT_SRC_KHR`. It must be
     /// the image's last access in the frame.
     pub fn add_present(&mut self, name: impl Into<String>, image: ImageHandle) {
-        self.passes.push(Pass {
-            name: name.into(),
-            accesses: vec![(Res::Image(image), Access::Present)],
-            bound: Vec::new(),
-            record: None,
-        });
+        let accesses = vec![(Res::Image(image), Access::Present)];
+        self.push(name.into(), accesses, Vec::new(), None);
     }
 }
 

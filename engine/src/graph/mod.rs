@@ -356,7 +356,7 @@ impl RenderGraph {
             let bytes = self.declared_bytes(&pass.accesses);
             let timed = timestamps
                 .as_deref_mut()
-                .is_some_and(|t| t.begin(ctx, cmd, &pass.name, bytes));
+                .is_some_and(|t| t.begin(ctx, cmd, &pass.name, &pass.owner, bytes));
             let mut pc = PassContext::new(
                 ctx,
                 cmd,

@@ -8,7 +8,9 @@ pub mod scene_gpu;
 pub mod scene_setup;
 pub mod uniforms;
 
-use crate::denoise::{self, Changes, DenoiseInputs, Denoiser, Retrace};
+use crate::denoise::{
+    self, registry, Changes, DenoiseInputs, Denoiser, DenoiserConfig, DenoiserInfo, Retrace,
+};
 use crate::error::{EngineError, Result, VkContext};
 use crate::gpu::timestamps::{PassTiming, TimestampPool};
 use crate::gpu::GpuContext;
@@ -181,6 +183,12 @@ struct Slot {
     pending_screenshot: Option<present::PendingScreenshot>,
 }
 
+/// A denoiser the frame runs, with its registry entry.
+struct Method {
+    info: &'static DenoiserInfo,
+    denoiser: Box<dyn Denoiser>,
+}
+
 struct Passes {
     features: SurfaceFeatures,
     path_trace: PathTrace,
@@ -194,7 +202,7 @@ pub struct Renderer {
     pub settings: RenderSettings,
     graph: RenderGraph,
     passes: Passes,
-    denoisers: Vec<Box<dyn Denoiser>>,
+    denoisers: Vec<Method>,
     scene: SceneImages,
     bricks: scene_gpu::BrickRanges,
     volume_dims: [u32; 3],
@@ -260,18 +268,7 @@ impl Renderer {
             accumulate: Accumulate::new(&ctx)?,
             present: None,
         };
-        let denoisers = denoisers
-            .iter()
-            .map(|n| {
-                denoise::create(
-                    &ctx,
-                    n,
-                    settings.motion_source,
-                    settings.dataset,
-                    settings.features,
-                )
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let denoisers = create_methods(&ctx, &settings, denoisers)?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
@@ -357,7 +354,7 @@ impl Renderer {
     pub fn denoiser_names(&self) -> Vec<String> {
         self.denoisers
             .iter()
-            .map(|d| d.name().to_string())
+            .map(|m| m.info.name.to_string())
             .collect()
     }
 
@@ -366,20 +363,9 @@ impl Renderer {
     /// never resumes from stale state.
     pub fn set_denoisers(&mut self, names: &[&str]) -> Result<Vec<FrameResult>> {
         let done = self.flush()?;
-        let new = names
-            .iter()
-            .map(|n| {
-                denoise::create(
-                    &self.ctx,
-                    n,
-                    self.settings.motion_source,
-                    self.settings.dataset,
-                    self.settings.features,
-                )
-            })
-            .collect::<Result<Vec<_>>>()?;
-        for d in &mut self.denoisers {
-            d.destroy(&self.ctx);
+        let new = create_methods(&self.ctx, &self.settings, names)?;
+        for m in &mut self.denoisers {
+            m.denoiser.destroy(&self.ctx);
         }
         self.denoisers = new;
         self.graph.reset_history("");
@@ -462,7 +448,12 @@ impl Renderer {
             (&self.ctx, &mut self.graph, &self.passes, self.settings.size);
 
         // features → path trace → motion → each denoiser on the same noisy frame.
-        let features = if self.denoisers.iter().any(|d| d.uses_surface_features()) {
+        let motion = self.settings.motion_source;
+        let features = if self
+            .denoisers
+            .iter()
+            .any(|m| m.info.features.needed(motion))
+        {
             Some(passes.features.add(ctx, graph, &mut frame, &scene, size)?)
         } else {
             None
@@ -517,8 +508,10 @@ impl Renderer {
             retrace,
         };
         let mut outputs: Vec<(String, ImageHandle)> = Vec::new();
-        for d in &self.denoisers {
-            outputs.push((d.name().to_string(), d.add(ctx, graph, &mut frame, &input)?));
+        for m in &self.denoisers {
+            let name = m.info.name;
+            let out = frame.add_owned(name, |f| m.denoiser.add(ctx, graph, f, &input))?;
+            outputs.push((name.to_string(), out));
         }
 
         let readbacks = if request.readback {
@@ -738,6 +731,29 @@ impl Renderer {
     }
 }
 
+/// Builds the denoisers called `names` for a renderer with `settings`.
+fn create_methods(
+    ctx: &GpuContext,
+    settings: &RenderSettings,
+    names: &[&str],
+) -> Result<Vec<Method>> {
+    let config = DenoiserConfig {
+        motion: settings.motion_source,
+        dataset: settings.dataset,
+        features: settings.features,
+    };
+    names
+        .iter()
+        .map(|n| {
+            let info = registry::find(n)?;
+            Ok(Method {
+                info,
+                denoiser: info.create(ctx, &config)?,
+            })
+        })
+        .collect()
+}
+
 /// The rgba32f pixels of a host-visible readback buffer.
 fn read_pixels(graph: &RenderGraph, buffer: BufferHandle) -> Result<Vec<[f32; 4]>> {
     let bytes = graph
@@ -830,8 +846,8 @@ impl Drop for Renderer {
             unsafe { ctx.device.destroy_fence(s.fence, None) };
         }
         unsafe { ctx.device.destroy_command_pool(self.pool, None) };
-        for d in &mut self.denoisers {
-            d.destroy(ctx);
+        for m in &mut self.denoisers {
+            m.denoiser.destroy(ctx);
         }
         self.graph.destroy(ctx);
     }
