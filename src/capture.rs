@@ -75,7 +75,7 @@ pub fn capture(
             "scene": setup.name,
             "width": setup.width(),
             "height": setup.height(),
-            "spp": setup.settings.spp,
+            "spp": setup.settings.spp(),
             "denoisers": renderer.denoiser_names(),
             "frames": timings,
         }),
@@ -198,7 +198,7 @@ pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, p
         scene: setup.name.clone(),
         width: setup.width(),
         height: setup.height(),
-        spp: setup.settings.spp,
+        spp: setup.settings.spp(),
         denoisers: renderer.denoiser_names(),
     };
     Ok((Profile::new(run, &stats, &window, Some(peak)), window))

@@ -115,7 +115,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
          every method fed the same noisy frames and scored against the reference. {why} \
          The references are cached in {}, so the next run renders only the methods.",
         describe(&chosen),
-        dvr_engine::scene::Scene::open(DEFAULT_SCENE)?.render.spp,
+        dvr_engine::scene::Scene::open(DEFAULT_SCENE)?.render.spp(),
         args.out.display(),
     );
     eprintln!("dvr demo: {}", describe(&chosen));

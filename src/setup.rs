@@ -8,8 +8,8 @@ use dvr_engine::denoise::{registry, MotionSource};
 use dvr_engine::gpu::GpuContext;
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
-use dvr_engine::renderer::{FrameInputs, RenderSettings, Renderer};
-use dvr_engine::scene::Scene;
+use dvr_engine::renderer::{FrameInputs, Renderer};
+use dvr_engine::scene::{RenderSettings, Scene};
 use std::path::Path;
 
 /// The scene `dvr` renders when none is named.
@@ -129,21 +129,21 @@ impl Setup {
             height: args.size.1,
         };
         let mut inner = SceneSetup::new(scene, size, args.spp, args.volume_size)?;
-        inner.settings.motion_source = args.motion;
+        inner.config.motion_source = args.motion;
         Ok(Self {
             name: inner.scene.name.clone(),
             frames: inner.scene.frames,
-            settings: inner.settings.clone(),
+            settings: inner.settings,
             inner,
         })
     }
 
     pub fn width(&self) -> u32 {
-        self.settings.size.width
+        self.inner.config.size.width
     }
 
     pub fn height(&self) -> u32 {
-        self.settings.size.height
+        self.inner.config.size.height
     }
 
     pub fn renderer(&self, denoisers: &[&str]) -> Result<Renderer> {
@@ -186,7 +186,7 @@ pub fn write_capture_page(
         setup.name,
         setup.width(),
         setup.height(),
-        setup.settings.spp,
+        setup.settings.spp(),
         setup.frames
     ));
     html.push_str(&format!(

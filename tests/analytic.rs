@@ -5,20 +5,16 @@
 mod common;
 
 use common::*;
-use dvr_engine::passes::path_trace::PathTraceFeatures;
 use dvr_engine::scene::{Estimator, Phase};
 
 /// Camera rays through a purely absorbing unit cube in front of a constant environment:
 /// every ray that crosses the cube along z sees exp(−μt·1).
 fn slab_transmittance(estimator: Estimator) -> f64 {
     let mut s = settings(8, 1);
-    s.features = PathTraceFeatures {
-        estimator,
-        ..Default::default()
-    };
-    s.density_scale = 1.5; // μt = opacity × scale = 1.5 per unit
-    s.step_voxels = 0.25;
-    s.filter_sigma = 0.0; // straight through the pixel centre
+    s.settings.set_estimator(estimator);
+    s.config.density_scale = 1.5; // μt = opacity × scale = 1.5 per unit
+    s.settings.set_step_size(0.25).expect("step");
+    s.settings.set_filter_sigma(0.0).expect("pinhole"); // straight through the pixel centre
     let volume = constant_volume(8, 1.0);
     let mut r = renderer(context(), s, &volume, &["none"]);
     let inputs = inputs(
@@ -55,9 +51,9 @@ fn slab_transmittance_matches_beer_lambert_ray_marching() {
 #[test]
 fn white_furnace_returns_the_environment() {
     let mut s = settings(8, 1);
-    s.density_scale = 4.0;
-    s.max_bounces = 1000;
-    s.rr_depth = 4;
+    s.config.density_scale = 4.0;
+    s.settings.set_max_bounces(1000).expect("bounces");
+    s.settings.set_russian_roulette_depth(4);
     let volume = constant_volume(8, 1.0);
     let mut r = renderer(context(), s, &volume, &["none"]);
     let inputs = inputs(
@@ -110,14 +106,11 @@ fn identical_seeds_give_identical_images() {
 #[test]
 fn henyey_greenstein_white_furnace_conserves_energy() {
     let mut s = settings(8, 1);
-    s.density_scale = 4.0;
-    s.max_bounces = 1000;
-    s.rr_depth = 4;
-    s.hg_g = 0.7;
-    s.features = PathTraceFeatures {
-        phase: Phase::Hg,
-        ..Default::default()
-    };
+    s.config.density_scale = 4.0;
+    s.settings.set_max_bounces(1000).expect("bounces");
+    s.settings.set_russian_roulette_depth(4);
+    s.settings.set_hg_g(0.7).expect("g");
+    s.settings.set_phase(Phase::Hg);
     let volume = constant_volume(8, 1.0);
     let mut r = renderer(context(), s, &volume, &["none"]);
     let inputs = inputs(
@@ -137,12 +130,9 @@ fn henyey_greenstein_white_furnace_conserves_energy() {
 #[test]
 fn emissive_slab_matches_the_emission_absorption_solution() {
     let mut s = settings(8, 1);
-    s.density_scale = 1.5;
-    s.filter_sigma = 0.0;
-    s.features = PathTraceFeatures {
-        emission: true,
-        ..Default::default()
-    };
+    s.config.density_scale = 1.5;
+    s.settings.set_filter_sigma(0.0).expect("pinhole");
+    s.settings.set_emission(true);
     let volume = constant_volume(8, 1.0);
     let mut lut = constant_lut(1.0, 0.0);
     lut.emissive = vec![[2.0, 2.0, 2.0, 0.0]; LUT];
@@ -177,21 +167,10 @@ fn environment_map_is_z_up_equirectangular() {
         rgba,
     };
     let mut s = settings(16, 1);
-    s.filter_sigma = 0.0;
-    s.features = PathTraceFeatures {
-        environment_map: true,
-        ..Default::default()
-    };
+    s.settings.set_filter_sigma(0.0).expect("pinhole");
     let volume = constant_volume(8, 0.0); // empty: the camera sees the environment
-    let r = dvr_engine::renderer::Renderer::new(
-        context(),
-        s,
-        &volume,
-        Some(&env),
-        &["none"],
-        LUT as u32,
-    );
-    let mut r = r.expect("renderer");
+                                          // The environment map specialises the path tracer for one.
+    let mut r = renderer_with(context(), s, &volume, Some(&env), &["none"]);
     let light = dvr_engine::shaders::frame::GpuLight {
         position_kind: glam::Vec4::new(0.0, 0.0, 0.0, LIGHT_ENV),
         radiance: glam::Vec4::new(0.0, 0.0, 0.0, ENV_MAP),

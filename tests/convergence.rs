@@ -7,7 +7,7 @@ mod common;
 
 use common::*;
 use dvr_engine::renderer::scene_gpu::{LutUpload, VolumeUpload};
-use dvr_engine::renderer::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
+use dvr_engine::renderer::{CameraMatrices, FrameInputs, Renderer};
 use dvr_engine::transfer::TransferFunction;
 use dvr_engine::volume::Volume;
 use glam::Vec3;
@@ -31,14 +31,11 @@ fn phantom_view() -> FrameInputs {
 
 fn phantom_renderer(seed: u32) -> (Renderer, FrameInputs) {
     let volume = VolumeUpload::from_volume(&Volume::builtin("phantom", 32).expect("phantom"));
-    let settings = RenderSettings {
-        seed,
-        density_scale: 150.0,
-        max_bounces: 4,
-        ..settings(16, 1)
-    };
-    let r =
-        Renderer::new(context(), settings, &volume, None, &["none"], LUT as u32).expect("renderer");
+    let mut s = settings(16, 1);
+    s.settings.set_seed(seed);
+    s.config.density_scale = 150.0;
+    s.settings.set_max_bounces(4).expect("bounces");
+    let r = renderer(context(), s, &volume, &["none"]);
     (r, phantom_view())
 }
 
@@ -88,13 +85,10 @@ fn majorant_grid_matches_a_global_majorant_on_odd_sized_volumes() {
                 max: vec![1.0],
             };
         }
-        let s = RenderSettings {
-            density_scale: 150.0,
-            max_bounces: 2,
-            ..settings(24, 1)
-        };
-        let mut r =
-            Renderer::new(context(), s, &volume, None, &["none"], LUT as u32).expect("renderer");
+        let mut s = settings(24, 1);
+        s.config.density_scale = 150.0;
+        s.settings.set_max_bounces(2).expect("bounces");
+        let mut r = renderer(context(), s, &volume, &["none"]);
         r.reference(&phantom_view(), 512, 4).expect("render")
     };
     let (grid, global) = (render(false), render(true));

@@ -76,7 +76,7 @@ fn ours_on_a_static_scene_beats_32_spp_after_64_frames() {
     ] {
         let scene = Scene::builtin(name).expect("scene");
         let mut setup = SceneSetup::new(scene, size, None, 32).expect("setup");
-        setup.settings.motion_source = motion;
+        setup.config.motion_source = motion;
         let inputs = setup.frame_inputs(0);
         let mut r = setup.renderer(context(), &["ours"]).expect("renderer");
         let request = FrameRequest {
@@ -90,7 +90,7 @@ fn ours_on_a_static_scene_beats_32_spp_after_64_frames() {
             .1
             .clone();
         let reference = r.reference(&inputs, 1024, 4).expect("reference");
-        setup.settings.seed = 99; // an independent stream for the 32-spp render
+        setup.settings.set_seed(99); // an independent stream for the 32-spp render
         let mut plain = setup.renderer(context(), &["none"]).expect("renderer");
         let spp32 = plain.reference(&inputs, 32, 4).expect("32 spp");
         let (e_ours, e_32) = (mse(&ours, &reference), mse(&spp32, &reference));

@@ -65,7 +65,9 @@ pub fn measure(
     label: &str,
     timing: &Arc<Timing>,
 ) -> Result<Vec<BaselinePoint>> {
-    renderer.settings.seed = renderer.settings.seed.wrapping_add(SEED_OFFSET);
+    let mut settings = *renderer.settings();
+    settings.set_seed(settings.seed().wrapping_add(SEED_OFFSET));
+    renderer.set_settings(&settings)?;
     // Each level is scored on the pool while the GPU renders the next.
     let mut jobs = Overlap::new(timing);
     let (w, h) = (setup.width(), setup.height());

@@ -65,7 +65,7 @@ impl Plan {
                 spec: spec.clone(),
                 name: label,
                 frames: scene.frames,
-                spp: args.spp.unwrap_or(scene.render.spp),
+                spp: args.spp.unwrap_or(scene.render.spp()),
                 references: ReferenceCache::new(&dir, key),
                 dir,
             });
@@ -368,7 +368,7 @@ pub fn evaluate_scene(
         readback: true,
         reset: false,
     };
-    let frame_units = f64::from(setup.settings.spp) + methods.len() as f64;
+    let frame_units = f64::from(setup.settings.spp()) + methods.len() as f64;
     let status = |f: u32| {
         format!(
             "{label} | {} | frame {f}/{}",
@@ -389,7 +389,7 @@ pub fn evaluate_scene(
     let rows: Vec<MetricRow> = state.jobs.finish()?.into_iter().flatten().collect();
     timing.frames.add(frames_started.elapsed());
 
-    let ms_per_spp = path_trace_ms_per_spp(&state.timings, setup.settings.spp);
+    let ms_per_spp = path_trace_ms_per_spp(&state.timings, setup.settings.spp());
     let baseline = timing.baseline.time(|| {
         baseline::measure(
             &mut renderer,
@@ -411,7 +411,7 @@ pub fn evaluate_scene(
             "scene": scene.name,
             "width": setup.width(),
             "height": setup.height(),
-            "spp": setup.settings.spp,
+            "spp": setup.settings.spp(),
             "denoisers": methods,
             "frames": state.timings,
         }),
@@ -422,7 +422,7 @@ pub fn evaluate_scene(
         name: scene.name.clone(),
         dir: dir_file_name(&scene.dir),
         frames: setup.frames,
-        spp: setup.settings.spp,
+        spp: setup.settings.spp(),
         methods: methods.to_vec(),
         event_frame,
         rows,

@@ -28,11 +28,11 @@ use dvr_engine::gpu::{ContextOptions, GpuContext, Swapchain};
 use dvr_engine::graph::Extent;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png, PNG_EXPOSURE};
 use dvr_engine::passes::present::PresentLayout;
-use dvr_engine::renderer::scene_setup::{self, inputs_for, load_volume, SceneSetup};
+use dvr_engine::renderer::scene_setup::{inputs_for, load_volume, SceneSetup};
 use dvr_engine::renderer::{
-    FrameRequest, FrameResult, PresentTarget, RenderSettings, Renderer, Screenshot,
+    FrameRequest, FrameResult, PresentTarget, Renderer, Screenshot, SettingsChange,
 };
-use dvr_engine::scene::{Scene, VolumeSource};
+use dvr_engine::scene::VolumeSource;
 use input::{apply_to_camera, Command, DragKind, Key, Pointer, Script};
 use overlay::EguiOverlay;
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
@@ -141,7 +141,7 @@ pub fn run(args: ExploreArgs) -> Result<()> {
         height: args.size.1,
     };
     let mut setup = SceneSetup::with_volume(scene, &volume, size, args.spp)?;
-    setup.settings.motion_source = args.motion;
+    setup.config.motion_source = args.motion;
     drop(volume);
     let event_loop = EventLoop::new().map_err(|e| anyhow::anyhow!("{NO_DISPLAY} ({e})"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
@@ -204,8 +204,6 @@ struct Explorer {
     recorder: Option<Recorder>,
     /// Frames submitted so far.
     frame: u64,
-    /// Restart denoiser histories on the next frame (settings changed).
-    reset: bool,
     resized: bool,
     /// Frame indices whose results should be saved as F12 screenshots.
     shots: Vec<u64>,
@@ -236,11 +234,7 @@ impl Explorer {
         let model = Model {
             tf: setup.scene.tf_a.clone(),
             lights: state.lights,
-            render: {
-                let mut r = setup.scene.render;
-                r.spp = setup.settings.spp;
-                r
-            },
+            render: setup.settings,
             exposure: PNG_EXPOSURE,
             vsync: !args.no_vsync,
             left: names[0].clone(),
@@ -272,7 +266,6 @@ impl Explorer {
             window: None,
             recorder,
             frame: 0,
-            reset: false,
             resized: false,
             shots: Vec::new(),
             shot_count: 0,
@@ -340,6 +333,7 @@ impl Explorer {
         let renderer = self
             .setup
             .renderer_shared(Arc::clone(&ctx), &self.denoiser_list())?;
+        self.ui.max_spp = renderer.samples_per_dispatch();
         self.ui.stats.device = ctx.info.name.clone();
         self.ui.stats.present_mode = format!("{:?}", swapchain.present_mode);
         let max_texture_side = 4096;
@@ -375,27 +369,6 @@ impl Explorer {
         v
     }
 
-    /// The renderer settings for the model: what a scene with the model's render
-    /// settings and lights asks for (`scene_setup::render_settings`, the one mapping),
-    /// over the current size, seed and motion source.
-    fn render_settings(&self, current: &RenderSettings) -> RenderSettings {
-        let scene = Scene {
-            render: self.model.render,
-            lights: self.model.lights.clone(),
-            ..self.setup.scene.clone()
-        };
-        let s = scene_setup::render_settings(&scene, current.size, self.model.render.spp);
-        RenderSettings {
-            spp: s.spp,
-            max_bounces: s.max_bounces,
-            rr_depth: s.rr_depth,
-            features: s.features,
-            hg_g: s.hg_g,
-            step_voxels: s.step_voxels,
-            ..current.clone()
-        }
-    }
-
     /// Brings the renderer and swapchain in line with the model.
     fn apply_model(&mut self) -> Result<Vec<FrameResult>> {
         let mut done = Vec::new();
@@ -403,39 +376,33 @@ impl Explorer {
             return Ok(done);
         }
         let denoisers: Vec<String> = self.denoiser_list().iter().map(|s| s.to_string()).collect();
-        let Some(current) = self
-            .gfx
-            .as_ref()
-            .and_then(|g| g.renderer.as_ref())
-            .map(|r| r.settings.clone())
-        else {
-            return Ok(done);
-        };
-        let settings = self.render_settings(&current);
         let Some(gfx) = self.gfx.as_mut() else {
             return Ok(done);
         };
         let Some(renderer) = gfx.renderer.as_mut() else {
             return Ok(done);
         };
-        if settings.features != renderer.settings.features {
-            // Specialisation constants change: a new renderer (same device and window).
-            done.extend(renderer.flush()?);
-            gfx.renderer = None;
-            self.setup.settings = settings;
-            let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
-            gfx.renderer = Some(self.setup.renderer_shared(Arc::clone(&gfx.ctx), &names)?);
-        } else {
-            if renderer.denoiser_names() != denoisers {
+        // The renderer checks the settings and restarts every history when they change.
+        match renderer.set_settings(&self.model.render) {
+            Ok(SettingsChange::NeedsNewRenderer) => {
+                // Specialisation constants change: a new renderer (same device and window).
+                done.extend(renderer.flush()?);
+                gfx.renderer = None;
+                self.setup.settings = self.model.render;
                 let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
-                done.extend(renderer.set_denoisers(&names)?);
+                let renderer = self.setup.renderer_shared(Arc::clone(&gfx.ctx), &names)?;
+                self.ui.max_spp = renderer.samples_per_dispatch();
+                gfx.renderer = Some(renderer);
             }
-            if settings.spp != renderer.settings.spp
-                || settings.max_bounces != renderer.settings.max_bounces
-                || settings.hg_g != renderer.settings.hg_g
-            {
-                renderer.settings = settings;
-                self.reset = true;
+            Ok(SettingsChange::Applied | SettingsChange::Unchanged) => {
+                if renderer.denoiser_names() != denoisers {
+                    let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
+                    done.extend(renderer.set_denoisers(&names)?);
+                }
+            }
+            Err(e) => {
+                self.ui.set_status(e.to_string());
+                self.model.render = *renderer.settings();
             }
         }
         if self.model.vsync != self.applied.vsync {
@@ -558,7 +525,6 @@ impl Explorer {
         let readback_hdr = want_shot || self.recorder.is_some();
         let split = (self.denoiser_list().len() == 2)
             .then(|| ((vw as f32 * self.model.split) as u32).clamp(1, vw - 1));
-        let reset = std::mem::take(&mut self.reset);
         let want_present_copy = want_shot || self.args.screenshot.is_some();
         let Some(gfx) = self.gfx.as_mut() else {
             return Ok(());
@@ -570,13 +536,7 @@ impl Explorer {
             width: vw,
             height: vh,
         };
-        let mut finished = Vec::new();
-        if renderer.settings.size != view {
-            // The graph reallocates its images at the new size: let the frames in
-            // flight that use the old ones finish first.
-            finished = renderer.flush()?;
-            renderer.settings.size = view;
-        }
+        let finished = renderer.resize(view)?;
         self.ui.stats.render_size = (vw, vh);
         let Some(image) = gfx.swapchain.acquire()? else {
             gfx.recreate_swapchain(size)?;
@@ -598,7 +558,7 @@ impl Explorer {
         };
         let request = FrameRequest {
             readback: readback_hdr,
-            reset,
+            reset: false,
         };
         let result = renderer.frame_presented(&inputs, &request, Some(&target))?;
         if !gfx.swapchain.present(&gfx.ctx, &image)? {

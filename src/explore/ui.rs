@@ -91,6 +91,8 @@ pub struct UiState {
     pub status: Option<(String, std::time::Instant)>,
     /// Recording: light kinds and counts are locked (a scene cannot animate them).
     pub recording: bool,
+    /// Most samples per pixel the renderer takes in one frame on this device.
+    pub max_spp: u32,
 }
 
 /// What the UI asks the frame loop to do besides editing the model.
@@ -109,6 +111,7 @@ impl UiState {
             stats: Stats::default(),
             status: None,
             recording: false,
+            max_spp: 1,
         }
     }
 
@@ -408,38 +411,86 @@ fn lights(ui: &mut egui::Ui, state: &UiState, lights: &mut Vec<Light>) {
     });
 }
 
-fn render_controls(ui: &mut egui::Ui, state: &UiState, model: &mut Model) {
+fn render_controls(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model) {
+    // Each edit goes through the settings' own checks; a refused value stays unapplied
+    // and says why.
     let r = &mut model.render;
-    ui.add(egui::Slider::new(&mut r.spp, 1..=4).text("spp / frame"));
-    ui.add(egui::Slider::new(&mut r.max_bounces, 0..=16).text("max bounces"));
+    let mut refused = None;
+    let mut spp = r.spp();
+    if ui
+        .add(egui::Slider::new(&mut spp, 1..=state.max_spp.max(1)).text("spp / frame"))
+        .changed()
+    {
+        refused = r.set_spp(spp).err().or(refused);
+    }
+    let mut bounces = r.max_bounces();
+    if ui
+        .add(egui::Slider::new(&mut bounces, 0..=16).text("max bounces"))
+        .changed()
+    {
+        refused = r.set_max_bounces(bounces).err().or(refused);
+    }
+    let mut estimator = r.estimator();
     ui.horizontal(|ui| {
         ui.label("estimator");
         egui::ComboBox::from_id_salt("estimator")
-            .selected_text(match r.estimator {
+            .selected_text(match estimator {
                 scene::Estimator::Delta => "delta tracking",
                 scene::Estimator::RayMarch => "ray marching",
             })
             .show_ui(ui, |ui| {
-                ui.selectable_value(&mut r.estimator, scene::Estimator::Delta, "delta tracking");
-                ui.selectable_value(&mut r.estimator, scene::Estimator::RayMarch, "ray marching");
+                ui.selectable_value(&mut estimator, scene::Estimator::Delta, "delta tracking");
+                ui.selectable_value(&mut estimator, scene::Estimator::RayMarch, "ray marching");
             });
     });
+    r.set_estimator(estimator);
+    if estimator == scene::Estimator::RayMarch {
+        let mut step = r.step_size();
+        if ui
+            .add(
+                egui::Slider::new(&mut step, 0.1..=4.0)
+                    .logarithmic(true)
+                    .text("step (voxels)"),
+            )
+            .changed()
+        {
+            refused = r.set_step_size(step).err().or(refused);
+        }
+    }
+    let mut phase = r.phase();
     ui.horizontal(|ui| {
         ui.label("phase");
         egui::ComboBox::from_id_salt("phase")
-            .selected_text(format!("{:?}", r.phase).to_lowercase())
+            .selected_text(format!("{phase:?}").to_lowercase())
             .show_ui(ui, |ui| {
                 for p in [
                     scene::Phase::Isotropic,
                     scene::Phase::Hg,
                     scene::Phase::Hybrid,
                 ] {
-                    ui.selectable_value(&mut r.phase, p, format!("{p:?}").to_lowercase());
+                    ui.selectable_value(&mut phase, p, format!("{p:?}").to_lowercase());
                 }
             });
     });
-    if r.phase != scene::Phase::Isotropic {
-        ui.add(egui::Slider::new(&mut r.hg_g, -0.9..=0.9).text("HG g"));
+    r.set_phase(phase);
+    if phase != scene::Phase::Isotropic {
+        let mut g = r.hg_g();
+        if ui
+            .add(egui::Slider::new(&mut g, -0.9..=0.9).text("HG g"))
+            .changed()
+        {
+            refused = r.set_hg_g(g).err().or(refused);
+        }
+    }
+    let mut rr = r.russian_roulette_depth();
+    if ui
+        .add(egui::Slider::new(&mut rr, 0..=16).text("roulette from bounce"))
+        .changed()
+    {
+        r.set_russian_roulette_depth(rr);
+    }
+    if let Some(e) = refused {
+        state.set_status(e.to_string());
     }
     ui.add(
         egui::Slider::new(&mut model.exposure, 0.1..=10.0)

@@ -6,7 +6,8 @@
 use dvr_engine::gpu::{validation, GpuContext};
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_gpu::{BrickRanges, LutUpload, VolumeFormat, VolumeUpload};
-use dvr_engine::renderer::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
+use dvr_engine::renderer::{CameraMatrices, FrameInputs, Renderer, RendererConfig};
+use dvr_engine::scene::RenderSettings;
 use dvr_engine::shaders::frame::{GpuLight, ENV_CONSTANT, LIGHT_ENV, LIGHT_POINT};
 use glam::{Vec3, Vec4};
 
@@ -71,24 +72,57 @@ pub fn front_camera(dist: f32, fov_deg: f32) -> CameraMatrices {
     )
 }
 
-pub fn settings(size: u32, spp: u32) -> RenderSettings {
-    RenderSettings {
-        size: Extent {
-            width: size,
-            height: size,
+/// What a test renderer is built with.
+pub struct TestSettings {
+    pub settings: RenderSettings,
+    pub config: RendererConfig,
+}
+
+/// A `size`² renderer at `spp` samples per frame, 8 bounces and a one-voxel ray-march
+/// step (the values these tests were written with), density scale 100.
+pub fn settings(size: u32, spp: u32) -> TestSettings {
+    let mut settings = RenderSettings::default();
+    settings.set_spp(spp).expect("spp");
+    settings.set_max_bounces(8).expect("bounces");
+    settings.set_step_size(1.0).expect("step");
+    TestSettings {
+        settings,
+        config: RendererConfig {
+            size: Extent {
+                width: size,
+                height: size,
+            },
+            ..Default::default()
         },
-        spp,
-        ..Default::default()
     }
 }
 
 pub fn renderer(
     ctx: GpuContext,
-    s: RenderSettings,
+    s: TestSettings,
     v: &VolumeUpload,
     denoisers: &[&str],
 ) -> Renderer {
-    Renderer::new(ctx, s, v, None, denoisers, LUT as u32).expect("renderer")
+    renderer_with(ctx, s, v, None, denoisers)
+}
+
+pub fn renderer_with(
+    ctx: GpuContext,
+    s: TestSettings,
+    v: &VolumeUpload,
+    environment: Option<&dvr_engine::renderer::scene_gpu::EnvironmentUpload>,
+    denoisers: &[&str],
+) -> Renderer {
+    Renderer::new(
+        ctx,
+        s.settings,
+        s.config,
+        v,
+        environment,
+        denoisers,
+        LUT as u32,
+    )
+    .expect("renderer")
 }
 
 pub fn inputs(camera: CameraMatrices, lights: Vec<GpuLight>, lut: LutUpload) -> FrameInputs {

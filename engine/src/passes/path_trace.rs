@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::gpu_block;
 use crate::graph::{Extent, Frame, History, ImageHandle, RenderGraph};
-use crate::scene::{Estimator, Phase};
+use crate::scene::{Estimator, Phase, PipelineKey};
 use crate::shaders::frame::{
     ESTIMATOR_DELTA, ESTIMATOR_RAY_MARCH, PHASE_HG, PHASE_HYBRID, PHASE_ISOTROPIC,
 };
@@ -23,13 +23,25 @@ gpu_block! {
     }
 }
 
-/// What the pipeline is specialised for (what the scene uses).
+/// What the pipeline is specialised for (what the scene uses): the render settings'
+/// [`PipelineKey`] and whether an environment map is bound.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct PathTraceFeatures {
     pub estimator: Estimator,
     pub phase: Phase,
     pub emission: bool,
     pub environment_map: bool,
+}
+
+impl PathTraceFeatures {
+    pub fn new(key: PipelineKey, environment_map: bool) -> Self {
+        Self {
+            estimator: key.estimator,
+            phase: key.phase,
+            emission: key.emission,
+            environment_map,
+        }
+    }
 }
 
 /// The specialisation constants of a pipeline that traces paths (include/path.glsl):

@@ -21,6 +21,7 @@ use crate::passes::path_trace::{PathTrace, PathTraceFeatures};
 use crate::passes::present::Present;
 use crate::passes::surface_features::SurfaceFeatures;
 use crate::passes::SceneBindings;
+use crate::scene::RenderSettings;
 use crate::shaders::frame::{FrameBlock, FrameParams, GpuLight, SampleStream};
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
@@ -59,53 +60,44 @@ pub fn samples_per_dispatch(info: &crate::gpu::DeviceInfo, pixels: u64) -> u32 {
     n.clamp(u64::from(MAX_SAMPLES_PER_DISPATCH), u64::from(u32::MAX)) as u32
 }
 
-/// Fixed settings of a renderer (changing them means a new renderer).
-#[derive(Clone, Debug)]
-pub struct RenderSettings {
+/// What a renderer is built for besides its [`RenderSettings`]: the image size and what
+/// the scene's volume fixes for the renderer's lifetime.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RendererConfig {
     pub size: Extent,
-    pub spp: u32,
-    pub max_bounces: u32,
-    /// Bounce from which Russian roulette may end a path.
-    pub rr_depth: u32,
-    pub features: PathTraceFeatures,
-    pub hg_g: f32,
-    /// Ray-marching step in voxels (ray-march estimator only).
-    pub step_voxels: f32,
-    /// Accumulated opacity at which the surface-features pass stops.
-    pub feature_threshold: f32,
-    /// Standard deviation of the Gaussian pixel filter, in pixels.
-    pub filter_sigma: f32,
-    /// Extinction per unit opacity (1/world unit).
+    /// Extinction per unit opacity (1/world unit): the scene volume's density scale.
     pub density_scale: f32,
-    pub seed: u32,
-    /// What the temporal denoisers reproject with.
+    /// What the temporal denoisers reproject with (their pipelines are specialised on
+    /// it).
     pub motion_source: denoise::MotionSource,
     /// The built-in dataset the volume is, if it is one (`rae` runs the network trained
     /// on it).
     pub dataset: Option<&'static str>,
 }
 
-impl Default for RenderSettings {
+impl Default for RendererConfig {
     fn default() -> Self {
         Self {
             size: Extent {
                 width: 256,
                 height: 256,
             },
-            spp: 2,
-            max_bounces: 8,
-            rr_depth: 3,
-            features: PathTraceFeatures::default(),
-            hg_g: 0.0,
-            step_voxels: 1.0,
-            feature_threshold: 0.5,
-            filter_sigma: 0.5,
             density_scale: 100.0,
-            seed: 1,
             motion_source: denoise::MotionSource::FirstHit,
             dataset: None,
         }
     }
+}
+
+/// What [`Renderer::set_settings`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SettingsChange {
+    Unchanged,
+    /// Applied; every history restarts on the next frame.
+    Applied,
+    /// Not applied: the settings specialise the pipelines differently (see
+    /// [`RenderSettings::pipeline_key`]), which takes a new renderer.
+    NeedsNewRenderer,
 }
 
 /// A camera as the renderer needs it.
@@ -199,7 +191,12 @@ struct Passes {
 }
 
 pub struct Renderer {
-    pub settings: RenderSettings,
+    settings: RenderSettings,
+    config: RendererConfig,
+    /// What the path-tracing pipelines are specialised for.
+    features: PathTraceFeatures,
+    /// Restart every history on the next frame (the live settings changed).
+    pending_reset: bool,
     graph: RenderGraph,
     passes: Passes,
     denoisers: Vec<Method>,
@@ -225,6 +222,7 @@ impl Renderer {
     pub fn new(
         ctx: GpuContext,
         settings: RenderSettings,
+        config: RendererConfig,
         volume: &VolumeUpload,
         environment: Option<&EnvironmentUpload>,
         denoisers: &[&str],
@@ -233,6 +231,7 @@ impl Renderer {
         Self::new_shared(
             Arc::new(ctx),
             settings,
+            config,
             volume,
             environment,
             denoisers,
@@ -241,34 +240,27 @@ impl Renderer {
     }
 
     /// [`Renderer::new`] on a context the caller keeps a handle to.
+    #[allow(clippy::too_many_arguments)]
     pub fn new_shared(
         ctx: Arc<GpuContext>,
         settings: RenderSettings,
+        config: RendererConfig,
         volume: &VolumeUpload,
         environment: Option<&EnvironmentUpload>,
         denoisers: &[&str],
         lut_size: u32,
     ) -> Result<Self> {
-        let max_spp = samples_per_dispatch(&ctx.info, settings.size.pixels());
-        if settings.spp == 0 || settings.spp > max_spp {
-            return Err(EngineError::Pass {
-                pass: "path_trace".into(),
-                problem: format!(
-                    "{} samples per pixel per frame; 1 to {max_spp} are supported on {} \
-                     (use `dvr reference` or the accum denoiser for more)",
-                    settings.spp, ctx.info.name
-                ),
-            });
-        }
+        check_spp(&ctx, settings.spp(), config.size)?;
+        let features = PathTraceFeatures::new(settings.pipeline_key(), environment.is_some());
         let mut graph = RenderGraph::new(&ctx)?;
         let passes = Passes {
             features: SurfaceFeatures::new(&ctx)?,
-            path_trace: PathTrace::new(&ctx, settings.features)?,
+            path_trace: PathTrace::new(&ctx, features)?,
             motion: Motion::new(&ctx)?,
             accumulate: Accumulate::new(&ctx)?,
             present: None,
         };
-        let denoisers = create_methods(&ctx, &settings, denoisers)?;
+        let denoisers = create_methods(&ctx, &config, features, denoisers)?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
@@ -312,6 +304,9 @@ impl Renderer {
 
         Ok(Self {
             settings,
+            config,
+            features,
+            pending_reset: false,
             graph,
             passes,
             denoisers,
@@ -334,15 +329,48 @@ impl Renderer {
         &self.ctx
     }
 
-    /// The shared context (to keep the device alive beyond this renderer).
-    pub fn shared_ctx(&self) -> Arc<GpuContext> {
-        Arc::clone(&self.ctx)
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    pub fn config(&self) -> &RendererConfig {
+        &self.config
     }
 
     /// Most samples per pixel one path-tracing dispatch takes on this device at this
     /// size (see [`samples_per_dispatch`]).
     pub fn samples_per_dispatch(&self) -> u32 {
-        samples_per_dispatch(&self.ctx.info, self.settings.size.pixels())
+        samples_per_dispatch(&self.ctx.info, self.config.size.pixels())
+    }
+
+    /// Runs with `settings` from the next frame on: every history restarts then. A
+    /// change of what the pipelines are specialised for is not applied (it takes a new
+    /// renderer); samples per pixel beyond what the device takes in one frame are an
+    /// error.
+    pub fn set_settings(&mut self, settings: &RenderSettings) -> Result<SettingsChange> {
+        if settings.pipeline_key() != self.settings.pipeline_key() {
+            return Ok(SettingsChange::NeedsNewRenderer);
+        }
+        if *settings == self.settings {
+            return Ok(SettingsChange::Unchanged);
+        }
+        check_spp(&self.ctx, settings.spp(), self.config.size)?;
+        self.settings = *settings;
+        self.pending_reset = true;
+        Ok(SettingsChange::Applied)
+    }
+
+    /// Renders at `size` from the next frame on. The graph reallocates its images then,
+    /// so the frames in flight, which use the old ones, are waited for first: their
+    /// results are returned.
+    pub fn resize(&mut self, size: Extent) -> Result<Vec<FrameResult>> {
+        if size == self.config.size {
+            return Ok(Vec::new());
+        }
+        check_spp(&self.ctx, self.settings.spp(), size)?;
+        let done = self.flush()?;
+        self.config.size = size;
+        Ok(done)
     }
 
     /// GPU time of every pass this renderer has collected results of (frames and
@@ -363,7 +391,7 @@ impl Renderer {
     /// never resumes from stale state.
     pub fn set_denoisers(&mut self, names: &[&str]) -> Result<Vec<FrameResult>> {
         let done = self.flush()?;
-        let new = create_methods(&self.ctx, &self.settings, names)?;
+        let new = create_methods(&self.ctx, &self.config, self.features, names)?;
         for m in &mut self.denoisers {
             m.denoiser.destroy(&self.ctx);
         }
@@ -393,19 +421,19 @@ impl Renderer {
             prev_view_proj,
             camera: inputs.camera.position,
             half_size: world * 0.5,
-            density_scale: s.density_scale,
+            density_scale: self.config.density_scale,
             majorant_max,
             volume_dims: self.volume_dims,
             brick: self.bricks.brick,
             lights: &inputs.lights,
             stream,
-            max_bounces: s.max_bounces,
-            rr_depth: s.rr_depth,
-            step: voxel * s.step_voxels,
-            hg_g: s.hg_g,
-            feature_threshold: s.feature_threshold,
-            filter_sigma: s.filter_sigma,
-            seed: s.seed,
+            max_bounces: s.max_bounces(),
+            rr_depth: s.russian_roulette_depth(),
+            step: voxel * s.step_size() as f32,
+            hg_g: s.hg_g() as f32,
+            feature_threshold: s.feature_threshold() as f32,
+            filter_sigma: s.filter_sigma() as f32,
+            seed: s.seed(),
         })
     }
 
@@ -434,8 +462,9 @@ impl Renderer {
         if present.is_some() && self.passes.present.is_none() {
             self.passes.present = Some(Present::new(&self.ctx)?);
         }
-        let changes = self.changes(inputs, request.reset);
-        if request.reset {
+        let reset = request.reset || std::mem::take(&mut self.pending_reset);
+        let changes = self.changes(inputs, reset);
+        if reset {
             self.graph.reset_history("");
         }
         let mut frame = Frame::new();
@@ -445,10 +474,10 @@ impl Renderer {
         let block = self.frame_block(inputs, majorant_max, SampleStream::Frame(self.frame_index));
         let scene = self.write_uniforms(slot, &block)?;
         let (ctx, graph, passes, size) =
-            (&self.ctx, &mut self.graph, &self.passes, self.settings.size);
+            (&self.ctx, &mut self.graph, &self.passes, self.config.size);
 
         // features → path trace → motion → each denoiser on the same noisy frame.
-        let motion = self.settings.motion_source;
+        let motion = self.config.motion_source;
         let features = if self
             .denoisers
             .iter()
@@ -466,7 +495,7 @@ impl Renderer {
             &scene,
             size,
             0,
-            self.settings.spp,
+            self.settings.spp(),
         )?;
         let motion = passes.motion.add(
             ctx,
@@ -503,7 +532,7 @@ impl Renderer {
             motion,
             size,
             camera: inputs.camera.position,
-            spp: self.settings.spp,
+            spp: self.settings.spp(),
             changes,
             retrace,
         };
@@ -556,7 +585,7 @@ impl Renderer {
             });
         }
         let opacity: Vec<f32> = lut.diffuse_opacity.iter().map(|c| c[3]).collect();
-        let majorants = scene_gpu::majorants(&self.bricks, &opacity, self.settings.density_scale);
+        let majorants = scene_gpu::majorants(&self.bricks, &opacity, self.config.density_scale);
         let majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
         if self.current_lut.as_ref() != Some(lut) {
             let (ctx, graph) = (&self.ctx, &mut self.graph);
@@ -682,7 +711,7 @@ impl Renderer {
             let block = self.frame_block(inputs, majorant_max, stream);
             let scene = self.write_uniforms(0, &block)?;
             let (ctx, graph, passes, size) =
-                (&self.ctx, &mut self.graph, &self.passes, self.settings.size);
+                (&self.ctx, &mut self.graph, &self.passes, self.config.size);
             let batch_out = passes.path_trace.add(
                 ctx,
                 graph,
@@ -731,16 +760,36 @@ impl Renderer {
     }
 }
 
-/// Builds the denoisers called `names` for a renderer with `settings`.
+/// Samples per pixel one frame of `size` may take on this device: at least 1 (the
+/// settings' own check), at most [`samples_per_dispatch`].
+fn check_spp(ctx: &GpuContext, spp: u32, size: Extent) -> Result<()> {
+    let max = samples_per_dispatch(&ctx.info, size.pixels());
+    if (1..=max).contains(&spp) {
+        return Ok(());
+    }
+    Err(EngineError::InvalidSetting {
+        name: "spp",
+        value: spp.to_string(),
+        allowed: format!(
+            "1 to {max} samples per pixel per frame on {} (use `dvr reference` or the \
+             accum denoiser for more)",
+            ctx.info.name
+        ),
+    })
+}
+
+/// Builds the denoisers called `names` for a renderer built for `config` whose path
+/// tracer is specialised for `features`.
 fn create_methods(
     ctx: &GpuContext,
-    settings: &RenderSettings,
+    config: &RendererConfig,
+    features: PathTraceFeatures,
     names: &[&str],
 ) -> Result<Vec<Method>> {
     let config = DenoiserConfig {
-        motion: settings.motion_source,
-        dataset: settings.dataset,
-        features: settings.features,
+        motion: config.motion_source,
+        dataset: config.dataset,
+        features,
     };
     names
         .iter()

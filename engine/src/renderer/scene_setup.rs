@@ -5,13 +5,12 @@
 //! all go through here.
 
 use super::scene_gpu::{EnvironmentUpload, LutUpload, VolumeUpload};
-use super::{CameraMatrices, FrameInputs, RenderSettings, Renderer};
-use crate::error::Result as EngineResult;
+use super::{CameraMatrices, FrameInputs, Renderer, RendererConfig};
+use crate::error::{EngineError, Result as EngineResult};
 use crate::gpu::GpuContext;
 use crate::graph::Extent;
 use crate::image_io::ImageIoError;
-use crate::passes::path_trace::PathTraceFeatures;
-use crate::scene::{self, Camera, EnvSource, Light, Scene, VolumeSource};
+use crate::scene::{self, Camera, EnvSource, Light, RenderSettings, Scene, VolumeSource};
 use crate::shaders::frame::{self, GpuLight};
 use crate::transfer::{TfLut, LUT_SIZE};
 use crate::volume::{RawFormat, RawParams, Volume, VolumeError};
@@ -27,12 +26,16 @@ pub enum SetupError {
     Environment(#[from] ImageIoError),
     #[error("scene {scene}: {problem}")]
     Invalid { scene: String, problem: String },
+    #[error(transparent)]
+    Setting(#[from] EngineError),
 }
 
 /// A scene made ready for rendering.
 pub struct SceneSetup {
     pub scene: Scene,
+    /// The scene's render settings, with the spp override applied.
     pub settings: RenderSettings,
+    pub config: RendererConfig,
     pub volume: VolumeUpload,
     pub environment: Option<EnvironmentUpload>,
     lut_a: TfLut,
@@ -60,13 +63,18 @@ impl SceneSetup {
         size: Extent,
         spp: Option<u32>,
     ) -> Result<Self, SetupError> {
-        let settings = render_settings(&scene, size, spp.unwrap_or(scene.render.spp));
+        let mut settings = scene.render;
+        if let Some(spp) = spp {
+            settings.set_spp(spp)?;
+        }
+        let config = renderer_config(&scene, size);
         let environment = load_environment(&scene.lights)?;
         let lut_a = scene.tf_a.lut();
         let lut_b = scene.tf_b.as_ref().map(|b| b.lut());
         Ok(Self {
             volume: VolumeUpload::from_volume(volume),
             settings,
+            config,
             environment,
             scene,
             lut_a,
@@ -87,7 +95,8 @@ impl SceneSetup {
     ) -> EngineResult<Renderer> {
         Renderer::new_shared(
             ctx,
-            self.settings.clone(),
+            self.settings,
+            self.config.clone(),
             &self.volume,
             self.environment.as_ref(),
             denoisers,
@@ -98,7 +107,7 @@ impl SceneSetup {
     /// The renderer's inputs for animation frame `f`.
     pub fn frame_inputs(&self, f: u32) -> FrameInputs {
         let state = self.scene.frame_state(f);
-        let size = self.settings.size;
+        let size = self.config.size;
         let aspect = size.width as f32 / size.height.max(1) as f32;
         let blended;
         let lut = match &self.lut_b {
@@ -152,24 +161,11 @@ pub fn load_volume(scene: &Scene, volume_size: u32) -> Result<Volume, VolumeErro
     }
 }
 
-/// The render settings a scene asks for, at `size` and `spp` samples per frame.
-pub fn render_settings(scene: &Scene, size: Extent, spp: u32) -> RenderSettings {
-    let r = &scene.render;
-    RenderSettings {
+/// What a renderer for `scene` at `size` is built for (reprojecting with the first
+/// collision until the caller picks otherwise).
+pub fn renderer_config(scene: &Scene, size: Extent) -> RendererConfig {
+    RendererConfig {
         size,
-        spp,
-        max_bounces: r.max_bounces,
-        rr_depth: r.russian_roulette_depth,
-        features: PathTraceFeatures {
-            estimator: r.estimator,
-            phase: r.phase,
-            emission: r.emission,
-            environment_map: scene.lights.iter().any(
-                |l| matches!(l, Light::Environment(e) if matches!(e.source, EnvSource::Map { .. })),
-            ),
-        },
-        hg_g: r.hg_g as f32,
-        step_voxels: r.step_size as f32,
         density_scale: scene.volume.density_scale as f32,
         dataset: match &scene.volume.source {
             VolumeSource::Builtin { dataset, .. } => Some(dataset.name()),

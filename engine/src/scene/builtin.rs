@@ -331,9 +331,11 @@ pub(crate) fn build(name: &str) -> Result<Scene, SceneError> {
         tf_b,
         camera: CameraSpec::default(),
         lights,
-        render: RenderSettings {
-            max_bounces: look.max_bounces,
-            ..RenderSettings::default()
+        render: {
+            let mut r = RenderSettings::default();
+            r.set_max_bounces(look.max_bounces)
+                .map_err(|e| ctx.invalid("render.max_bounces", e.to_string()))?;
+            r
         },
         frames: DEFAULT_FRAMES,
         animation,

@@ -5,7 +5,7 @@
 //! see [`builtin`]). The renderer never reads the file itself: it asks a [`Scene`] for
 //! the [`FrameState`] of each frame (camera with its matrices, lights, TF blend),
 //! uploads the TF LUTs from [`Scene::tf_luts`], specialises its pipeline from
-//! [`Scene::features`], and uses [`changed`] between consecutive frames to decide which
+//! [`Scene::render`] (its [`PipelineKey`]) and the lights, and uses [`changed`] between consecutive frames to decide which
 //! history to reset. Scripted animations are what makes denoisers comparable: every
 //! method sees exactly the same sequence, and `with_frames` resamples it for an 8-frame
 //! test or a 120-frame evaluation.
@@ -39,7 +39,6 @@ pub mod animation;
 pub mod builtin;
 pub mod camera;
 pub mod error;
-pub mod features;
 mod file;
 pub mod frame;
 pub mod light;
@@ -55,12 +54,11 @@ use std::path::Path;
 pub use animation::{Animation, CameraKey, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES};
 pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR};
 pub use error::SceneError;
-pub use features::Features;
 pub use frame::{changed, Change, FrameState};
 pub use light::{
     AreaLight, EnvMode, EnvSource, EnvironmentLight, Facing, Light, LightKind, PointLight,
 };
-pub use render::{Estimator, Phase, RenderSettings};
+pub use render::{Estimator, Phase, PipelineKey, RenderSettings, MAX_BOUNCES};
 pub use transfer_ref::TransferSpec;
 pub use volume::{BuiltinVolume, RawFormat, RawLayout, VolumeSource, VolumeSpec};
 
@@ -195,7 +193,7 @@ impl Scene {
             b.validate().map_err(tf_err("transfer.b"))?;
         }
         self.camera.check(ctx, "camera")?;
-        if self.lights.is_empty() && !self.render.emission {
+        if self.lights.is_empty() && !self.render.emission() {
             return Err(ctx.invalid(
                 "light",
                 "a scene needs at least one [[light]] (or render.emission = true)",

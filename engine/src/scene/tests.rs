@@ -169,6 +169,30 @@ fn tf_jump_goes_from_0_to_1_in_one_frame() {
     }
 }
 
+/// Whether the scene animates between `transfer.a` and `transfer.b`.
+fn tf_blend(s: &Scene) -> bool {
+    s.tf_b.is_some() && !s.animation.tf.is_empty()
+}
+
+fn has_point_light(s: &Scene) -> bool {
+    s.lights.iter().any(|l| matches!(l, Light::Point(_)))
+}
+
+fn has_area_light(s: &Scene) -> bool {
+    s.lights.iter().any(|l| matches!(l, Light::Area(_)))
+}
+
+fn environment_mode(s: &Scene) -> Option<EnvMode> {
+    s.lights.iter().find_map(|l| match l {
+        Light::Environment(e) => Some(match e.source {
+            EnvSource::Constant { .. } => EnvMode::Constant,
+            EnvSource::Gradient { .. } => EnvMode::Gradient,
+            EnvSource::Map { .. } => EnvMode::Map,
+        }),
+        _ => None,
+    })
+}
+
 #[test]
 fn tf_edit_blends_smoothly_and_the_lut_follows() {
     let s = builtin("phantom/tf-edit");
@@ -179,8 +203,8 @@ fn tf_edit_blends_smoothly_and_the_lut_follows() {
     let (a, b) = s.tf_luts();
     assert_eq!(s.tf_lut(0.0, 0.0), a);
     assert_eq!(s.tf_lut(1.0, 0.0), b);
-    assert!(s.features().tf_blend);
-    assert!(!builtin("phantom/orbit").features().tf_blend);
+    assert!(tf_blend(&s));
+    assert!(!tf_blend(&builtin("phantom/orbit")));
 }
 
 #[test]
@@ -193,8 +217,8 @@ fn light_animations_change_only_lights() {
         }
     }
     let area = builtin("mri/area-light");
-    assert!(area.features().area_lights && !area.features().point_lights);
-    assert_eq!(area.features().environment, Some(EnvMode::Gradient));
+    assert!(has_area_light(&area) && !has_point_light(&area));
+    assert_eq!(environment_mode(&area), Some(EnvMode::Gradient));
 }
 
 #[test]
@@ -232,9 +256,11 @@ fn example_scene_uses_every_section() {
     let s = Scene::load(example_path()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.name, "example");
     assert_eq!(s.lights.len(), 3);
-    let f = s.features();
     assert!(
-        f.point_lights && f.area_lights && f.environment == Some(EnvMode::Gradient) && f.tf_blend
+        has_point_light(&s)
+            && has_area_light(&s)
+            && environment_mode(&s) == Some(EnvMode::Gradient)
+            && tf_blend(&s)
     );
     assert!(
         !s.animation.camera.is_empty()
