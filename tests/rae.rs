@@ -23,7 +23,7 @@ const TOLERANCE: f32 = 5e-5;
 const F16_TOLERANCE: f32 = 1e-2;
 
 fn assets() -> PathBuf {
-    dvr_engine::transfer::assets_dir().join("rae")
+    dvr_engine::assets::rae_dir()
 }
 
 struct Fixture {

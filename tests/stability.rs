@@ -58,7 +58,7 @@ fn every_denoiser_stays_finite_and_bounded_on_every_built_in_animation() {
 }
 
 /// On a static view, 64 frames of `ours` at 2 spp end closer to the 1024-spp reference
-/// than a 32-spp render without denoising (issue 4's requirement), with both motion
+/// than a 32-spp render without denoising (what `ours` must beat), with both motion
 /// sources. This test found two real faults: motion vectors measured from the pixel
 /// centre gave the jittered first collision a random sub-pixel motion on a still view
 /// (every frame resampled the models), and the paper's relative-distance weights biased

@@ -4,6 +4,7 @@
 //! `renderer` (the frame). CPU-side data (`volume`, `transfer`, `scene`, `metrics`) feeds
 //! them.
 
+pub mod assets;
 pub mod denoise;
 pub mod error;
 pub mod gpu;

@@ -23,7 +23,7 @@
 //! about 1e-6) or rgba16f ([`Precision::F16`], the `*_f16` shader variants: half the
 //! memory traffic, arithmetic still fp32; tests/rae.rs bounds its difference from
 //! torch's fp32). Weights and their manifest are `assets/rae/<net>.{json,bin}`
-//! (read at creation through `$DVR_ASSETS` like the TF presets); a missing, truncated or
+//! (found through [`crate::assets`], like the TF presets); a missing, truncated or
 //! inconsistent file is an error naming the file. Like the paper's network, the
 //! recurrent state is never reset on camera, light or TF changes: the network was
 //! trained on moving sequences and has no reprojection.
@@ -189,11 +189,7 @@ fn weights_error(file: &Path, problem: impl Into<String>) -> EngineError {
 impl RaeWeights {
     /// The shipped network `net`: `<assets>/rae/<net>.json` and the weight file it names.
     pub fn builtin(net: &str) -> Result<Self> {
-        Self::load(
-            &crate::transfer::assets_dir()
-                .join("rae")
-                .join(format!("{net}.json")),
-        )
+        Self::load(&crate::assets::rae_manifest(net))
     }
 
     /// Reads a manifest and its weight file; every inconsistency (format, layer list,

@@ -319,10 +319,6 @@ impl Swapchain {
         self.create(ctx, self.extent)
     }
 
-    pub fn image_count(&self) -> usize {
-        self.images.len()
-    }
-
     /// Acquires the next image. `None` means the swapchain is out of date: recreate it
     /// and try again. A suboptimal swapchain is used for this frame; the following
     /// [`Swapchain::present`] reports it.

@@ -1,7 +1,9 @@
 //! How a pass touches a resource, and the state tracker that turns a sequence of such
 //! accesses into barriers. Pure logic with no device: the unit tests below check
 //! read-after-write, write-after-read, write-after-write and layout transitions, which
-//! lavapipe's validation layer does not catch on its own (see shared/LAVAPIPE.md).
+//! lavapipe's validation layer does not catch on its own (measured with Mesa 22.3:
+//! synchronization validation let two back-to-back compute dispatches read and write
+//! one storage image without a barrier).
 
 use ash::vk;
 

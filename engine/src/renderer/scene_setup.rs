@@ -10,10 +10,10 @@ use crate::error::{EngineError, Result as EngineResult};
 use crate::gpu::GpuContext;
 use crate::graph::Extent;
 use crate::image_io::ImageIoError;
-use crate::scene::{self, Camera, EnvSource, Light, RenderSettings, Scene, VolumeSource};
+use crate::scene::{Camera, EnvSource, Light, RenderSettings, Scene, VolumeSource};
 use crate::shaders::frame::{self, GpuLight};
 use crate::transfer::{TfLut, LUT_SIZE};
-use crate::volume::{RawFormat, RawParams, Volume, VolumeError};
+use crate::volume::{RawParams, Volume, VolumeError};
 use glam::{Vec3, Vec4};
 use std::sync::Arc;
 use thiserror::Error;
@@ -149,11 +149,7 @@ pub fn load_volume(scene: &Scene, volume_size: u32) -> Result<Volume, VolumeErro
         VolumeSource::File { path, raw } => {
             let params = raw.as_ref().map(|r| RawParams {
                 dims: r.dims,
-                format: match r.format {
-                    scene::RawFormat::U8 => RawFormat::U8,
-                    scene::RawFormat::U16 => RawFormat::U16,
-                    scene::RawFormat::F32 => RawFormat::F32,
-                },
+                format: r.format,
                 spacing: r.spacing.map(|s| s as f32),
             });
             Volume::load(path, params.as_ref())

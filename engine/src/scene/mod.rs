@@ -60,7 +60,7 @@ pub use light::{
 };
 pub use render::{Estimator, Phase, PipelineKey, RenderSettings, MAX_BOUNCES};
 pub use transfer_ref::TransferSpec;
-pub use volume::{BuiltinVolume, RawFormat, RawLayout, VolumeSource, VolumeSpec};
+pub use volume::{BuiltinVolume, RawLayout, VolumeSource, VolumeSpec};
 
 use crate::transfer::{TfLut, TransferFunction};
 use error::Ctx;

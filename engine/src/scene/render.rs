@@ -62,9 +62,9 @@ pub struct RenderSettings {
     spp: u32,
     /// Maximum number of scattering events per path. 0 leaves only emission and the
     /// unscattered background; 1 is single scattering (direct light at the first
-    /// collision). The default of 4 is a starting point, not a measurement: DESIGN §7
-    /// asks for the bounce count to be set from the reference difference between N and
-    /// N+1 bounces. The built-in cloud scenes (albedo ~0.97, many scattering events) use 8.
+    /// collision). The default of 4 is a starting point, not a measurement: a scene's
+    /// bounce count should come from the reference difference between N and N+1
+    /// bounces. The built-in cloud scenes (albedo ~0.97, many scattering events) use 8.
     max_bounces: u32,
     estimator: Estimator,
     phase: Phase,

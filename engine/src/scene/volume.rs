@@ -10,6 +10,7 @@
 //! per world unit. At the default of 100, an opacity-1 voxel has a mean free path of
 //! 0.01 world units, about one voxel of a 128³ volume.
 
+use crate::volume::RawFormat;
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
@@ -43,17 +44,6 @@ impl BuiltinVolume {
             Self::Cloud => "cloud",
         }
     }
-}
-
-/// Sample format of a headerless raw volume file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum RawFormat {
-    U8,
-    /// Little-endian.
-    U16,
-    /// Little-endian IEEE float.
-    F32,
 }
 
 /// How to read a headerless raw file (`file = "x.raw"` plus `dims` and `format`).

@@ -57,4 +57,3 @@ pub use control_point::ControlPoint;
 pub use error::TransferError;
 pub use function::TransferFunction;
 pub use lut::{TfLut, LUT_SIZE};
-pub use preset::assets_dir;

@@ -1,37 +1,15 @@
 //! Named presets: `assets/transfer/<name>.toml`, one file per TF.
 //!
 //! Presets are files, not code, so they can be tuned without a rebuild and a user can
-//! copy one as a starting point. The assets folder is `$DVR_ASSETS` when set (an
-//! installed binary points it at its data), otherwise the source tree's `assets/`
-//! (`CARGO_MANIFEST_DIR/../assets`), which is what tests and `cargo run` use.
-
-use std::path::{Path, PathBuf};
+//! copy one as a starting point. Where the folder is: [`crate::assets`].
 
 use super::{TransferError, TransferFunction};
-
-/// Environment variable that overrides the assets folder.
-pub const ASSETS_ENV: &str = "DVR_ASSETS";
-
-/// The assets folder: `$DVR_ASSETS` if set and non-empty, else the workspace's `assets/`.
-pub fn assets_dir() -> PathBuf {
-    match std::env::var_os(ASSETS_ENV) {
-        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("..")
-            .join("assets"),
-    }
-}
-
-/// The folder holding the TF presets.
-pub fn preset_dir() -> PathBuf {
-    assets_dir().join("transfer")
-}
 
 impl TransferFunction {
     /// Loads the preset `name` (`assets/transfer/<name>.toml`). An unknown name lists
     /// the available ones.
     pub fn preset(name: &str) -> Result<Self, TransferError> {
-        let dir = preset_dir();
+        let dir = crate::assets::transfer_presets();
         let plain = !name.is_empty() && !name.contains(['/', '\\']) && name != "." && name != "..";
         let path = dir.join(format!("{name}.toml"));
         if !plain || !path.is_file() {
@@ -51,7 +29,7 @@ impl TransferFunction {
 
     /// The names of all presets (file stems in `assets/transfer/`), sorted.
     pub fn preset_names() -> Result<Vec<String>, TransferError> {
-        let dir = preset_dir();
+        let dir = crate::assets::transfer_presets();
         let io = |source| TransferError::Io {
             path: dir.clone(),
             source,

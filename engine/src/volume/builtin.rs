@@ -1,6 +1,6 @@
-//! The built-in datasets by name, and where the asset files live.
+//! The built-in datasets by name.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
@@ -8,21 +8,6 @@ use super::{cloud, phantom, validate_dims, Volume};
 
 /// Names accepted by [`Volume::builtin`].
 pub const BUILTIN_NAMES: [&str; 3] = ["phantom", "cloud", "mri"];
-
-/// The MNI152 T1 template, relative to [`assets_dir`].
-const MRI_ASSET: &str = "volumes/mni152_t1.nii.gz";
-
-/// The assets folder: `$DVR_ASSETS` when set, else `assets/` in the workspace root this
-/// crate was built from.
-pub fn assets_dir() -> PathBuf {
-    match std::env::var_os("DVR_ASSETS") {
-        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR"))
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join("assets"),
-    }
-}
 
 pub(crate) fn build(name: &str, size: u32) -> Result<Volume, VolumeError> {
     let procedural = |size: u32| validate_dims(Path::new(name), [i64::from(size); 3]);
@@ -38,7 +23,7 @@ pub(crate) fn build(name: &str, size: u32) -> Result<Volume, VolumeError> {
             Volume::from_stored(Path::new(name), name.into(), dims, [1.0; 3], stored)
         }
         "mri" => {
-            let mut v = Volume::load(&assets_dir().join(MRI_ASSET), None)?;
+            let mut v = Volume::load(&crate::assets::mri_volume(), None)?;
             v.name = name.into();
             Ok(v)
         }

@@ -60,7 +60,7 @@ mod write;
 
 use std::path::Path;
 
-pub use builtin::{assets_dir, BUILTIN_NAMES};
+pub use builtin::BUILTIN_NAMES;
 pub use error::VolumeError;
 pub use majorant::MajorantGrid;
 pub use raw::{RawFormat, RawParams};

@@ -1,0 +1,288 @@
+//! The frame: scripted commands, the UI, model application, then render and present;
+//! and what happens to a finished frame's results (timings, screenshots, recording).
+
+use super::*;
+
+/// Frames left out of the frame-rate summary (pipeline compilation on first use).
+const WARMUP_FRAMES: usize = 5;
+
+impl Explorer {
+    /// One frame: see the module docs.
+    pub(super) fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        let Some(window) = self.window.clone() else {
+            return Ok(());
+        };
+        let size = window.inner_size();
+        if size.width == 0 || size.height == 0 {
+            return Ok(()); // minimised
+        }
+        let now = Instant::now();
+        if let Some(t) = self.frame_started.replace(now) {
+            self.frame_ms.push((now - t).as_secs_f32() * 1000.0);
+        }
+        if let Some(gfx) = self.gfx.as_mut() {
+            let e = gfx.swapchain.extent;
+            if self.resized || (e.width, e.height) != (size.width, size.height) {
+                gfx.recreate_swapchain(size)?;
+                self.resized = false;
+            }
+        }
+        let due: Vec<Command> = self.script.at(self.frame).cloned().collect();
+        for c in &due {
+            self.command(c);
+        }
+
+        // The UI edits the model.
+        let Some(egui_state) = self.egui_state.as_mut() else {
+            return Ok(());
+        };
+        let raw = egui_state.take_egui_input(&window);
+        let (ui_state, model) = (&mut self.ui, &mut self.model);
+        let mut requests = ui::UiRequests::default();
+        let output = self.egui_ctx.run_ui(raw, |ui| {
+            requests = ui::draw(ui, ui_state, model);
+        });
+        egui_state.handle_platform_output(&window, output.platform_output);
+        if requests.screenshot {
+            self.shots.push(self.frame);
+        }
+        let primitives = self
+            .egui_ctx
+            .tessellate(output.shapes, output.pixels_per_point);
+        // Texture uploads now; frees once the frames drawing with them are done.
+        let mut textures = output.textures_delta;
+        self.free_textures.extend(textures.free.drain());
+        let uploaded = match self.gfx.as_mut() {
+            Some(gfx) => match gfx.overlay.as_mut() {
+                Some(o) => {
+                    o.set_primitives(primitives, output.pixels_per_point);
+                    o.set_textures(&gfx.ctx, &textures)
+                }
+                None => Ok(()),
+            },
+            None => Ok(()),
+        };
+        textures.clear();
+        uploaded?;
+        for r in self.apply_model()? {
+            self.completed(r)?;
+        }
+
+        // Render and present.
+        let (vw, vh) = self.view_size();
+        let spec = self.camera.spec();
+        let inputs = inputs_for(
+            &spec.camera(),
+            vw as f32 / vh as f32,
+            &self.model.lights,
+            &self.model.tf.lut(),
+        );
+        let want_shot = self.shots.contains(&self.frame);
+        let readback_hdr = want_shot || self.recorder.is_some();
+        let split = (self.denoiser_list().len() == 2)
+            .then(|| ((vw as f32 * self.model.split) as u32).clamp(1, vw - 1));
+        let want_present_copy = want_shot || self.args.screenshot.is_some();
+        let Some(gfx) = self.gfx.as_mut() else {
+            return Ok(());
+        };
+        let (Some(renderer), Some(overlay)) = (gfx.renderer.as_mut(), gfx.overlay.as_ref()) else {
+            return Ok(());
+        };
+        let view = Extent {
+            width: vw,
+            height: vh,
+        };
+        let finished = renderer.resize(view)?;
+        self.ui.stats.render_size = (vw, vh);
+        let Some(image) = gfx.swapchain.acquire()? else {
+            gfx.recreate_swapchain(size)?;
+            return Ok(());
+        };
+        let bg = ui::PANEL_FILL.to_normalized_gamma_f32();
+        let target = PresentTarget {
+            image,
+            left: 0,
+            right: split.map(|_| 1),
+            layout: PresentLayout {
+                offset: [0, 0],
+                split_x: split,
+                exposure: self.model.exposure,
+                background: [bg[0], bg[1], bg[2]],
+            },
+            readback: want_present_copy && gfx.swapchain.readable,
+            overlay: Some(overlay),
+        };
+        let request = FrameRequest {
+            readback: readback_hdr,
+            reset: false,
+        };
+        let result = renderer.frame_presented(&inputs, &request, Some(&target))?;
+        if !gfx.swapchain.present(&gfx.ctx, &image)? {
+            self.resized = true;
+        }
+        if !self.free_textures.is_empty() {
+            gfx.ctx.wait_idle()?;
+            if let Some(o) = gfx.overlay.as_mut() {
+                o.free_textures(&std::mem::take(&mut self.free_textures))?;
+            }
+        }
+        if let Some(rec) = self.recorder.as_mut() {
+            rec.push(spec, &self.model.lights, &self.model.tf, &self.model.left)?;
+        }
+        self.frame += 1;
+        for r in finished.into_iter().chain(result) {
+            self.completed(r)?;
+        }
+        if self.args.frames.is_some_and(|n| self.frame >= n) {
+            event_loop.exit();
+        }
+        Ok(())
+    }
+
+    /// Handles the results of a finished frame: timings, screenshots, recorded frames.
+    pub(super) fn completed(&mut self, r: FrameResult) -> Result<()> {
+        let frame_ms = self.frame_ms.last().copied().unwrap_or(0.0);
+        let (w, h) = self.ui.stats.render_size;
+        let shown = r.images.first();
+        if let Some(rec) = &self.recorder {
+            if let Some((_, pixels)) = shown {
+                if pixels.len() == (w * h) as usize {
+                    write_png(&rec.frame_path(r.index), &to_rgb(w, h, pixels))?;
+                }
+            }
+        }
+        if let Some(pos) = self.shots.iter().position(|&f| f == r.index) {
+            self.shots.remove(pos);
+            let stem = PathBuf::from(format!("dvr-explore-{:04}", self.shot_count));
+            self.shot_count += 1;
+            let mut saved = Vec::new();
+            if let Some(s) = &r.screenshot {
+                let path = stem.with_extension("png");
+                save_screenshot(&path, s)?;
+                saved.push(path);
+            }
+            if let Some((_, pixels)) = shown {
+                if pixels.len() == (w * h) as usize {
+                    let path = stem.with_extension("exr");
+                    write_exr(&path, &to_rgb(w, h, pixels))?;
+                    saved.push(path);
+                }
+            }
+            let names: Vec<String> = saved.iter().map(|p| p.display().to_string()).collect();
+            self.ui.set_status(format!("saved {}", names.join(", ")));
+            println!("explore: saved {}", names.join(", "));
+        }
+        if r.screenshot.is_some() {
+            self.last_screenshot = r.screenshot;
+        }
+        if r.index >= WARMUP_FRAMES as u64 {
+            self.gpu_spans.push(ui::gpu_span_ms(&r.timings));
+            for t in &r.timings {
+                match self.pass_totals.iter_mut().find(|p| p.0 == t.pass) {
+                    Some(p) => {
+                        p.1 += t.ms;
+                        p.2 += 1;
+                    }
+                    None => self.pass_totals.push((t.pass.clone(), t.ms, 1)),
+                }
+            }
+        }
+        self.ui.stats.push(frame_ms, r.timings);
+        Ok(())
+    }
+
+    /// After the event loop: the last frames' results, `--screenshot`, the recorded
+    /// scene, the frame-rate summary, and the first error if there was one.
+    pub(super) fn finish(&mut self) -> Result<()> {
+        if let Some(e) = self.error.take() {
+            self.gfx = None;
+            return Err(e);
+        }
+        let flushed = match self.gfx.as_mut().and_then(|g| g.renderer.as_mut()) {
+            Some(r) => r.flush()?,
+            None => Vec::new(),
+        };
+        for r in flushed {
+            self.completed(r)?;
+        }
+        let summary = self.gfx.as_ref().map(|g| {
+            (
+                g.ctx.info.name.clone(),
+                format!("{:?}", g.swapchain.present_mode),
+            )
+        });
+        self.gfx = None;
+        if let Some(path) = &self.args.screenshot {
+            let shot = self.last_screenshot.as_ref().with_context(|| {
+                format!(
+                    "--screenshot {}: no frame was read back (the surface does not allow \
+                     copying from swapchain images, or no frame was presented)",
+                    path.display()
+                )
+            })?;
+            save_screenshot(path, shot)?;
+            println!("explore: wrote {}", path.display());
+        }
+        if let Some(rec) = &self.recorder {
+            if let Some(path) = rec.finish(&self.setup.scene, self.args.volume_size)? {
+                println!(
+                    "explore: recorded {} frames; replay with: dvr capture --scene {} --size {}x{} \
+                     --volume-size {} --motion {} --denoiser {}",
+                    rec.frame_count(),
+                    path.display(),
+                    self.ui.stats.render_size.0,
+                    self.ui.stats.render_size.1,
+                    self.args.volume_size,
+                    match self.args.motion {
+                        MotionSource::FirstHit => "first-hit",
+                        MotionSource::Features => "features",
+                    },
+                    self.model.left,
+                );
+            }
+        }
+        let timed = self.frame_ms.iter().skip(WARMUP_FRAMES).collect::<Vec<_>>();
+        if let (Some((device, mode)), false) = (summary, timed.is_empty()) {
+            let mean = timed.iter().copied().sum::<f32>() / timed.len() as f32;
+            println!(
+                "explore: {} frames in {:.1} s; {:.1} ms/frame ({:.2} fps) after {WARMUP_FRAMES} \
+                 warm-up frames, view {}x{}, {device}, {mode}",
+                self.frame,
+                self.started.elapsed().as_secs_f64(),
+                mean,
+                1000.0 / mean,
+                self.ui.stats.render_size.0,
+                self.ui.stats.render_size.1,
+            );
+            let passes: Vec<String> = self
+                .pass_totals
+                .iter()
+                .map(|(pass, ms, n)| format!("{pass} {:.1}", ms / f64::from(*n)))
+                .collect();
+            if !passes.is_empty() {
+                let span = self.gpu_spans.iter().sum::<f64>() / self.gpu_spans.len().max(1) as f64;
+                println!(
+                    "explore: GPU frame span {span:.1} ms; ms per pass: {}",
+                    passes.join(", ")
+                );
+            }
+        }
+        Ok(())
+    }
+}
+
+pub(super) fn save_screenshot(path: &Path, s: &Screenshot) -> Result<()> {
+    let rgb: Vec<u8> = s
+        .rgba
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    image::save_buffer(
+        path,
+        &rgb,
+        s.width,
+        s.height,
+        image::ExtendedColorType::Rgb8,
+    )
+    .with_context(|| format!("writing {}", path.display()))
+}
