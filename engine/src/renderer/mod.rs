@@ -3,18 +3,25 @@
 //! render graph, submitted once. Frames alternate between two slots so recording frame N overlaps the GPU's work
 //! on frame N−1; timestamps and readbacks of a slot are collected when it comes round.
 
+mod inputs;
 pub mod present;
+mod reference;
 pub mod scene_gpu;
 pub mod scene_setup;
+mod submit;
 pub mod uniforms;
+
+pub use inputs::{CameraMatrices, FrameInputs, FrameRequest, FrameResult};
+pub use reference::{samples_per_dispatch, MAX_SAMPLES_PER_DISPATCH, PIXEL_SAMPLES_PER_DISPATCH};
+use submit::{add_readbacks, read_pixels, submit, Slot};
 
 use crate::denoise::{
     self, registry, Changes, DenoiseInputs, Denoiser, DenoiserConfig, DenoiserInfo, Retrace,
 };
 use crate::error::{EngineError, Result, VkContext};
-use crate::gpu::timestamps::{PassTiming, TimestampPool};
+use crate::gpu::timestamps::TimestampPool;
 use crate::gpu::GpuContext;
-use crate::graph::{BufferHandle, Extent, Frame, ImageHandle, RenderGraph};
+use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
 use crate::passes::accumulate::Accumulate;
 use crate::passes::motion::Motion;
 use crate::passes::path_trace::{PathTrace, PathTraceFeatures};
@@ -22,43 +29,15 @@ use crate::passes::present::Present;
 use crate::passes::surface_features::SurfaceFeatures;
 use crate::passes::SceneBindings;
 use crate::scene::RenderSettings;
-use crate::shaders::frame::{FrameBlock, FrameParams, GpuLight, SampleStream};
+use crate::shaders::frame::{FrameBlock, FrameParams, SampleStream};
 use ash::vk;
-use glam::{Mat4, Vec3, Vec4};
+use glam::Vec3;
 use gpu_allocator::MemoryLocation;
 pub use present::{Overlay, PresentTarget, Screenshot};
 use scene_gpu::{EnvironmentUpload, LutUpload, SceneImages, VolumeUpload};
 use std::sync::Arc;
 
 const SLOTS: usize = 2;
-
-/// Most samples one path-tracing dispatch takes per pixel on lavapipe. llvmpipe guards
-/// every shader loop with an iteration limiter (65535) whose count is not reset when an
-/// inner loop is re-entered, so a dispatch whose per-pixel sample loop runs many
-/// delta-tracking or ray-marching steps is silently cut short (measured: 128 samples in
-/// one dispatch came out 27% dark, 512 samples 73% dark). There, references accumulate
-/// batches of at most this many samples and per-frame rendering is limited to it; other
-/// devices have no such limiter (see [`samples_per_dispatch`]).
-pub const MAX_SAMPLES_PER_DISPATCH: u32 = 4;
-
-/// Pixel-samples one path-tracing dispatch may take on a device without llvmpipe's loop
-/// limiter: 256×256 at 1024 spp (a suite reference in one dispatch). It keeps one
-/// dispatch short (about 20 ms on an H200, well under a second on a small GPU) so no
-/// display watchdog fires and the queue stays responsive; larger images split their
-/// references into a few dispatches.
-pub const PIXEL_SAMPLES_PER_DISPATCH: u64 = 1 << 26;
-
-/// Most samples per pixel one path-tracing dispatch of `pixels` pixels takes on the
-/// device described by `info`: [`MAX_SAMPLES_PER_DISPATCH`] on lavapipe (detected by
-/// its driver ID), else as many as [`PIXEL_SAMPLES_PER_DISPATCH`] allows, never fewer
-/// than lavapipe's.
-pub fn samples_per_dispatch(info: &crate::gpu::DeviceInfo, pixels: u64) -> u32 {
-    if info.is_llvmpipe() {
-        return MAX_SAMPLES_PER_DISPATCH;
-    }
-    let n = PIXEL_SAMPLES_PER_DISPATCH / pixels.max(1);
-    n.clamp(u64::from(MAX_SAMPLES_PER_DISPATCH), u64::from(u32::MAX)) as u32
-}
 
 /// What a renderer is built for besides its [`RenderSettings`]: the image size and what
 /// the scene's volume fixes for the renderer's lifetime.
@@ -98,81 +77,6 @@ pub enum SettingsChange {
     /// Not applied: the settings specialise the pipelines differently (see
     /// [`RenderSettings::pipeline_key`]), which takes a new renderer.
     NeedsNewRenderer,
-}
-
-/// A camera as the renderer needs it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CameraMatrices {
-    pub view: Mat4,
-    pub proj: Mat4,
-    pub position: Vec3,
-}
-
-impl CameraMatrices {
-    /// A perspective camera in Vulkan conventions: right-handed view space, clip-space y
-    /// pointing down (image row 0 at the top), depth in [0, 1].
-    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_y: f32, aspect: f32) -> Self {
-        let f = (target - eye).normalize();
-        let s = f.cross(up).normalize();
-        let u = s.cross(f);
-        let view = Mat4::from_cols(
-            Vec4::new(s.x, u.x, -f.x, 0.0),
-            Vec4::new(s.y, u.y, -f.y, 0.0),
-            Vec4::new(s.z, u.z, -f.z, 0.0),
-            Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
-        );
-        let (near, far) = (0.01f32, 100.0f32);
-        let h = 1.0 / (0.5 * fov_y).tan();
-        let proj = Mat4::from_cols(
-            Vec4::new(h / aspect, 0.0, 0.0, 0.0),
-            Vec4::new(0.0, -h, 0.0, 0.0), // y down in Vulkan clip space
-            Vec4::new(0.0, 0.0, far / (near - far), -1.0),
-            Vec4::new(0.0, 0.0, near * far / (near - far), 0.0),
-        );
-        Self {
-            view,
-            proj,
-            position: eye,
-        }
-    }
-}
-
-/// The per-frame state of an animation.
-#[derive(Clone, Debug)]
-pub struct FrameInputs {
-    pub camera: CameraMatrices,
-    pub lights: Vec<GpuLight>,
-    /// The transfer function this frame (uploaded only when it differs from the last).
-    pub lut: LutUpload,
-}
-
-/// What one frame should produce.
-#[derive(Clone, Debug, Default)]
-pub struct FrameRequest {
-    /// Read the outputs of these methods back to the host ("noisy" is the raw radiance).
-    pub readback: bool,
-    /// Restart every history (a cut).
-    pub reset: bool,
-}
-
-/// Results of a completed frame.
-#[derive(Clone, Debug, Default)]
-pub struct FrameResult {
-    pub index: u64,
-    pub timings: Vec<PassTiming>,
-    /// (method, rgba pixels) for each method when readback was requested.
-    pub images: Vec<(String, Vec<[f32; 4]>)>,
-    /// The presented image, UI included, when its readback was requested.
-    pub screenshot: Option<Screenshot>,
-}
-
-struct Slot {
-    cmd: vk::CommandBuffer,
-    fence: vk::Fence,
-    timestamps: TimestampPool,
-    uniforms: BufferHandle,
-    pending: Option<(u64, Vec<(String, BufferHandle)>)>,
-    pending_screenshot: Option<present::PendingScreenshot>,
 }
 
 /// A denoiser the frame runs, with its registry entry.
@@ -685,79 +589,6 @@ impl Renderer {
         out.sort_by_key(|r| r.index);
         Ok(out)
     }
-
-    /// Renders a high-sample reference of one animation frame: `spp` samples accumulated
-    /// in dispatches of at most `batch` (and at most what the device takes in one, see
-    /// [`Renderer::samples_per_dispatch`]), from a sample stream of its own (independent
-    /// of the per-frame noise the denoisers see).
-    pub fn reference(
-        &mut self,
-        inputs: &FrameInputs,
-        spp: u32,
-        batch: u32,
-    ) -> Result<Vec<[f32; 4]>> {
-        self.flush()?;
-        let batch = batch.clamp(1, spp.clamp(1, self.samples_per_dispatch()));
-        self.graph.reset_history("reference.");
-        let mut done = 0;
-        let mut image = Vec::new();
-        while done < spp {
-            let n = batch.min(spp - done);
-            let mut frame = Frame::new();
-            let majorant_max = self.upload_transfer_function(&mut frame, 0, &inputs.lut)?;
-            let stream = SampleStream::Reference {
-                after_frames: self.frame_index,
-            };
-            let block = self.frame_block(inputs, majorant_max, stream);
-            let scene = self.write_uniforms(0, &block)?;
-            let (ctx, graph, passes, size) =
-                (&self.ctx, &mut self.graph, &self.passes, self.config.size);
-            let batch_out = passes.path_trace.add(
-                ctx,
-                graph,
-                &mut frame,
-                "reference.path_trace",
-                &scene,
-                size,
-                done,
-                n,
-            )?;
-            let mean = passes.accumulate.add(
-                ctx,
-                graph,
-                &mut frame,
-                "reference.accumulate",
-                batch_out.radiance,
-                n as f32,
-                size,
-            )?;
-            done += n;
-            let readbacks = if done >= spp {
-                add_readbacks(
-                    ctx,
-                    graph,
-                    &mut frame,
-                    0,
-                    &[("reference".to_string(), mean)],
-                    size,
-                )?
-            } else {
-                Vec::new()
-            };
-            // Timed with slot 0's pool, idle after the flush above.
-            let timestamps = &mut self.slots[0].timestamps;
-            ctx.submit_and_wait(|cmd| {
-                timestamps.reset(ctx, cmd);
-                graph.execute(ctx, cmd, Some(timestamps), frame)
-            })?;
-            self.gpu_ms += timestamps.read(ctx)?.iter().map(|t| t.ms).sum::<f64>();
-            graph.end_frame();
-            if let Some((_, buffer)) = readbacks.first() {
-                image = read_pixels(graph, *buffer)?;
-            }
-        }
-        Ok(image)
-    }
 }
 
 /// Samples per pixel one frame of `size` may take on this device: at least 1 (the
@@ -803,89 +634,6 @@ fn create_methods(
         .collect()
 }
 
-/// The rgba32f pixels of a host-visible readback buffer.
-fn read_pixels(graph: &RenderGraph, buffer: BufferHandle) -> Result<Vec<[f32; 4]>> {
-    let bytes = graph
-        .buffer_ref(buffer)
-        .mapped()
-        .ok_or_else(|| EngineError::Resource {
-            resource: "readback".into(),
-            problem: "buffer is not host visible".into(),
-        })?;
-    Ok(bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec())
-}
-
-fn add_readbacks<'f>(
-    ctx: &GpuContext,
-    graph: &mut RenderGraph,
-    frame: &mut Frame<'f>,
-    slot: usize,
-    outputs: &[(String, ImageHandle)],
-    size: Extent,
-) -> Result<Vec<(String, BufferHandle)>> {
-    let bytes = size.width as u64 * size.height as u64 * 16;
-    let mut out = Vec::new();
-    for (name, image) in outputs {
-        let buffer = graph.buffer(
-            ctx,
-            &format!("readback.{name}.{slot}"),
-            bytes,
-            MemoryLocation::GpuToCpu,
-        )?;
-        frame.add_readback(name, *image, buffer);
-        out.push((name.clone(), buffer));
-    }
-    Ok(out)
-}
-
-/// Records and submits a frame. `semaphores` (acquire, render-finished) when it presents:
-/// the submission waits for the swapchain image at the stage the graph's first barrier
-/// on it starts from, and signals the semaphore presentation waits on.
-fn submit(
-    ctx: &GpuContext,
-    graph: &mut RenderGraph,
-    slot: &mut Slot,
-    frame: Frame,
-    semaphores: Option<(vk::Semaphore, vk::Semaphore)>,
-) -> Result<()> {
-    let d = &ctx.device;
-    unsafe {
-        d.reset_fences(&[slot.fence]).vk("vkResetFences")?;
-        d.reset_command_buffer(slot.cmd, vk::CommandBufferResetFlags::empty())
-            .vk("vkResetCommandBuffer")?;
-        d.begin_command_buffer(
-            slot.cmd,
-            &vk::CommandBufferBeginInfo::default()
-                .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT),
-        )
-        .vk("vkBeginCommandBuffer")?;
-    }
-    slot.timestamps.reset(ctx, slot.cmd);
-    graph.execute(ctx, slot.cmd, Some(&mut slot.timestamps), frame)?;
-    unsafe {
-        d.end_command_buffer(slot.cmd).vk("vkEndCommandBuffer")?;
-        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(slot.cmd)];
-        let (waits, signals) = match semaphores {
-            Some((wait, signal)) => (
-                vec![vk::SemaphoreSubmitInfo::default()
-                    .semaphore(wait)
-                    .stage_mask(crate::gpu::swapchain::ACQUIRE_WAIT_STAGE)],
-                vec![vk::SemaphoreSubmitInfo::default()
-                    .semaphore(signal)
-                    .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)],
-            ),
-            None => (Vec::new(), Vec::new()),
-        };
-        let submit = [vk::SubmitInfo2::default()
-            .command_buffer_infos(&cmds)
-            .wait_semaphore_infos(&waits)
-            .signal_semaphore_infos(&signals)];
-        d.queue_submit2(ctx.queue, &submit, slot.fence)
-            .vk("vkQueueSubmit2")?;
-    }
-    Ok(())
-}
-
 impl Drop for Renderer {
     fn drop(&mut self) {
         let ctx = &self.ctx;
@@ -899,44 +647,5 @@ impl Drop for Renderer {
             m.denoiser.destroy(ctx);
         }
         self.graph.destroy(ctx);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::gpu::DeviceInfo;
-
-    fn device(driver_id: vk::DriverId) -> DeviceInfo {
-        DeviceInfo {
-            name: "a device".into(),
-            device_type: vk::PhysicalDeviceType::DISCRETE_GPU,
-            driver_id,
-            timestamp_period: 1.0,
-            max_image_dimension_3d: 2048,
-            max_memory_allocation_size: 1 << 30,
-            max_storage_buffer_range: 1 << 27,
-            max_push_constants_size: 128,
-            device_local_heap: 1 << 30,
-            storage_write_without_format: true,
-        }
-    }
-
-    #[test]
-    fn only_llvmpipe_caps_samples_per_dispatch() {
-        let lavapipe = device(vk::DriverId::MESA_LLVMPIPE);
-        assert_eq!(
-            samples_per_dispatch(&lavapipe, 64 * 64),
-            MAX_SAMPLES_PER_DISPATCH
-        );
-        let gpu = device(vk::DriverId::NVIDIA_PROPRIETARY);
-        // A suite reference (256x256, 1024 spp) in one dispatch; 720p in 15.
-        assert_eq!(samples_per_dispatch(&gpu, 256 * 256), 1024);
-        assert_eq!(samples_per_dispatch(&gpu, 1280 * 720), 72);
-        // Never fewer than lavapipe's, however large the image.
-        assert_eq!(
-            samples_per_dispatch(&gpu, 8192 * 8192),
-            MAX_SAMPLES_PER_DISPATCH
-        );
     }
 }

@@ -1,0 +1,73 @@
+//! What a frame takes (camera, lights, TF; what to produce) and what it gives back.
+
+use super::scene_gpu::LutUpload;
+use super::Screenshot;
+use crate::gpu::timestamps::PassTiming;
+use crate::shaders::frame::GpuLight;
+use glam::{Mat4, Vec3, Vec4};
+
+/// A camera as the renderer needs it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraMatrices {
+    pub view: Mat4,
+    pub proj: Mat4,
+    pub position: Vec3,
+}
+
+impl CameraMatrices {
+    /// A perspective camera in Vulkan conventions: right-handed view space, clip-space y
+    /// pointing down (image row 0 at the top), depth in [0, 1].
+    pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_y: f32, aspect: f32) -> Self {
+        let f = (target - eye).normalize();
+        let s = f.cross(up).normalize();
+        let u = s.cross(f);
+        let view = Mat4::from_cols(
+            Vec4::new(s.x, u.x, -f.x, 0.0),
+            Vec4::new(s.y, u.y, -f.y, 0.0),
+            Vec4::new(s.z, u.z, -f.z, 0.0),
+            Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
+        );
+        let (near, far) = (0.01f32, 100.0f32);
+        let h = 1.0 / (0.5 * fov_y).tan();
+        let proj = Mat4::from_cols(
+            Vec4::new(h / aspect, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, -h, 0.0, 0.0), // y down in Vulkan clip space
+            Vec4::new(0.0, 0.0, far / (near - far), -1.0),
+            Vec4::new(0.0, 0.0, near * far / (near - far), 0.0),
+        );
+        Self {
+            view,
+            proj,
+            position: eye,
+        }
+    }
+}
+
+/// The per-frame state of an animation.
+#[derive(Clone, Debug)]
+pub struct FrameInputs {
+    pub camera: CameraMatrices,
+    pub lights: Vec<GpuLight>,
+    /// The transfer function this frame (uploaded only when it differs from the last).
+    pub lut: LutUpload,
+}
+
+/// What one frame should produce.
+#[derive(Clone, Debug, Default)]
+pub struct FrameRequest {
+    /// Read the outputs of these methods back to the host ("noisy" is the raw radiance).
+    pub readback: bool,
+    /// Restart every history (a cut).
+    pub reset: bool,
+}
+
+/// Results of a completed frame.
+#[derive(Clone, Debug, Default)]
+pub struct FrameResult {
+    pub index: u64,
+    pub timings: Vec<PassTiming>,
+    /// (method, rgba pixels) for each method when readback was requested.
+    pub images: Vec<(String, Vec<[f32; 4]>)>,
+    /// The presented image, UI included, when its readback was requested.
+    pub screenshot: Option<Screenshot>,
+}

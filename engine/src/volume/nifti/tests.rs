@@ -1,0 +1,161 @@
+//! Tests of `nifti.rs`.
+
+use super::*;
+use crate::volume::write::{self, NiftiData};
+use crate::volume::VolumeData;
+
+#[test]
+fn nii_and_nii_gz_round_trip() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let u8s: Vec<u8> = (0..60).map(|i| (i * 4) as u8).collect();
+    for name in ["a.nii", "a.nii.gz"] {
+        let path = dir.path().join(name);
+        write::nifti(
+            &path,
+            [5, 4, 3],
+            [0.8, 0.9, 1.5],
+            &NiftiData::U8(u8s.clone()),
+            None,
+        );
+        let v = Volume::load(&path, None).expect(name);
+        assert_eq!(v.name, "a");
+        assert_eq!(v.dims, [5, 4, 3]);
+        assert_eq!(v.spacing, [0.8, 0.9, 1.5]);
+        assert_eq!(v.data, VolumeData::U8(u8s.clone()), "{name}");
+    }
+}
+
+#[test]
+fn scaling_int16_uint16_and_float() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // int16 with scl_slope 2, scl_inter -1000: physical -1000..-1000+2*59*10.
+    let path = dir.path().join("s.nii.gz");
+    let i: Vec<i16> = (0..60).map(|x| x * 10).collect();
+    write::nifti(
+        &path,
+        [5, 4, 3],
+        [1.0; 3],
+        &NiftiData::I16(i),
+        Some((2.0, -1000.0)),
+    );
+    let v = Volume::load(&path, None).expect("int16");
+    assert_eq!(v.window, [-1000.0, 180.0]);
+    let VolumeData::U16(d) = &v.data else {
+        panic!("int16 must load as U16")
+    };
+    assert_eq!((d[0], d[59]), (0, 65535));
+
+    let path = dir.path().join("u.nii");
+    let u: Vec<u16> = (0..60).map(|x| x * 1000).collect();
+    write::nifti(&path, [5, 4, 3], [1.0; 3], &NiftiData::U16(u.clone()), None);
+    assert_eq!(
+        Volume::load(&path, None).expect("u16").data,
+        VolumeData::U16(u)
+    );
+
+    let path = dir.path().join("f.nii");
+    let fl: Vec<f32> = (0..60).map(|x| x as f32 / 59.0).collect();
+    write::nifti(
+        &path,
+        [5, 4, 3],
+        [1.0; 3],
+        &NiftiData::F32(fl.clone()),
+        None,
+    );
+    assert_eq!(
+        Volume::load(&path, None).expect("f32").data,
+        VolumeData::F32(fl)
+    );
+}
+
+#[test]
+fn bad_files_are_rejected_by_name() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let good = dir.path().join("good.nii");
+    write::nifti(
+        &good,
+        [5, 4, 3],
+        [1.0; 3],
+        &NiftiData::U8(vec![7; 60]),
+        None,
+    );
+    let bytes = std::fs::read(&good).expect("read");
+    let variant = |name: &str, edit: &dyn Fn(&mut Vec<u8>)| {
+        let mut b = bytes.clone();
+        edit(&mut b);
+        let p = dir.path().join(name);
+        write::bytes(&p, &b);
+        let err = Volume::load(&p, None).unwrap_err();
+        assert!(err.to_string().contains(name), "{err}");
+        err
+    };
+    let err = variant("cut.nii", &|b| b.truncate(b.len() - 5));
+    assert!(
+        matches!(
+            err,
+            VolumeError::Truncated {
+                expected: 60,
+                found: 55,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    let err = variant("long.nii", &|b| b.extend_from_slice(&[0; 3]));
+    assert!(matches!(err, VolumeError::SizeMismatch { .. }), "{err}");
+    let err = variant("zero.nii", &|b| {
+        b[42..44].copy_from_slice(&0i16.to_le_bytes())
+    });
+    assert!(matches!(err, VolumeError::BadDims { .. }), "{err}");
+    let err = variant("big.nii", &|b| {
+        b[42..44].copy_from_slice(&5000i16.to_le_bytes())
+    });
+    assert!(matches!(err, VolumeError::BadDims { .. }), "{err}");
+    let err = variant("dt.nii", &|b| {
+        b[70..72].copy_from_slice(&64i16.to_le_bytes())
+    });
+    assert!(matches!(err, VolumeError::UnsupportedType { .. }), "{err}");
+    assert!(err.to_string().contains("float64"));
+    let err = variant("magic.nii", &|b| b[344..348].copy_from_slice(b"xyz\0"));
+    assert!(
+        matches!(&err, VolumeError::MalformedHeader { field, .. } if field == "magic"),
+        "{err}"
+    );
+    let err = variant("hdr.nii", &|b| {
+        b[0..4].copy_from_slice(&100i32.to_le_bytes())
+    });
+    assert!(
+        matches!(&err, VolumeError::MalformedHeader { field, .. } if field == "sizeof_hdr"),
+        "{err}"
+    );
+    let err = variant("tiny.nii", &|b| b.truncate(100));
+    assert!(matches!(err, VolumeError::MalformedHeader { .. }), "{err}");
+    let err = variant("t4.nii", &|b| {
+        b[40..42].copy_from_slice(&4i16.to_le_bytes());
+        b[48..50].copy_from_slice(&2i16.to_le_bytes());
+    });
+    assert!(matches!(err, VolumeError::Unsupported { .. }), "{err}");
+}
+
+#[test]
+fn nan_in_float_nifti_is_rejected() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("nan.nii.gz");
+    let mut f = vec![0.5f32; 60];
+    f[17] = f32::NAN;
+    write::nifti(&path, [5, 4, 3], [1.0; 3], &NiftiData::F32(f), None);
+    let err = Volume::load(&path, None).unwrap_err();
+    // voxel 17 = (2, 3, 0) in a 5x4 slice.
+    assert!(
+        matches!(
+            err,
+            VolumeError::NonFinite {
+                count: 1,
+                first: [2, 3, 0],
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("nan.nii.gz"));
+}

@@ -1,0 +1,222 @@
+//! Tests of `nrrd.rs`.
+
+use super::*;
+use crate::volume::write::{self, NrrdData};
+use crate::volume::VolumeData;
+
+fn ramp_i16() -> Vec<i16> {
+    (0..60).map(|i| i as i16 * 50 - 1000).collect()
+}
+
+#[test]
+fn attached_raw_and_gzip_round_trip() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = NrrdData::I16(ramp_i16());
+    for (name, gzip, big) in [
+        ("a.nrrd", false, false),
+        ("b.nrrd", true, false),
+        ("c.nrrd", false, true),
+    ] {
+        let path = dir.path().join(name);
+        write::nrrd(&path, [3, 4, 5], [0.5, 0.75, 2.0], &data, gzip, big, false);
+        let v = Volume::load(&path, None).expect(name);
+        assert_eq!(v.dims, [3, 4, 5], "{name}");
+        assert_eq!(v.spacing, [0.5, 0.75, 2.0], "{name}");
+        // -1000..1950 is a small part of i16: windowed to the data.
+        assert_eq!(v.window, [-1000.0, 1950.0], "{name}");
+        let VolumeData::U16(d) = &v.data else {
+            panic!("int16 must load as U16")
+        };
+        assert_eq!(d[0], 0);
+        assert_eq!(d[59], 65535);
+        assert!(
+            d.windows(2).all(|w| w[0] < w[1]),
+            "{name}: ramp must stay monotone"
+        );
+    }
+}
+
+#[test]
+fn detached_header_round_trips_with_space_directions() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("d.nhdr");
+    let values: Vec<u8> = (0..24).map(|i| i * 10).collect();
+    write::nrrd(
+        &path,
+        [2, 3, 4],
+        [1.0, 2.0, 3.0],
+        &NrrdData::U8(values.clone()),
+        true,
+        false,
+        true,
+    );
+    assert!(dir.path().join("d.raw.gz").is_file());
+    let v = Volume::load(&path, None).expect("nhdr");
+    assert_eq!(v.dims, [2, 3, 4]);
+    assert_eq!(v.spacing, [1.0, 2.0, 3.0]);
+    // 0..230 is most of u8: untouched.
+    assert_eq!(v.data, VolumeData::U8(values));
+}
+
+#[test]
+fn float_and_u16_round_trip() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("f.nrrd");
+    let f = vec![0.0, 0.5, 1.0, 0.25];
+    write::nrrd(
+        &path,
+        [2, 2, 1],
+        [1.0; 3],
+        &NrrdData::F32(f.clone()),
+        false,
+        false,
+        false,
+    );
+    assert_eq!(
+        Volume::load(&path, None).expect("f32").data,
+        VolumeData::F32(f)
+    );
+    let path = dir.path().join("u.nrrd");
+    let u = vec![0, 65535, 1, 30000];
+    write::nrrd(
+        &path,
+        [2, 2, 1],
+        [1.0; 3],
+        &NrrdData::U16(u.clone()),
+        true,
+        true,
+        false,
+    );
+    assert_eq!(
+        Volume::load(&path, None).expect("u16").data,
+        VolumeData::U16(u)
+    );
+}
+
+#[test]
+fn hand_written_header_variants() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("h.nrrd");
+    // 4D with a leading size-1 axis, spacings with nan, a comment and a key/value.
+    let mut file = b"NRRD0004\n# comment\ntype: unsigned char\ndimension: 4\n\
+sizes: 1 2 2 1\nspacings: nan 0.5 0.5 3\nencoding: raw\nmodality:=CT\n\n"
+        .to_vec();
+    file.extend_from_slice(&[0, 255, 10, 20]);
+    write::bytes(&path, &file);
+    let v = Volume::load(&path, None).expect("4D size-1");
+    assert_eq!(v.dims, [2, 2, 1]);
+    assert_eq!(v.spacing, [0.5, 0.5, 3.0]);
+    assert_eq!(v.data, VolumeData::U8(vec![0, 255, 10, 20]));
+}
+
+#[test]
+fn bad_files_are_rejected_by_name() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = NrrdData::I16(ramp_i16());
+    let good = dir.path().join("good.nrrd");
+    write::nrrd(&good, [3, 4, 5], [1.0; 3], &data, false, false, false);
+    let bytes = std::fs::read(&good).expect("read");
+
+    let cut = dir.path().join("cut.nrrd");
+    write::bytes(&cut, &bytes[..bytes.len() - 10]);
+    let err = Volume::load(&cut, None).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            VolumeError::Truncated {
+                expected: 120,
+                found: 110,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("cut.nrrd"));
+
+    let long = dir.path().join("long.nrrd");
+    let mut b = bytes.clone();
+    b.extend_from_slice(&[0; 4]);
+    write::bytes(&long, &b);
+    let err = Volume::load(&long, None).unwrap_err();
+    assert!(matches!(err, VolumeError::SizeMismatch { .. }), "{err}");
+    assert!(err.to_string().contains("long.nrrd"));
+
+    let text = String::from_utf8_lossy(&bytes[..bytes.len() - 120]).to_string();
+    let header_only = |name: &str, h: String, data: &[u8]| {
+        let p = dir.path().join(name);
+        let mut f = h.into_bytes();
+        f.extend_from_slice(data);
+        write::bytes(&p, &f);
+        Volume::load(&p, None).unwrap_err()
+    };
+    let err = header_only(
+        "zero.nrrd",
+        text.replace("sizes: 3 4 5", "sizes: 3 0 5"),
+        &[],
+    );
+    assert!(matches!(err, VolumeError::BadDims { .. }), "{err}");
+    assert!(err.to_string().contains("zero.nrrd"));
+
+    let err = header_only(
+        "huge.nrrd",
+        text.replace("sizes: 3 4 5", "sizes: 3 4 100000"),
+        &[],
+    );
+    assert!(matches!(err, VolumeError::BadDims { .. }), "{err}");
+    assert!(err.to_string().contains("huge.nrrd"));
+
+    let err = header_only("dbl.nrrd", text.replace("type: int16", "type: double"), &[]);
+    assert!(matches!(err, VolumeError::UnsupportedType { .. }), "{err}");
+    assert!(err.to_string().contains("dbl.nrrd") && err.to_string().contains("double"));
+
+    let err = header_only("nosizes.nrrd", text.replace("sizes: 3 4 5\n", ""), &[]);
+    assert!(
+        matches!(&err, VolumeError::MalformedHeader { field, .. } if field == "sizes"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("nosizes.nrrd"));
+
+    let err = header_only(
+        "sz.nrrd",
+        text.replace("sizes: 3 4 5", "sizes: 3 four 5"),
+        &[],
+    );
+    assert!(matches!(err, VolumeError::MalformedHeader { .. }), "{err}");
+    assert!(err.to_string().contains("`sizes`"));
+
+    let err = header_only("magic.nrrd", text.replace("NRRD0004", "NRRX0004"), &[]);
+    assert!(
+        matches!(&err, VolumeError::MalformedHeader { field, .. } if field == "magic"),
+        "{err}"
+    );
+    assert!(err.to_string().contains("magic.nrrd"));
+
+    let err = header_only(
+        "bz.nrrd",
+        text.replace("encoding: raw", "encoding: bzip2"),
+        &[],
+    );
+    assert!(matches!(err, VolumeError::Unsupported { .. }), "{err}");
+    assert!(err.to_string().contains("bz.nrrd") && err.to_string().contains("bzip2"));
+
+    let gz = dir.path().join("corrupt.nrrd");
+    let mut f = text.replace("encoding: raw", "encoding: gzip").into_bytes();
+    f.extend_from_slice(&[0x1f, 0x8b, 8, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9]);
+    write::bytes(&gz, &f);
+    let err = Volume::load(&gz, None).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            VolumeError::Decompress { .. } | VolumeError::Truncated { .. }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("corrupt.nrrd"));
+}
+
+#[test]
+fn directions_parse() {
+    let v = parse_directions("none (1,0,0) (0, 2 ,0) (0,0,-3)").expect("parse");
+    assert_eq!(v, vec![None, Some(1.0), Some(2.0), Some(3.0)]);
+    assert!(parse_directions("(1,0").is_none());
+}
