@@ -103,7 +103,7 @@ pub fn capture(
 }
 
 pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
-    if let Some(n) = args.spp.filter(|&n| n > MAX_SAMPLES_PER_DISPATCH) {
+    if let Some(n) = args.render.spp.filter(|&n| n > MAX_SAMPLES_PER_DISPATCH) {
         bail!(
             "`dvr reference` takes its samples per pixel from --ref-spp: use --ref-spp {n} \
              (--spp is the noisy input's 1 to {MAX_SAMPLES_PER_DISPATCH} samples per frame and \

@@ -8,9 +8,9 @@
 //! about three minutes on two cores ([`CPU_PRESET`]). The page says which was chosen.
 
 use crate::eval::{self, EvalArgs};
-use crate::setup::{parse_motion, parse_size, DEFAULT_MOTION, DEFAULT_SCENE};
+use crate::setup::{parse_size, DEFAULT_SCENE};
 use crate::video::{self, VideoArgs};
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use ash::vk;
 use dvr_engine::gpu::GpuContext;
 use std::path::PathBuf;
@@ -122,13 +122,14 @@ pub fn run(args: &DemoArgs) -> Result<()> {
     eval::eval(&EvalArgs {
         scene: DEFAULT_SCENE.to_string(),
         frames: Some(chosen.frames),
-        spp: None,
         ref_spp: chosen.ref_spp,
         size: chosen.size,
         denoiser: args.denoiser.clone(),
         out: args.out.clone(),
-        volume_size: args.volume_size,
-        motion: parse_motion(DEFAULT_MOTION).map_err(|e| anyhow!(e))?,
+        render: crate::RenderArgs {
+            volume_size: args.volume_size,
+            ..Default::default()
+        },
         video: VideoArgs {
             video,
             video_fps: video::DEFAULT_FPS,

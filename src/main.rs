@@ -42,18 +42,36 @@ pub struct SceneArgs {
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256", value_parser = setup::parse_size)]
     pub size: (u32, u32),
+    #[command(flatten)]
+    pub render: RenderArgs,
+}
+
+/// How every rendering command (and the explorer) renders a scene.
+#[derive(clap::Args, Clone, Debug)]
+pub struct RenderArgs {
     /// Samples per pixel per frame (default: the scene's, 2 for built-ins).
     #[arg(long)]
     pub spp: Option<u32>,
     /// Edge length of procedural volumes (phantom, cloud).
-    #[arg(long, default_value_t = 128)]
+    #[arg(long, default_value_t = RenderArgs::default().volume_size)]
     pub volume_size: u32,
     /// Position the temporal denoisers reproject with: `features` (opacity-threshold
     /// surface, or the expected first collision through semi-transparent layers; measured
     /// 0.2–0.5 dB better for every temporal method) or `first-hit` (the closest first real
-    /// collision among the frame's samples, the paper's choice).
-    #[arg(long, default_value = setup::DEFAULT_MOTION, value_parser = setup::parse_motion)]
+    /// collision among the frame's samples, the paper's choice). References do not
+    /// depend on it.
+    #[arg(long, default_value_t = RenderArgs::default().motion)]
     pub motion: dvr_engine::denoise::MotionSource,
+}
+
+impl Default for RenderArgs {
+    fn default() -> Self {
+        Self {
+            spp: None,
+            volume_size: 128,
+            motion: dvr_engine::denoise::MotionSource::Features,
+        }
+    }
 }
 
 #[derive(Subcommand)]

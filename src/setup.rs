@@ -4,7 +4,7 @@
 use crate::profile::PassStats;
 use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
-use dvr_engine::denoise::{registry, MotionSource};
+use dvr_engine::denoise::registry;
 use dvr_engine::gpu::GpuContext;
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
@@ -39,20 +39,6 @@ pub fn parse_frames(s: &str) -> Result<u32, String> {
         Ok(n) if n >= 1 => Ok(n),
         _ => Err(format!(
             "{s:?} is not a frame count (a whole number, at least 1)"
-        )),
-    }
-}
-
-/// The `--motion` every rendering command (and the explorer) defaults to.
-pub const DEFAULT_MOTION: &str = "features";
-
-/// Parses `--motion`: the position motion vectors come from.
-pub fn parse_motion(s: &str) -> Result<MotionSource, String> {
-    match s {
-        "first-hit" => Ok(MotionSource::FirstHit),
-        "features" => Ok(MotionSource::Features),
-        other => Err(format!(
-            "unknown motion source {other:?}; use first-hit or features"
         )),
     }
 }
@@ -128,8 +114,8 @@ impl Setup {
             width: args.size.0,
             height: args.size.1,
         };
-        let mut inner = SceneSetup::new(scene, size, args.spp, args.volume_size)?;
-        inner.config.motion_source = args.motion;
+        let mut inner = SceneSetup::new(scene, size, args.render.spp, args.render.volume_size)?;
+        inner.config.motion_source = args.render.motion;
         Ok(Self {
             name: inner.scene.name.clone(),
             frames: inner.scene.frames,

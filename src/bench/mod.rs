@@ -116,9 +116,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             scene: args.scene.clone(),
             frames: Some(args.frames),
             size,
-            spp: None,
-            volume_size: args.volume_size,
-            motion: dvr_engine::denoise::MotionSource::Features,
+            render: crate::RenderArgs {
+                volume_size: args.volume_size,
+                ..Default::default()
+            },
         };
         let (report, _) = run_profile(&scene, &denoisers)?;
         let stem = args.out.join(format!("profile_{}", size_name(size)));
@@ -166,13 +167,14 @@ fn run_eval<'a>(args: &'a BenchArgs, denoisers: &[String]) -> Result<EvalRecord<
     let eval_args = EvalArgs {
         scene: args.eval_scene.clone(),
         frames: args.eval_frames,
-        spp: None,
         ref_spp: args.ref_spp,
         size: args.eval_size,
         denoiser: denoisers.to_vec(),
         out: eval_out.clone(),
-        volume_size: args.volume_size,
-        motion: dvr_engine::denoise::MotionSource::Features,
+        render: crate::RenderArgs {
+            volume_size: args.volume_size,
+            ..Default::default()
+        },
         video: crate::video::VideoArgs {
             video: false,
             video_fps: crate::video::DEFAULT_FPS,

@@ -14,7 +14,6 @@ use super::plots::{colour_hex, method_colour, scene_plot_stems, METRIC_PLOTS, OV
 use super::run::SceneResult;
 use super::{EvalArgs, EXPOSURE, GPU_WARMUP_FRAMES, RECOVERY_TOLERANCE_DB};
 use anyhow::{Context, Result};
-use dvr_engine::denoise::MotionSource;
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -116,10 +115,7 @@ pub fn page_data(info: &PageInfo, results: &[SceneResult], overall: &[Overall]) 
             "height": height,
             "spp": results.first().map(|r| r.spp),
             "ref_spp": info.args.ref_spp,
-            "motion": match info.args.motion {
-                MotionSource::FirstHit => "first-hit",
-                MotionSource::Features => "features",
-            },
+            "motion": info.args.render.motion.name(),
             "exposure": EXPOSURE,
             "warmup_frames": GPU_WARMUP_FRAMES,
             "recovery_tolerance_db": RECOVERY_TOLERANCE_DB,

@@ -67,10 +67,6 @@ pub struct EvalArgs {
     /// Frames of each animation (default: each scene's own length).
     #[arg(long, value_parser = crate::setup::parse_frames)]
     pub frames: Option<u32>,
-    /// Samples per pixel per frame of the noisy input (default: the scene's, 2 for
-    /// built-ins).
-    #[arg(long)]
-    pub spp: Option<u32>,
     /// Samples per pixel of the references.
     #[arg(long = "ref-spp", default_value_t = 1024)]
     pub ref_spp: u32,
@@ -83,13 +79,8 @@ pub struct EvalArgs {
     /// Output folder (references in it are reused when their settings match).
     #[arg(long, default_value = "out/eval")]
     pub out: PathBuf,
-    /// Edge length of procedural volumes (phantom, cloud).
-    #[arg(long, default_value_t = 128)]
-    pub volume_size: u32,
-    /// Position the temporal denoisers reproject with: `first-hit` or `features` (as
-    /// for `dvr capture`; references do not depend on it).
-    #[arg(long, default_value = "features", value_parser = crate::setup::parse_motion)]
-    pub motion: dvr_engine::denoise::MotionSource,
+    #[command(flatten)]
+    pub render: crate::RenderArgs,
     #[command(flatten)]
     pub video: crate::video::VideoArgs,
     /// A paragraph shown at the top of the results page (what was run, and why).

@@ -60,12 +60,12 @@ impl Plan {
         for ((spec, scene), (label, dir)) in opened.into_iter().zip(scenes::unique_labels(&labels))
         {
             let dir = args.out.join(dir);
-            let key = ReferenceKey::new(&scene, args.size, args.ref_spp, args.volume_size)?;
+            let key = ReferenceKey::new(&scene, args.size, args.ref_spp, args.render.volume_size)?;
             scenes.push(PlannedScene {
                 spec: spec.clone(),
                 name: label,
                 frames: scene.frames,
-                spp: args.spp.unwrap_or(scene.render.spp()),
+                spp: args.render.spp.unwrap_or(scene.render.spp()),
                 references: ReferenceCache::new(&dir, key),
                 dir,
             });
@@ -283,9 +283,7 @@ fn scene_args(args: &EvalArgs, name: &str) -> SceneArgs {
         scene: name.to_string(),
         frames: args.frames,
         size: args.size,
-        spp: args.spp,
-        volume_size: args.volume_size,
-        motion: args.motion,
+        render: args.render.clone(),
     }
 }
 

@@ -224,7 +224,7 @@ impl Explorer {
             println!("explore: wrote {}", path.display());
         }
         if let Some(rec) = &self.recorder {
-            if let Some(path) = rec.finish(&self.setup.scene, self.args.volume_size)? {
+            if let Some(path) = rec.finish(&self.setup.scene, self.args.render.volume_size)? {
                 println!(
                     "explore: recorded {} frames; replay with: dvr capture --scene {} --size {}x{} \
                      --volume-size {} --motion {} --denoiser {}",
@@ -232,11 +232,8 @@ impl Explorer {
                     path.display(),
                     self.ui.stats.render_size.0,
                     self.ui.stats.render_size.1,
-                    self.args.volume_size,
-                    match self.args.motion {
-                        MotionSource::FirstHit => "first-hit",
-                        MotionSource::Features => "features",
-                    },
+                    self.args.render.volume_size,
+                    self.args.render.motion,
                     self.model.left,
                 );
             }

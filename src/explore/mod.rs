@@ -30,7 +30,7 @@ use crate::setup;
 use anyhow::{bail, Context, Result};
 use ash::vk;
 use camera::OrbitCamera;
-use dvr_engine::denoise::{registry, MotionSource};
+use dvr_engine::denoise::registry;
 use dvr_engine::gpu::{ContextOptions, GpuContext, Swapchain};
 use dvr_engine::graph::Extent;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png, PNG_EXPOSURE};
@@ -95,16 +95,8 @@ pub struct ExploreArgs {
     /// Scripted input, e.g. "orbit:30,0@10;zoom:2@20" (see README, Explorer).
     #[arg(long)]
     pub script: Option<String>,
-    /// Samples per pixel per frame (default: the scene's).
-    #[arg(long)]
-    pub spp: Option<u32>,
-    /// Edge length of procedural volumes (phantom, cloud).
-    #[arg(long, default_value_t = 128)]
-    pub volume_size: u32,
-    /// Where motion vectors come from: `features` (opacity-threshold surface) or
-    /// `first-hit` (closest first real collision), as for the other commands.
-    #[arg(long, default_value = setup::DEFAULT_MOTION, value_parser = setup::parse_motion)]
-    pub motion: MotionSource,
+    #[command(flatten)]
+    pub render: crate::RenderArgs,
 }
 
 /// True when the environment names an X11 or Wayland display.
@@ -140,14 +132,14 @@ pub fn run(args: ExploreArgs) -> Result<()> {
             raw: None,
         };
     }
-    let volume = load_volume(&scene, args.volume_size)?;
+    let volume = load_volume(&scene, args.render.volume_size)?;
     let histogram = volume.histogram(HISTOGRAM_BINS);
     let size = Extent {
         width: args.size.0,
         height: args.size.1,
     };
-    let mut setup = SceneSetup::with_volume(scene, &volume, size, args.spp)?;
-    setup.config.motion_source = args.motion;
+    let mut setup = SceneSetup::with_volume(scene, &volume, size, args.render.spp)?;
+    setup.config.motion_source = args.render.motion;
     drop(volume);
     let event_loop = EventLoop::new().map_err(|e| anyhow::anyhow!("{NO_DISPLAY} ({e})"))?;
     event_loop.set_control_flow(ControlFlow::Poll);

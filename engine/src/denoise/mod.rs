@@ -43,12 +43,39 @@ pub enum MotionSource {
 }
 
 impl MotionSource {
+    pub const ALL: [MotionSource; 2] = [MotionSource::FirstHit, MotionSource::Features];
+
+    /// The name on the command line, in scene sessions and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionSource::FirstHit => "first-hit",
+            MotionSource::Features => "features",
+        }
+    }
+
     /// The value of the shaders' MOTION_SOURCE specialisation constant.
     pub fn spec(self) -> i32 {
         match self {
             MotionSource::FirstHit => 0,
             MotionSource::Features => 1,
         }
+    }
+}
+
+impl std::fmt::Display for MotionSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for MotionSource {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown motion source {s:?}; use first-hit or features"))
     }
 }
 
