@@ -203,3 +203,46 @@ fn peak_bandwidth_is_measured_with_a_copy_pass() {
     assert!(peak.method.contains("measured"), "{peak:?}");
     assert_validation_clean();
 }
+
+/// Images are created for the ways frames declare them: one only uploaded (a transfer
+/// destination) and read as storage in a later frame is created again for that, with
+/// its contents, and the run stays validation clean.
+#[test]
+fn an_image_used_a_new_way_keeps_its_contents() {
+    let ctx = context();
+    let mut graph = RenderGraph::new(&ctx).expect("graph");
+    let acc = Accumulate::new(&ctx).expect("pipeline");
+    let desc = ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT);
+    let input = graph.image(&ctx, "input", desc).expect("image");
+    let data = vec![[3.0f32, 2.0, 1.0, 1.0]; (W * H) as usize];
+    let mut f = Frame::new();
+    add_upload(
+        &ctx,
+        &mut graph,
+        &mut f,
+        "upload",
+        input,
+        bytemuck::cast_slice(&data),
+    )
+    .expect("upload");
+    ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
+        .expect("submit");
+    graph.end_frame();
+    let size = Extent {
+        width: W,
+        height: H,
+    };
+    // Frames later, the upload is read as a storage image for the first time.
+    for _ in 0..4 {
+        let mut f = Frame::new();
+        let mean = acc
+            .add(&ctx, &mut graph, &mut f, "acc", input, 1.0, size)
+            .expect("add");
+        ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
+            .expect("submit");
+        graph.end_frame();
+        assert_eq!(read_image(&ctx, &mut graph, mean)[0], data[0]);
+    }
+    graph.destroy(&ctx);
+    assert_validation_clean();
+}

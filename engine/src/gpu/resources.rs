@@ -67,14 +67,21 @@ pub struct GpuImage {
     pub image: vk::Image,
     pub view: vk::ImageView,
     pub desc: ImageDesc,
+    /// What it was created for (none for an image not allocated yet).
+    pub usage: vk::ImageUsageFlags,
     allocation: Option<Allocation>,
     /// Owned elsewhere (a swapchain image): `destroy` leaves it alone.
     external: bool,
 }
 
 impl GpuImage {
-    /// Allocates a device-local image usable as storage, sampled, and transfer src/dst.
-    pub fn new(ctx: &GpuContext, name: &str, desc: ImageDesc) -> Result<Self> {
+    /// Allocates a device-local image for `usage`.
+    pub fn new(
+        ctx: &GpuContext,
+        name: &str,
+        desc: ImageDesc,
+        usage: vk::ImageUsageFlags,
+    ) -> Result<Self> {
         let bytes = desc.texel_count() * format_size(desc.format);
         if bytes > ctx.info.max_memory_allocation_size {
             return Err(EngineError::TooLarge {
@@ -84,10 +91,6 @@ impl GpuImage {
                 device: ctx.info.name.clone(),
             });
         }
-        let usage = vk::ImageUsageFlags::STORAGE
-            | vk::ImageUsageFlags::SAMPLED
-            | vk::ImageUsageFlags::TRANSFER_SRC
-            | vk::ImageUsageFlags::TRANSFER_DST;
         let info = vk::ImageCreateInfo::default()
             .image_type(desc.kind)
             .format(desc.format)
@@ -109,20 +112,47 @@ impl GpuImage {
             .inspect_err(|_| unsafe { d.destroy_image(image, None) })?;
         unsafe { d.bind_image_memory(image, allocation.memory(), allocation.offset()) }
             .vk("vkBindImageMemory")?;
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(image)
-            .view_type(desc.view_type())
-            .format(desc.format)
-            .subresource_range(color_range());
-        let view = unsafe { d.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
+        // Shaders and attachments see an image through a view; transfers do not, and an
+        // image made for transfers only may not have one.
+        let viewed = vk::ImageUsageFlags::SAMPLED
+            | vk::ImageUsageFlags::STORAGE
+            | vk::ImageUsageFlags::COLOR_ATTACHMENT;
+        let view = if usage.intersects(viewed) {
+            let view_info = vk::ImageViewCreateInfo::default()
+                .image(image)
+                .view_type(desc.view_type())
+                .format(desc.format)
+                .subresource_range(color_range());
+            unsafe { d.create_image_view(&view_info, None) }.vk("vkCreateImageView")?
+        } else {
+            vk::ImageView::null()
+        };
         set_name(ctx, image, name);
         Ok(Self {
             image,
             view,
             desc,
+            usage,
             allocation: Some(allocation),
             external: false,
         })
+    }
+
+    /// An image of shape `desc` not allocated yet (the render graph allocates it when a
+    /// frame first declares how it is used).
+    pub fn unallocated(desc: ImageDesc) -> Self {
+        Self {
+            image: vk::Image::null(),
+            view: vk::ImageView::null(),
+            desc,
+            usage: vk::ImageUsageFlags::empty(),
+            allocation: None,
+            external: false,
+        }
+    }
+
+    pub fn is_allocated(&self) -> bool {
+        self.external || self.image != vk::Image::null()
     }
 
     /// An image and view owned by someone else (a swapchain), described by `desc`.
@@ -131,6 +161,7 @@ impl GpuImage {
             image,
             view,
             desc,
+            usage: vk::ImageUsageFlags::empty(),
             allocation: None,
             external: true,
         }
@@ -141,13 +172,15 @@ impl GpuImage {
     }
 
     pub fn destroy(&mut self, ctx: &GpuContext) {
-        if self.external {
+        if self.external || !self.is_allocated() {
             return;
         }
         unsafe {
             ctx.device.destroy_image_view(self.view, None);
             ctx.device.destroy_image(self.image, None);
         }
+        self.image = vk::Image::null();
+        self.view = vk::ImageView::null();
         if let (Some(a), Ok(mut alloc)) = (self.allocation.take(), ctx.allocator.lock()) {
             let _ = alloc.free(a);
         }

@@ -219,6 +219,17 @@ impl<'f> Frame<'f> {
         self.push(name.into(), accesses, Vec::new(), None);
     }
 
+    /// A pass with no commands that makes `images` ready for shaders to sample: for
+    /// images a frame fills (uploads) that only later frames read, so the graph knows
+    /// from their first frame how they will be used.
+    pub fn add_ready_for_sampling(&mut self, name: impl Into<String>, images: &[ImageHandle]) {
+        let accesses = images
+            .iter()
+            .map(|&h| (Res::Image(h), Access::Sampled))
+            .collect();
+        self.push(name.into(), accesses, Vec::new(), None);
+    }
+
     /// A pass with no commands that hands `image` (an imported swapchain image) to the
     /// presentation engine: the graph transitions it to `PRESENT_SRC_KHR`. It must be
     /// the image's last access in the frame.

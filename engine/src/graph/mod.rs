@@ -23,7 +23,11 @@ use crate::gpu::{GpuBuffer, GpuContext, GpuImage, ImageDesc};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use resources::{BufferSlot, HistorySlot, ImageSlot};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
+
+/// Frames after which an image replaced during a frame is released: more than the frames
+/// a renderer keeps in flight (two), so none still uses it.
+const RETIRE_AFTER_FRAMES: u64 = 3;
 
 /// Persistent graph resources and their synchronisation state.
 pub struct RenderGraph {
@@ -32,6 +36,10 @@ pub struct RenderGraph {
     buffers: Vec<BufferSlot>,
     buffer_names: HashMap<String, BufferHandle>,
     histories: HashMap<String, HistorySlot>,
+    /// Images replaced by a larger-usage copy, with the frame count when they were.
+    retired: Vec<(GpuImage, u64)>,
+    /// Frames ended so far.
+    frames_ended: u64,
     linear_sampler: vk::Sampler,
     nearest_sampler: vk::Sampler,
 }
@@ -58,14 +66,17 @@ impl RenderGraph {
             buffers: Vec::new(),
             buffer_names: HashMap::new(),
             histories: HashMap::new(),
+            retired: Vec::new(),
+            frames_ended: 0,
             linear_sampler: make(vk::Filter::LINEAR)?,
             nearest_sampler: make(vk::Filter::NEAREST)?,
         })
     }
 
-    /// The image named `name` with shape `desc`: created on first use (and cleared to
-    /// zero before its first access), reused on later frames, recreated if `desc`
-    /// changes (a resize).
+    /// The image named `name` with shape `desc`: allocated when a frame first uses it,
+    /// for the ways that frame declares (see [`RenderGraph::execute`]), cleared to zero
+    /// before its first access, reused on later frames, recreated if `desc` changes (a
+    /// resize).
     pub fn image(&mut self, ctx: &GpuContext, name: &str, desc: ImageDesc) -> Result<ImageHandle> {
         if let Some(&h) = self.image_names.get(name) {
             let slot = &mut self.images[h.0 as usize];
@@ -79,7 +90,7 @@ impl RenderGraph {
                 return Ok(h);
             }
             slot.image.destroy(ctx);
-            slot.image = GpuImage::new(ctx, name, desc)?;
+            slot.image = GpuImage::unallocated(desc);
             slot.state = ResourceState::default();
             slot.needs_clear = true;
             return Ok(h);
@@ -87,7 +98,7 @@ impl RenderGraph {
         let h = ImageHandle(self.images.len() as u32);
         self.images.push(ImageSlot {
             name: name.to_string(),
-            image: GpuImage::new(ctx, name, desc)?,
+            image: GpuImage::unallocated(desc),
             state: ResourceState::default(),
             needs_clear: true,
         });
@@ -146,6 +157,7 @@ impl RenderGraph {
             .histories
             .entry(name.to_string())
             .or_insert(HistorySlot {
+                images: [a, b],
                 flip: false,
                 valid: false,
                 used: false,
@@ -313,7 +325,8 @@ impl RenderGraph {
         Ok(())
     }
 
-    /// Records `frame` into `cmd`: barriers, clears of new resources, labels, timestamps.
+    /// Records `frame` into `cmd`: image allocations, barriers, clears of new resources,
+    /// labels, timestamps.
     pub fn execute(
         &mut self,
         ctx: &GpuContext,
@@ -322,6 +335,8 @@ impl RenderGraph {
         frame: Frame,
     ) -> Result<()> {
         self.validate(&frame)?;
+        self.release_retired(ctx);
+        self.allocate_images(ctx, cmd, &frame)?;
         let mut timestamps = timestamps;
         for mut pass in frame.passes {
             self.clear_new_resources(ctx, cmd, &pass.accesses);
@@ -410,8 +425,73 @@ impl RenderGraph {
         }
     }
 
+    /// Gives every image `frame` uses memory, created for all the ways the frame
+    /// declares it (a history's two images for both sides' ways, since they trade
+    /// places; always transfer source and destination, for clears and readbacks at any
+    /// time). An image a frame uses in a way it was not created for is created again
+    /// with that way added, its contents copied over, and the old one released once no
+    /// frame in flight can still use it.
+    fn allocate_images(
+        &mut self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        frame: &Frame,
+    ) -> Result<()> {
+        let mut needed: BTreeMap<u32, vk::ImageUsageFlags> = BTreeMap::new();
+        for pass in &frame.passes {
+            for &(r, a) in &pass.accesses {
+                if let Res::Image(h) = r {
+                    *needed.entry(h.0).or_default() |= a.image_usage();
+                }
+            }
+        }
+        for history in self.histories.values() {
+            let [a, b] = history.images.map(|h| h.0);
+            if needed.contains_key(&a) || needed.contains_key(&b) {
+                let both = needed.get(&a).copied().unwrap_or_default()
+                    | needed.get(&b).copied().unwrap_or_default();
+                needed.insert(a, both);
+                needed.insert(b, both);
+            }
+        }
+        let always = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
+        for (i, usage) in needed {
+            let slot = &mut self.images[i as usize];
+            let usage = usage | always;
+            if slot.image.is_external() || slot.image.usage.contains(usage) {
+                continue;
+            }
+            if !slot.image.is_allocated() {
+                slot.image = GpuImage::new(ctx, &slot.name, slot.image.desc, usage)?;
+                continue;
+            }
+            let grown = GpuImage::new(ctx, &slot.name, slot.image.desc, slot.image.usage | usage)?;
+            let old = std::mem::replace(&mut slot.image, grown);
+            let mut state = ResourceState::default();
+            if !slot.needs_clear {
+                copy_image(ctx, cmd, (&old, &mut slot.state), (&slot.image, &mut state));
+            }
+            slot.state = state;
+            self.retired.push((old, self.frames_ended));
+        }
+        Ok(())
+    }
+
+    /// Releases images replaced long enough ago that no frame in flight uses them.
+    fn release_retired(&mut self, ctx: &GpuContext) {
+        let now = self.frames_ended;
+        self.retired.retain_mut(|(image, at)| {
+            let done = now >= *at + RETIRE_AFTER_FRAMES;
+            if done {
+                image.destroy(ctx);
+            }
+            !done
+        });
+    }
+
     /// Ends the frame: histories used this frame swap and become valid.
     pub fn end_frame(&mut self) {
+        self.frames_ended += 1;
         for slot in self.histories.values_mut() {
             if slot.used {
                 slot.flip = !slot.flip;
@@ -425,6 +505,10 @@ impl RenderGraph {
         for s in &mut self.images {
             s.image.destroy(ctx);
         }
+        for (image, _) in &mut self.retired {
+            image.destroy(ctx);
+        }
+        self.retired.clear();
         for s in &mut self.buffers {
             s.buffer.destroy(ctx);
         }
@@ -437,6 +521,51 @@ impl RenderGraph {
             ctx.device.destroy_sampler(self.linear_sampler, None);
             ctx.device.destroy_sampler(self.nearest_sampler, None);
         }
+    }
+}
+
+/// Copies all of `from` into `to` (the same shape), with the barriers each needs.
+fn copy_image(
+    ctx: &GpuContext,
+    cmd: vk::CommandBuffer,
+    (from, from_state): (&GpuImage, &mut ResourceState),
+    (to, to_state): (&GpuImage, &mut ResourceState),
+) {
+    let barriers: Vec<_> = [
+        access::transition(from_state, Access::TransferSrc, true)
+            .map(|b| image_barrier(from.image, &b)),
+        access::transition(to_state, Access::TransferDst, true)
+            .map(|b| image_barrier(to.image, &b)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let layers = vk::ImageSubresourceLayers {
+        aspect_mask: vk::ImageAspectFlags::COLOR,
+        mip_level: 0,
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    let [width, height, depth] = from.desc.extent;
+    let region = vk::ImageCopy::default()
+        .src_subresource(layers)
+        .dst_subresource(layers)
+        .extent(vk::Extent3D {
+            width,
+            height,
+            depth,
+        });
+    unsafe {
+        let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+        ctx.device.cmd_pipeline_barrier2(cmd, &dep);
+        ctx.device.cmd_copy_image(
+            cmd,
+            from.image,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            to.image,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &[region],
+        );
     }
 }
 

@@ -67,6 +67,8 @@ pub(crate) struct BufferSlot {
 }
 
 pub(crate) struct HistorySlot {
+    /// Its two images (`name#0`, `name#1`), which trade places every frame.
+    pub images: [ImageHandle; 2],
     pub flip: bool,
     pub valid: bool,
     pub used: bool,

@@ -290,6 +290,8 @@ pub fn create<'f>(
             h
         }
     };
+    // Later frames' shaders sample what this frame uploads.
+    frame.add_ready_for_sampling("scene_ready", &[vol, tf[0], tf[1], tf[2], majorant, env]);
     Ok(SceneImages {
         volume: vol,
         tf,
