@@ -1,8 +1,9 @@
 //! dvr engine: everything the applications share. Layers, each knowing only those below:
+//! `shaders` (the compiled SPIR-V, block layouts, the frame block and shared constants) →
 //! `gpu` (device, memory, pipelines, timestamps) → `graph` (explicit render graph) →
 //! `passes` (one GPU pass per file) and `denoise` (each denoiser's passes and history) →
 //! `renderer` (the frame). CPU-side data (`volume`, `transfer`, `scene`, `metrics`) feeds
-//! them.
+//! them; `assets` says where the shipped files are.
 
 pub mod assets;
 pub mod denoise;
