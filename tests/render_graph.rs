@@ -15,13 +15,51 @@ use dvr_engine::renderer::scene_gpu::add_upload;
 const W: u32 = 8;
 const H: u32 = 4;
 
-#[test]
-fn history_accumulates_across_frames_and_resets() {
+/// A W×H rgba32f graph image.
+fn image(
+    ctx: &dvr_engine::gpu::GpuContext,
+    graph: &mut RenderGraph,
+    name: &str,
+) -> dvr_engine::graph::ImageHandle {
+    let desc = ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT);
+    graph.image(ctx, name, desc).expect("image")
+}
+
+/// A device, a graph, the accumulation pass and its input image.
+fn accumulating() -> (
+    dvr_engine::gpu::GpuContext,
+    RenderGraph,
+    Accumulate,
+    dvr_engine::graph::ImageHandle,
+) {
     let ctx = context();
     let mut graph = RenderGraph::new(&ctx).expect("graph");
     let acc = Accumulate::new(&ctx).expect("pipeline");
-    let desc = ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT);
-    let input = graph.image(&ctx, "input", desc).expect("image");
+    let input = image(&ctx, &mut graph, "input");
+    (ctx, graph, acc, input)
+}
+
+/// Submits `f`, waits for it and ends the frame.
+fn run_frame(ctx: &dvr_engine::gpu::GpuContext, graph: &mut RenderGraph, f: Frame<'_>) {
+    ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
+        .expect("submit");
+    graph.end_frame();
+}
+
+/// Adds an upload of `data` into `image` to `f`.
+fn upload(
+    ctx: &dvr_engine::gpu::GpuContext,
+    graph: &mut RenderGraph,
+    f: &mut Frame<'_>,
+    image: dvr_engine::graph::ImageHandle,
+    data: &[[f32; 4]],
+) {
+    add_upload(ctx, graph, f, "upload", image, bytemuck::cast_slice(data)).expect("upload");
+}
+
+#[test]
+fn history_accumulates_across_frames_and_resets() {
+    let (ctx, mut graph, acc, input) = accumulating();
     let size = Extent {
         width: W,
         height: H,
@@ -36,21 +74,11 @@ fn history_accumulates_across_frames_and_resets() {
         let value = frame_index as f32;
         let data = vec![[value, value, value, 1.0f32]; (W * H) as usize];
         let mut f = Frame::new();
-        add_upload(
-            &ctx,
-            &mut graph,
-            &mut f,
-            "upload",
-            input,
-            bytemuck::cast_slice(&data),
-        )
-        .expect("upload");
+        upload(&ctx, &mut graph, &mut f, input, &data);
         let mean = acc
             .add(&ctx, &mut graph, &mut f, "acc", input, 1.0, size)
             .expect("add");
-        ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
-            .expect("submit");
-        graph.end_frame();
+        run_frame(&ctx, &mut graph, f);
         means.push(read_image(&ctx, &mut graph, mean)[0][0]);
     }
     assert_eq!(
@@ -67,9 +95,8 @@ fn history_accumulates_across_frames_and_resets() {
 fn undeclared_resources_are_refused_naming_the_pass() {
     let ctx = context();
     let mut graph = RenderGraph::new(&ctx).expect("graph");
-    let desc = ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT);
-    let a = graph.image(&ctx, "a", desc).expect("image");
-    let b = graph.image(&ctx, "b", desc).expect("image");
+    let a = image(&ctx, &mut graph, "a");
+    let b = image(&ctx, &mut graph, "b");
     let mut pipeline =
         dvr_engine::gpu::ComputePipeline::new(&ctx, "accumulate", &[]).expect("pipeline");
     let mut f = Frame::new();
@@ -108,13 +135,7 @@ fn undeclared_resources_are_refused_naming_the_pass() {
 fn new_images_start_at_zero() {
     let ctx = context();
     let mut graph = RenderGraph::new(&ctx).expect("graph");
-    let img = graph
-        .image(
-            &ctx,
-            "fresh",
-            ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT),
-        )
-        .expect("image");
+    let img = image(&ctx, &mut graph, "fresh");
     let px = read_image(&ctx, &mut graph, img);
     assert!(px.iter().all(|p| *p == [0.0; 4]));
     graph.destroy(&ctx);
@@ -163,13 +184,7 @@ fn a_timed_pass_reports_the_bytes_of_what_it_declares() {
     let mut graph = RenderGraph::new(&ctx).expect("graph");
     let acc = Accumulate::new(&ctx).expect("pipeline");
     let mut timestamps = TimestampPool::new(&ctx).expect("timestamps");
-    let input = graph
-        .image(
-            &ctx,
-            "input",
-            ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT),
-        )
-        .expect("image");
+    let input = image(&ctx, &mut graph, "input");
     let size = Extent {
         width: W,
         height: H,
@@ -209,25 +224,11 @@ fn peak_bandwidth_is_measured_with_a_copy_pass() {
 /// its contents, and the run stays validation clean.
 #[test]
 fn an_image_used_a_new_way_keeps_its_contents() {
-    let ctx = context();
-    let mut graph = RenderGraph::new(&ctx).expect("graph");
-    let acc = Accumulate::new(&ctx).expect("pipeline");
-    let desc = ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT);
-    let input = graph.image(&ctx, "input", desc).expect("image");
+    let (ctx, mut graph, acc, input) = accumulating();
     let data = vec![[3.0f32, 2.0, 1.0, 1.0]; (W * H) as usize];
     let mut f = Frame::new();
-    add_upload(
-        &ctx,
-        &mut graph,
-        &mut f,
-        "upload",
-        input,
-        bytemuck::cast_slice(&data),
-    )
-    .expect("upload");
-    ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
-        .expect("submit");
-    graph.end_frame();
+    upload(&ctx, &mut graph, &mut f, input, &data);
+    run_frame(&ctx, &mut graph, f);
     let size = Extent {
         width: W,
         height: H,
@@ -238,9 +239,7 @@ fn an_image_used_a_new_way_keeps_its_contents() {
         let mean = acc
             .add(&ctx, &mut graph, &mut f, "acc", input, 1.0, size)
             .expect("add");
-        ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, f))
-            .expect("submit");
-        graph.end_frame();
+        run_frame(&ctx, &mut graph, f);
         assert_eq!(read_image(&ctx, &mut graph, mean)[0], data[0]);
     }
     graph.destroy(&ctx);

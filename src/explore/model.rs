@@ -39,7 +39,7 @@ impl Explorer {
                 gfx.renderer = None;
                 self.setup.settings = self.model.render;
                 let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
-                let renderer = self.setup.renderer_shared(Arc::clone(&gfx.ctx), &names)?;
+                let renderer = self.setup.renderer(Arc::clone(&gfx.ctx), &names)?;
                 self.ui.max_spp = renderer.samples_per_dispatch();
                 gfx.renderer = Some(renderer);
             }

@@ -411,24 +411,35 @@ fn lights(ui: &mut egui::Ui, state: &UiState, lights: &mut Vec<Light>) {
     });
 }
 
+/// A slider over `range` starting at `value`; the new value when the user moved it.
+fn slider<T: egui::emath::Numeric>(
+    ui: &mut egui::Ui,
+    value: T,
+    range: std::ops::RangeInclusive<T>,
+    label: &str,
+) -> Option<T> {
+    let mut v = value;
+    ui.add(egui::Slider::new(&mut v, range).text(label))
+        .changed()
+        .then_some(v)
+}
+
 fn render_controls(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model) {
     // Each edit goes through the settings' own checks; a refused value stays unapplied
     // and says why.
     let r = &mut model.render;
     let mut refused = None;
-    let mut spp = r.spp();
-    if ui
-        .add(egui::Slider::new(&mut spp, 1..=state.max_spp.max(1)).text("spp / frame"))
-        .changed()
+    let spp = slider(ui, r.spp(), 1..=state.max_spp.max(1), "spp / frame");
+    let bounces = slider(ui, r.max_bounces(), 0..=16, "max bounces");
+    for e in [
+        spp.map(|n| r.set_spp(n)),
+        bounces.map(|n| r.set_max_bounces(n)),
+    ]
+    .into_iter()
+    .flatten()
+    .filter_map(Result::err)
     {
-        refused = r.set_spp(spp).err().or(refused);
-    }
-    let mut bounces = r.max_bounces();
-    if ui
-        .add(egui::Slider::new(&mut bounces, 0..=16).text("max bounces"))
-        .changed()
-    {
-        refused = r.set_max_bounces(bounces).err().or(refused);
+        refused = Some(e);
     }
     let mut estimator = r.estimator();
     ui.horizontal(|ui| {
@@ -445,15 +456,7 @@ fn render_controls(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model) {
     });
     r.set_estimator(estimator);
     if estimator == scene::Estimator::RayMarch {
-        let mut step = r.step_size();
-        if ui
-            .add(
-                egui::Slider::new(&mut step, 0.1..=4.0)
-                    .logarithmic(true)
-                    .text("step (voxels)"),
-            )
-            .changed()
-        {
+        if let Some(step) = slider(ui, r.step_size(), 0.1..=4.0, "step (voxels)") {
             refused = r.set_step_size(step).err().or(refused);
         }
     }
@@ -474,19 +477,16 @@ fn render_controls(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model) {
     });
     r.set_phase(phase);
     if phase != scene::Phase::Isotropic {
-        let mut g = r.hg_g();
-        if ui
-            .add(egui::Slider::new(&mut g, -0.9..=0.9).text("HG g"))
-            .changed()
-        {
+        if let Some(g) = slider(ui, r.hg_g(), -0.9..=0.9, "HG g") {
             refused = r.set_hg_g(g).err().or(refused);
         }
     }
-    let mut rr = r.russian_roulette_depth();
-    if ui
-        .add(egui::Slider::new(&mut rr, 0..=16).text("roulette from bounce"))
-        .changed()
-    {
+    if let Some(rr) = slider(
+        ui,
+        r.russian_roulette_depth(),
+        0..=16,
+        "roulette from bounce",
+    ) {
         r.set_russian_roulette_depth(rr);
     }
     if let Some(e) = refused {

@@ -90,7 +90,7 @@ impl Explorer {
         let overlay = EguiOverlay::new(&ctx, swapchain.format)?;
         let renderer = self
             .setup
-            .renderer_shared(Arc::clone(&ctx), &self.denoiser_list())?;
+            .renderer(Arc::clone(&ctx), &self.denoiser_list())?;
         self.ui.max_spp = renderer.samples_per_dispatch();
         self.ui.stats.device = ctx.info.name.clone();
         self.ui.stats.present_mode = format!("{:?}", swapchain.present_mode);
@@ -130,14 +130,24 @@ impl Explorer {
     }
 }
 
-impl ApplicationHandler for Explorer {
-    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if self.window.is_some() {
-            return;
-        }
-        if let Err(e) = self.open_window(event_loop) {
+impl Explorer {
+    /// Runs `step`; an error ends the event loop, and `finish` reports it.
+    fn or_exit(
+        &mut self,
+        event_loop: &ActiveEventLoop,
+        step: fn(&mut Self, &ActiveEventLoop) -> Result<()>,
+    ) {
+        if let Err(e) = step(self, event_loop) {
             self.error = Some(e);
             event_loop.exit();
+        }
+    }
+}
+
+impl ApplicationHandler for Explorer {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_none() {
+            self.or_exit(event_loop, Self::open_window);
         }
     }
 
@@ -189,12 +199,8 @@ impl ApplicationHandler for Explorer {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        if self.error.is_some() {
-            return;
-        }
-        if let Err(e) = self.frame(event_loop) {
-            self.error = Some(e);
-            event_loop.exit();
+        if self.error.is_none() {
+            self.or_exit(event_loop, Self::frame);
         }
     }
 }

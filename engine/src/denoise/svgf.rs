@@ -107,19 +107,24 @@ pub struct SvgfParams {
     pub tolerance: f32,
 }
 
+impl SvgfParams {
+    /// The paper's parameters (a const, so tests of the edge-stopping mirror use them).
+    pub const DEFAULT: Self = Self {
+        color_alpha: 0.2,
+        moments_alpha: 0.2,
+        min_history: 4.0,
+        sigma_z: 1.0,
+        sigma_n: 128.0,
+        sigma_l: 4.0,
+        luminance_eps: 1e-6,
+        demod_eps: 0.01,
+        tolerance: super::REPROJECTION_TOLERANCE_PX,
+    };
+}
+
 impl Default for SvgfParams {
     fn default() -> Self {
-        Self {
-            color_alpha: 0.2,
-            moments_alpha: 0.2,
-            min_history: 4.0,
-            sigma_z: 1.0,
-            sigma_n: 128.0,
-            sigma_l: 4.0,
-            luminance_eps: 1e-6,
-            demod_eps: 0.01,
-            tolerance: super::REPROJECTION_TOLERANCE_PX,
-        }
+        Self::DEFAULT
     }
 }
 
@@ -319,17 +324,7 @@ pub mod edge {
         use super::*;
         use crate::denoise::svgf::SvgfParams;
 
-        const P: SvgfParams = SvgfParams {
-            color_alpha: 0.2,
-            moments_alpha: 0.2,
-            min_history: 4.0,
-            sigma_z: 1.0,
-            sigma_n: 128.0,
-            sigma_l: 4.0,
-            luminance_eps: 1e-6,
-            demod_eps: 0.01,
-            tolerance: crate::denoise::REPROJECTION_TOLERANCE_PX,
-        };
+        const P: SvgfParams = SvgfParams::DEFAULT;
 
         #[test]
         fn test_params_are_the_defaults() {

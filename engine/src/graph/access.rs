@@ -112,13 +112,15 @@ impl Access {
     /// What an image must have been created for to be accessed this way.
     pub fn image_usage(self) -> vk::ImageUsageFlags {
         use vk::ImageUsageFlags as U;
+        if self.is_storage() {
+            return U::STORAGE;
+        }
         match self {
             Access::Sampled => U::SAMPLED,
-            Access::StorageRead | Access::StorageWrite | Access::StorageReadWrite => U::STORAGE,
             Access::TransferSrc => U::TRANSFER_SRC,
             Access::TransferDst => U::TRANSFER_DST,
             Access::ColorAttachment => U::COLOR_ATTACHMENT,
-            Access::Uniform | Access::HostRead | Access::Present => U::empty(),
+            _ => U::empty(),
         }
     }
 

@@ -123,30 +123,11 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    pub fn new(
-        ctx: GpuContext,
-        settings: RenderSettings,
-        config: RendererConfig,
-        volume: &VolumeUpload,
-        environment: Option<&EnvironmentUpload>,
-        denoisers: &[&str],
-        lut_size: u32,
-    ) -> Result<Self> {
-        Self::new_shared(
-            Arc::new(ctx),
-            settings,
-            config,
-            volume,
-            environment,
-            denoisers,
-            lut_size,
-        )
-    }
-
-    /// [`Renderer::new`] on a context the caller keeps a handle to.
+    /// A renderer on `ctx`: a context it owns, or one the caller keeps a handle to (the
+    /// explorer's, which also owns the window's swapchain and outlives renderers).
     #[allow(clippy::too_many_arguments)]
-    pub fn new_shared(
-        ctx: Arc<GpuContext>,
+    pub fn new(
+        ctx: impl Into<Arc<GpuContext>>,
         settings: RenderSettings,
         config: RendererConfig,
         volume: &VolumeUpload,
@@ -154,6 +135,7 @@ impl Renderer {
         denoisers: &[&str],
         lut_size: u32,
     ) -> Result<Self> {
+        let ctx = ctx.into();
         check_spp(&ctx, settings.spp(), config.size)?;
         let features = PathTraceFeatures::new(settings.pipeline_key(), environment.is_some());
         let mut graph = RenderGraph::new(&ctx)?;

@@ -256,40 +256,25 @@ pub fn create<'f>(
         "scene.majorant",
         ImageDesc::d3(volume.bricks.grid, vk::Format::R32_SFLOAT),
     )?;
-    let env = match environment {
-        Some(e) => {
-            let h = graph.image(
-                ctx,
-                "scene.environment",
-                ImageDesc::d2(e.width, e.height, vk::Format::R32G32B32A32_SFLOAT),
-            )?;
-            add_upload(
-                ctx,
-                graph,
-                frame,
-                "upload_environment",
-                h,
-                bytemuck::cast_slice(&e.rgba),
-            )?;
-            h
-        }
-        None => {
-            let h = graph.image(
-                ctx,
-                "scene.environment",
-                ImageDesc::d2(1, 1, vk::Format::R32G32B32A32_SFLOAT),
-            )?;
-            add_upload(
-                ctx,
-                graph,
-                frame,
-                "upload_environment",
-                h,
-                bytemuck::cast_slice(&[[0f32; 4]]),
-            )?;
-            h
-        }
+    // Without a map, a black 1×1 stands in (the binding exists in every variant).
+    let black = [[0f32; 4]];
+    let (width, height, rgba) = match environment {
+        Some(e) => (e.width, e.height, &e.rgba[..]),
+        None => (1, 1, &black[..]),
     };
+    let env = graph.image(
+        ctx,
+        "scene.environment",
+        ImageDesc::d2(width, height, vk::Format::R32G32B32A32_SFLOAT),
+    )?;
+    add_upload(
+        ctx,
+        graph,
+        frame,
+        "upload_environment",
+        env,
+        bytemuck::cast_slice(rgba),
+    )?;
     // Later frames' shaders sample what this frame uploads.
     frame.add_ready_for_sampling("scene_ready", &[vol, tf[0], tf[1], tf[2], majorant, env]);
     Ok(SceneImages {

@@ -82,18 +82,14 @@ impl SceneSetup {
         })
     }
 
-    pub fn renderer(&self, ctx: GpuContext, denoisers: &[&str]) -> EngineResult<Renderer> {
-        self.renderer_shared(Arc::new(ctx), denoisers)
-    }
-
-    /// A renderer on a context the caller keeps a handle to (the explorer's, which
-    /// also owns the window's swapchain).
-    pub fn renderer_shared(
+    /// A renderer for this scene on `ctx` (owned, or shared with the caller: see
+    /// [`Renderer::new`]).
+    pub fn renderer(
         &self,
-        ctx: Arc<GpuContext>,
+        ctx: impl Into<Arc<GpuContext>>,
         denoisers: &[&str],
     ) -> EngineResult<Renderer> {
-        Renderer::new_shared(
+        Renderer::new(
             ctx,
             self.settings,
             self.config.clone(),
