@@ -102,7 +102,7 @@ pub struct DenoiseInputs {
     /// Luminance moments (x mean, y second moment).
     pub moments: ImageHandle,
     /// Deterministic surface features; rendered only when a denoiser of this frame
-    /// uses them ([`Denoiser::uses_surface_features`]).
+    /// reads them (its registry entry's [`DenoiserInfo::features`]).
     pub features: Option<FeatureImages>,
     /// Closest first real collision per pixel, this frame's and last frame's.
     pub first_hit: History,
