@@ -11,7 +11,7 @@ mod common;
 
 use ash::vk;
 use common::*;
-use dvr_engine::denoise::svgf::{edge, Svgf, SvgfParams, ITERATIONS};
+use dvr_engine::denoise::svgf::{edge, SvgfParams, ITERATIONS};
 use dvr_engine::denoise::{self, Changes, DenoiseInputs, Denoiser};
 use dvr_engine::gpu::{GpuContext, ImageDesc};
 use dvr_engine::graph::Extent;
@@ -473,8 +473,8 @@ fn svgf_frame0_ignores_garbage_and_reset_histories() {
             _ => [5.0, 0.0, 5.0, 2.0],
         })
         .collect();
-    poisoned.poison_history(Svgf::COLOR_HISTORY, &garbage);
-    poisoned.poison_history(Svgf::MOMENTS_HISTORY, &garbage);
+    poisoned.poison_history("svgf.color", &garbage);
+    poisoned.poison_history("svgf.moments", &garbage);
     let out = poisoned.step(&input);
     assert_eq!(
         max_abs_diff(&out, &clean),

@@ -8,12 +8,15 @@ use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::accumulate::Accumulate;
 
 pub struct Accum {
+    /// Its registry name, which also names its pass and running sum.
+    name: &'static str,
     pass: Accumulate,
 }
 
 impl Accum {
-    pub fn new(ctx: &GpuContext) -> Result<Self> {
+    pub fn new(ctx: &GpuContext, name: &'static str) -> Result<Self> {
         Ok(Self {
+            name,
             pass: Accumulate::new(ctx)?,
         })
     }
@@ -21,7 +24,7 @@ impl Accum {
 
 impl Denoiser for Accum {
     fn name(&self) -> &str {
-        "accum"
+        self.name
     }
 
     fn add<'f>(
@@ -32,13 +35,13 @@ impl Denoiser for Accum {
         input: &DenoiseInputs,
     ) -> Result<ImageHandle> {
         if input.changes.any() {
-            graph.reset_history("accum.");
+            graph.reset_history(&format!("{}.", self.name));
         }
         self.pass.add(
             ctx,
             graph,
             frame,
-            "accum",
+            self.name,
             input.noisy,
             input.spp as f32,
             input.size,

@@ -5,11 +5,12 @@ use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 
-pub struct Passthrough;
+/// The name comes from its registry row.
+pub struct Passthrough(pub &'static str);
 
 impl Denoiser for Passthrough {
     fn name(&self) -> &str {
-        "none"
+        self.0
     }
 
     fn add<'f>(

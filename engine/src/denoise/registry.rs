@@ -169,10 +169,10 @@ impl DenoiserInfo {
     pub fn create(&self, ctx: &GpuContext, config: &DenoiserConfig) -> Result<Box<dyn Denoiser>> {
         let motion = config.motion;
         Ok(match self.kind {
-            Kind::Passthrough => Box::new(Passthrough),
-            Kind::Accum => Box::new(Accum::new(ctx)?),
-            Kind::Taa => Box::new(Taa::new(ctx, motion)?),
-            Kind::Svgf => Box::new(Svgf::new(ctx, motion)?),
+            Kind::Passthrough => Box::new(Passthrough(self.name)),
+            Kind::Accum => Box::new(Accum::new(ctx, self.name)?),
+            Kind::Taa => Box::new(Taa::new(ctx, self.name, motion)?),
+            Kind::Svgf => Box::new(Svgf::new(ctx, self.name, motion)?),
             Kind::Wrls => {
                 let variant =
                     WrlsVariant::from_name(self.name).ok_or_else(|| unknown(self.name))?;

@@ -129,6 +129,8 @@ impl Default for SvgfParams {
 }
 
 pub struct Svgf {
+    /// Its registry name, which also names its passes and images (`<name>.color`, …).
+    name: &'static str,
     temporal: Pipeline<SvgfTemporalPush>,
     variance: Pipeline<SvgfVariancePush>,
     atrous: Pipeline<SvgfAtrousPush>,
@@ -138,12 +140,9 @@ pub struct Svgf {
 }
 
 impl Svgf {
-    /// History keys (for tests and resets).
-    pub const COLOR_HISTORY: &'static str = "svgf.color";
-    pub const MOMENTS_HISTORY: &'static str = "svgf.moments";
-
-    pub fn new(ctx: &GpuContext, motion: MotionSource) -> Result<Self> {
+    pub fn new(ctx: &GpuContext, name: &'static str, motion: MotionSource) -> Result<Self> {
         Ok(Self {
+            name,
             temporal: ctx.pipeline(
                 "svgf_temporal",
                 &[("MOTION_SOURCE", SpecValue::I32(motion.spec()))],
@@ -158,7 +157,7 @@ impl Svgf {
 
 impl Denoiser for Svgf {
     fn name(&self) -> &str {
-        "svgf"
+        self.name
     }
 
     fn add<'f>(
@@ -170,12 +169,13 @@ impl Denoiser for Svgf {
     ) -> Result<ImageHandle> {
         let size = input.size;
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
-        let color = graph.history(ctx, Self::COLOR_HISTORY, desc)?;
-        let moments = graph.history(ctx, Self::MOMENTS_HISTORY, desc)?;
-        let geometry = graph.image(ctx, "svgf.geometry", desc)?;
-        let ping = graph.image(ctx, "svgf.ping", desc)?;
-        let pong = graph.image(ctx, "svgf.pong", desc)?;
-        let out = graph.image(ctx, "svgf.out", desc)?;
+        let n = self.name;
+        let color = graph.history(ctx, &format!("{n}.color"), desc)?;
+        let moments = graph.history(ctx, &format!("{n}.moments"), desc)?;
+        let geometry = graph.image(ctx, &format!("{n}.geometry"), desc)?;
+        let ping = graph.image(ctx, &format!("{n}.ping"), desc)?;
+        let pong = graph.image(ctx, &format!("{n}.pong"), desc)?;
+        let out = graph.image(ctx, &format!("{n}.out"), desc)?;
         let reproj = input.reprojection(self.name(), self.motion)?;
         let valid = color.valid && moments.valid && reproj.valid;
         let p = self.params;
@@ -194,7 +194,7 @@ impl Denoiser for Svgf {
             demod_eps: p.demod_eps,
             feature_step: STEP_VOXELS,
         };
-        frame.add_compute("svgf.temporal", &self.temporal, push, size, |b| {
+        frame.add_compute(format!("{n}.temporal"), &self.temporal, push, size, |b| {
             reproj.bind(b);
             b.read("noisy", noisy)
                 .read("feature_albedo", albedo)
@@ -216,7 +216,7 @@ impl Denoiser for Svgf {
             pad1: 0.0,
             pad2: 0.0,
         };
-        frame.add_compute("svgf.variance", &self.variance, vpush, size, |b| {
+        frame.add_compute(format!("{n}.variance"), &self.variance, vpush, size, |b| {
             b.read("integrated", ping)
                 .read("moments", moments.cur)
                 .read("geometry", geometry)
@@ -247,7 +247,7 @@ impl Denoiser for Svgf {
                 pad1: 0.0,
                 pad2: 0.0,
             };
-            let name = format!("svgf.atrous{i}");
+            let name = format!("{n}.atrous{i}");
             frame.add_compute(name, &self.atrous, apush, size, |b| {
                 b.read("color_in", src)
                     .read("geometry", geometry)

@@ -49,6 +49,8 @@ impl Default for TaaParams {
 }
 
 pub struct Taa {
+    /// Its registry name, which also names its pass and history (`<name>.color`).
+    name: &'static str,
     pipeline: Pipeline<TaaPush>,
     pub params: TaaParams,
     /// 0: motion from the first real collision (the paper's, as `ours`), 1: from features.
@@ -56,11 +58,9 @@ pub struct Taa {
 }
 
 impl Taa {
-    /// The history key (for tests and resets).
-    pub const HISTORY: &'static str = "taa.color";
-
-    pub fn new(ctx: &GpuContext, motion: MotionSource) -> Result<Self> {
+    pub fn new(ctx: &GpuContext, name: &'static str, motion: MotionSource) -> Result<Self> {
         Ok(Self {
+            name,
             pipeline: ctx.pipeline("taa", &[("MOTION_SOURCE", SpecValue::I32(motion.spec()))])?,
             params: TaaParams::default(),
             motion,
@@ -70,7 +70,7 @@ impl Taa {
 
 impl Denoiser for Taa {
     fn name(&self) -> &str {
-        "taa"
+        self.name
     }
 
     fn add<'f>(
@@ -82,7 +82,7 @@ impl Denoiser for Taa {
     ) -> Result<ImageHandle> {
         let size = input.size;
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
-        let color = graph.history(ctx, Self::HISTORY, desc)?;
+        let color = graph.history(ctx, &format!("{}.color", self.name), desc)?;
         let reproj = input.reprojection(self.name(), self.motion)?;
         let valid = color.valid && reproj.valid;
         let p = self.params;
@@ -98,7 +98,7 @@ impl Denoiser for Taa {
             pad1: 0.0,
         };
         let noisy = input.noisy;
-        frame.add_compute("taa", &self.pipeline, push, size, |b| {
+        frame.add_compute(self.name, &self.pipeline, push, size, |b| {
             reproj.bind(b);
             b.read("noisy", noisy)
                 .sampled("history_prev", color.prev)
