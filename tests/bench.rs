@@ -66,7 +66,7 @@ fn gpu_bench_writes_one_small_folder_and_a_tarball() {
     assert!(
         profile
             .lines()
-            .any(|l| l.starts_with("24x16,ours.spatial,")),
+            .any(|l| l.starts_with("24x16,ours.update,")),
         "{profile}"
     );
     let methods = read(&out.join("methods.csv"));
