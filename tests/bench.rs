@@ -64,9 +64,7 @@ fn gpu_bench_writes_one_small_folder_and_a_tarball() {
     let profile = read(&out.join("profile.csv"));
     assert!(profile.starts_with("size,pass,mean_ms,median_ms,p95_ms,mb,gb_per_s,percent_of_peak"));
     assert!(
-        profile
-            .lines()
-            .any(|l| l.starts_with("24x16,ours.update,")),
+        profile.lines().any(|l| l.starts_with("24x16,ours.update,")),
         "{profile}"
     );
     let methods = read(&out.join("methods.csv"));
