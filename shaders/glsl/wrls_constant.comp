@@ -27,6 +27,7 @@ layout(binding = 5, rgba32f) uniform writeonly image2D stats_cur;
 layout(binding = 6, rgba32f) uniform writeonly image2D prediction;  // rgb, a variance
 layout(binding = 7, rgba32f) uniform writeonly image2D residual;    // rgb, a variance (< 0: none)
 layout(binding = 8) uniform sampler2D drift_prev;                    // rgb mean, a variance
+layout(binding = 9, rgba32f) uniform readonly image2D moments;       // x mean, y 2nd moment of luminance
 
 layout(push_constant) uniform WrlsConstantPush {
     vec4 camera;          // xyz camera position
@@ -45,7 +46,7 @@ layout(push_constant) uniform WrlsConstantPush {
     float change_gain;    // relative change at which the history is forgotten: 1/gain
     float shrink;         // squared standard errors of the gradient ratio that halve it
     float drift_z;        // pooled residual, in standard errors, that starts to count
-    float pad0;
+    float spp;            // samples per pixel of the noisy frame
 } pc;
 
 const float P_MAX = 1e6;
@@ -82,7 +83,19 @@ void main() {
     vec3 e = I - beta;
     float r2 = dot(e, e);
     bool fresh = noise_level < 0.0;
-    if (fresh) noise_level = r2;
+    if (fresh) {
+        // A new model has no residuals yet: its noise level is the variance of this
+        // frame's pixel mean, from the samples' luminance moments over the 3×3
+        // neighbourhood (one pixel's two samples say too little), over three channels.
+        float v = 0.0;
+        for (int dy = -1; dy <= 1; ++dy) {
+            for (int dx = -1; dx <= 1; ++dx) {
+                vec2 m = imageLoad(moments, clamp(p + ivec2(dx, dy), ivec2(0), size - 1)).xy;
+                v += max(m.y - m.x * m.x, 0.0);
+            }
+        }
+        noise_level = 3.0 * v / 9.0 / max(pc.spp - 1.0, 1.0) + 1e-6;
+    }
     // The change threshold, fixed before this frame's restart may raise the noise level.
     float cap = pc.change_ratio * (noise_level + 1e-6);
     bool far = r2 > cap;

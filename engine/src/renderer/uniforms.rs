@@ -121,7 +121,7 @@ pub struct WrlsConstantPush {
     pub change_gain: f32,
     pub shrink: f32,
     pub drift_z: f32,
-    pub pad0: f32,
+    pub spp: f32,
 }
 
 #[repr(C)]
@@ -416,7 +416,7 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 change_gain,
                 shrink,
                 drift_z,
-                pad0
+                spp
             }),
         ),
         (

@@ -82,7 +82,7 @@ impl Default for WrlsParams {
             kappa: 2.0,
             change_ratio: 12.0,
             outlier_sigmas: 10.0,
-            stratum: 2,
+            stratum: 4,
             lambda_min: 0.1,
             change_gain: 8.0,
             shrink: 4.0,

@@ -68,14 +68,15 @@ impl Wrls {
             change_gain: p.change_gain,
             shrink: p.shrink,
             drift_z: p.drift_z,
-            pad0: 0.0,
+            spp: input.spp as f32,
         };
-        let (noisy, g, lag) = (input.noisy, *gradients, *lag);
+        let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
         frame.add_pass(
             format!("{n}.update"),
             |b| {
                 reproj.declare(b);
                 b.read(noisy)
+                    .read(moments)
                     .read(g.new)
                     .read(g.old)
                     .sampled(lag.drift.prev)
@@ -89,6 +90,7 @@ impl Wrls {
                 let mut binds = reproj.binds();
                 binds.extend([
                     ("noisy", Bind::Image(noisy)),
+                    ("moments", Bind::Image(moments)),
                     ("model_prev", Bind::Image(model.prev)),
                     ("stats_prev", Bind::Image(stats.prev)),
                     ("model_cur", Bind::Image(model.cur)),
