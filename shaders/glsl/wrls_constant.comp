@@ -43,7 +43,7 @@ layout(push_constant) uniform WrlsConstantPush {
     uint drift_valid;     // drift_prev holds last frame's pooled residuals
     uint stratum;         // the gradients' stratum edge in pixels
     float lambda_min;     // forgetting factor at a sudden change
-    float change_gain;    // relative change at which the history is forgotten: 1/gain
+    float change_gain;    // change per frame over the noise at which the history is forgotten: 1/gain
     float shrink;         // squared standard errors of the gradient ratio that halve it
     float drift_z;        // pooled residual, in standard errors, that starts to count
     float spp;            // samples per pixel of the noisy frame
@@ -60,10 +60,7 @@ void main() {
     if (!all_finite(I)) I = vec3(0.0);
 
     Reprojection r = reproject(p, size, pc.history_valid != 0u, pc.camera.xyz, pc.tolerance);
-    SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink);
-    // Forgetting in proportion to the measured change: a still scene keeps λ, a sudden
-    // change falls to λ_min (what the scaling did not explain is learned anew).
-    float lambda = mix(pc.lambda_min, pc.lambda, 1.0 - min(1.0, pc.change_gain * sc.change));
+    float lambda = pc.lambda;
 
     vec3 beta = vec3(0.0);
     float P = pc.delta;
@@ -72,12 +69,25 @@ void main() {
     if (r.valid) {
         vec4 m = history_fetch(model_prev, r);
         vec4 st = history_fetch(stats_prev, r);
+        // The scene changed: scale the model by the ratio the gradients measured, so it
+        // follows the change instead of lagging, and forget in proportion to what the
+        // scaling may have missed (below).
+        SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink);
         float mean_ratio = dot(sc.ratio, vec3(1.0 / 3.0));
         beta = m.rgb * sc.ratio;
         P = m.a;
         noise_level = st.x * mean_ratio * mean_ratio;
         streak = st.y;
-        if (pc.drift_valid != 0u) beta += significant_drift(history_fetch(drift_prev, r), pc.drift_z);
+        // Forget in proportion to the change per frame against this pixel's noise (a
+        // steady-state Kalman gain grows as the change over the noise): a bright pixel
+        // under a moving light keeps a short history, a dim, noisy one a longer one.
+        float sigma = sqrt(max(noise_level, 0.0) / 3.0);
+        float forget = min(1.0, pc.change_gain * sc.change * luminance(beta) / (sigma + 1e-6));
+        lambda = mix(pc.lambda, pc.lambda_min, forget);
+        if (pc.drift_valid != 0u) {
+            vec4 drift = history_fetch(drift_prev, r);
+            beta += significant_drift(drift, pc.drift_z);
+        }
     }
 
     vec3 e = I - beta;

@@ -54,8 +54,10 @@ pub struct WrlsParams {
     pub stratum: u32,
     /// Smallest forgetting factor the temporal gradients may set (a sudden change).
     pub lambda_min: f32,
-    /// How fast the forgetting factor falls with the relative change the gradients
-    /// measure: the history keeps 1 − min(1, gain·change) of its weight.
+    /// How fast the forgetting factor falls towards λ_min with the change the gradients
+    /// measure: ours by gain × relative change × luminance / noise σ (the change per
+    /// frame against the pixel's noise, as a steady-state Kalman gain); the paper's
+    /// models (`ours-feature`) by gain × relative change.
     pub change_gain: f32,
     /// Shrinkage of the gradient ratio towards 1: a ratio `k` standard errors from 1
     /// keeps k²/(k² + shrink) of its departure.
@@ -65,6 +67,7 @@ pub struct WrlsParams {
     pub drift_z: f32,
     /// Radius of the pooled lag test's square neighbourhood, in pixels.
     pub drift_radius: u32,
+
     /// À-trous iterations of the spatial filter (steps 1, 2, 4, …).
     pub atrous_iterations: u32,
 }
@@ -84,7 +87,7 @@ impl Default for WrlsParams {
             outlier_sigmas: 10.0,
             stratum: 4,
             lambda_min: 0.1,
-            change_gain: 8.0,
+            change_gain: 4.0,
             shrink: 4.0,
             drift_z: 3.0,
             drift_radius: 2,
