@@ -21,40 +21,15 @@ pub(crate) fn open_regular(path: &Path) -> Result<(File, u64), VolumeError> {
         path: path.to_path_buf(),
         source,
     };
-    let meta = std::fs::metadata(path).map_err(io_err)?;
-    if !meta.is_file() {
+    if let Some(what) = crate::files::not_a_regular_file(path).map_err(io_err)? {
         return Err(VolumeError::NotAFile {
             path: path.to_path_buf(),
-            what: file_type_name(&meta.file_type()),
+            what,
         });
     }
     let file = File::open(path).map_err(io_err)?;
-    Ok((file, meta.len()))
-}
-
-/// What a non-regular file is, for [`VolumeError::NotAFile`].
-fn file_type_name(t: &std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if t.is_fifo() {
-            return "a named pipe (FIFO)";
-        }
-        if t.is_char_device() {
-            return "a character device";
-        }
-        if t.is_block_device() {
-            return "a block device";
-        }
-        if t.is_socket() {
-            return "a socket";
-        }
-    }
-    if t.is_dir() {
-        "a folder"
-    } else {
-        "not a regular file"
-    }
+    let len = file.metadata().map_err(io_err)?.len();
+    Ok((file, len))
 }
 
 /// Reads a whole regular file of at most `limit` bytes (sidecars, DICOM slices),
