@@ -1,6 +1,7 @@
 //! The offscreen commands: capture (sequences), reference (high-sample frames) and the
 //! render loop behind profile.
 
+use crate::eval::reference::{FillReport, ReferenceCache, ReferenceKey};
 use crate::profile::{self, Profile};
 use crate::setup::Setup;
 use crate::SceneArgs;
@@ -76,35 +77,52 @@ pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()>
     Ok(())
 }
 
+/// `dvr reference`: the same cache as `dvr eval`'s, in `out/reference/`, so a rerun with
+/// the same key reuses (or finishes) what is there.
 pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
     let setup = Setup::new(args)?;
-    let mut renderer = setup.renderer(&["none"])?;
-    let dir = out.join("reference");
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    let started = Instant::now();
-    let batch = 32;
-    for f in 0..setup.frames {
-        let pixels = renderer.reference(&setup.inputs(f), spp, batch)?;
-        let img = to_rgb(setup.width(), setup.height(), &pixels);
-        write_exr(&dir.join(format!("{}.exr", frame_name(f as u64))), &img)?;
-        write_png(&dir.join(format!("{}.png", frame_name(f as u64))), &img)?;
-        let secs = started.elapsed().as_secs_f64();
-        let samples = (f + 1) as f64 * spp as f64 * setup.width() as f64 * setup.height() as f64;
-        eprint!(
-            "\rreference: frame {}/{} | {:.2} Msamples/s | {:.0} s left   ",
-            f + 1,
-            setup.frames,
-            samples / secs / 1e6,
-            secs / (f + 1) as f64 * (setup.frames - f - 1) as f64
-        );
-    }
-    eprintln!();
+    let key = ReferenceKey::new(setup.scene(), args.size, spp, args.volume_size)?;
+    let cache = ReferenceCache::new(out, key);
+    let mut report = ReferenceReport {
+        started: Instant::now(),
+        samples_per_frame: f64::from(spp) * f64::from(setup.width() * setup.height()),
+    };
+    cache.fill(&setup, &mut report)?;
     println!(
         "wrote {} reference frames to {}",
         setup.frames,
-        dir.display()
+        cache.dir.display()
     );
     Ok(())
+}
+
+/// `dvr reference`'s progress line: frames, Msamples/s, time left.
+struct ReferenceReport {
+    started: Instant,
+    samples_per_frame: f64,
+}
+
+impl FillReport for ReferenceReport {
+    fn note(&mut self, text: Option<&str>) {
+        if let Some(text) = text {
+            eprintln!("reference: {text}");
+        }
+    }
+
+    fn rendered(&mut self, done: usize, of: usize) {
+        if done == 0 {
+            return;
+        }
+        let secs = self.started.elapsed().as_secs_f64();
+        eprint!(
+            "\rreference: frame {done}/{of} | {:.2} Msamples/s | {:.0} s left   ",
+            done as f64 * self.samples_per_frame / secs / 1e6,
+            secs / done as f64 * (of - done) as f64
+        );
+        if done == of {
+            eprintln!();
+        }
+    }
 }
 
 pub fn profile(

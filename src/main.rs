@@ -6,6 +6,7 @@
 mod capture;
 mod eval;
 mod explore;
+mod logger;
 mod profile;
 mod setup;
 
@@ -20,6 +21,9 @@ use std::path::PathBuf;
     about = "Monte Carlo direct volume rendering with temporal denoising"
 )]
 struct Cli {
+    /// Show only errors (no warnings). `DVR_LOG=info|debug` shows more instead.
+    #[arg(long, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -31,16 +35,16 @@ pub struct SceneArgs {
     #[arg(long, default_value = setup::DEFAULT_SCENE)]
     pub scene: String,
     /// Frames of the animation to render (default: the scene's own length).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: Option<u32>,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256", value_parser = setup::parse_size)]
     pub size: (u32, u32),
-    /// Samples per pixel per frame (default: the scene's, 2 for built-ins).
-    #[arg(long)]
+    /// Samples per pixel per frame, 1 to 4 (default: the scene's, 2 for built-ins).
+    #[arg(long, value_parser = setup::parse_spp)]
     pub spp: Option<u32>,
-    /// Edge length of procedural volumes (phantom, cloud).
-    #[arg(long, default_value_t = 128)]
+    /// Edge length of procedural volumes (phantom, cloud), 8 to 4096.
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Position the temporal denoisers reproject with: `features` (opacity-threshold
     /// surface, or the expected first collision through semi-transparent layers; measured
@@ -71,8 +75,9 @@ enum Command {
     Reference {
         #[command(flatten)]
         scene: SceneArgs,
-        /// Samples per pixel of the reference.
-        #[arg(long = "ref-spp", alias = "samples", default_value_t = 1024)]
+        /// Samples per pixel of the reference (at least 1).
+        #[arg(long = "ref-spp", alias = "samples", default_value_t = 1024,
+              value_parser = clap::value_parser!(u32).range(1..))]
         ref_spp: u32,
         #[arg(long, default_value = "out/reference")]
         out: PathBuf,
@@ -101,17 +106,29 @@ enum Command {
     },
 }
 
+/// Exit status of a run that failed with an error (a bad file, value or device).
+pub const EXIT_ERROR: i32 = 1;
+/// Exit status of a command line clap could not parse (clap's own convention; clap
+/// exits with it itself).
+#[allow(dead_code)]
+pub const EXIT_USAGE: i32 = 2;
+/// Exit status when the Vulkan validation layer (`DVR_VALIDATION=1`) reported anything,
+/// even if the command otherwise succeeded.
+pub const EXIT_VALIDATION: i32 = 3;
+
 fn main() {
+    // A usage error exits with clap's status 2 (EXIT_USAGE); --help and --version 0.
     let cli = Cli::parse();
+    logger::init(cli.quiet);
     let result = run(cli);
     let validation_messages = dvr_engine::gpu::validation::message_count();
     if let Err(e) = result {
         eprintln!("dvr: error: {}", error_chain(&e));
-        std::process::exit(1);
+        std::process::exit(EXIT_ERROR);
     }
     if validation_messages > 0 {
         eprintln!("dvr: the Vulkan validation layer reported {validation_messages} message(s)");
-        std::process::exit(2);
+        std::process::exit(EXIT_VALIDATION);
     }
 }
 

@@ -153,8 +153,13 @@ pub fn write_page(
     results: &[SceneResult],
     overall: &[Overall],
 ) -> Result<()> {
-    std::fs::write(path, page(info, results, overall))
-        .with_context(|| format!("writing {}", path.display()))
+    let html = page(info, results, overall);
+    dvr_engine::files::write_atomic(
+        path,
+        html.as_bytes(),
+        dvr_engine::files::Durability::Renamed,
+    )
+    .with_context(|| format!("writing {}", path.display()))
 }
 
 #[cfg(test)]

@@ -32,7 +32,7 @@ mod html;
 mod images;
 mod plots;
 mod progress;
-mod reference;
+pub(crate) mod reference;
 mod run;
 mod scenes;
 mod score;
@@ -60,14 +60,15 @@ pub struct EvalArgs {
     #[arg(long, default_value = "suite")]
     pub scene: String,
     /// Frames of each animation (default: each scene's own length).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: Option<u32>,
     /// Samples per pixel per frame of the noisy input (default: the scene's, 2 for
     /// built-ins).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::setup::parse_spp)]
     pub spp: Option<u32>,
-    /// Samples per pixel of the references.
-    #[arg(long = "ref-spp", default_value_t = 1024)]
+    /// Samples per pixel of the references (at least 1).
+    #[arg(long = "ref-spp", default_value_t = 1024,
+          value_parser = clap::value_parser!(u32).range(1..))]
     pub ref_spp: u32,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256", value_parser = crate::setup::parse_size)]
@@ -78,8 +79,8 @@ pub struct EvalArgs {
     /// Output folder (references in it are reused when their settings match).
     #[arg(long, default_value = "out/eval")]
     pub out: PathBuf,
-    /// Edge length of procedural volumes (phantom, cloud).
-    #[arg(long, default_value_t = 128)]
+    /// Edge length of procedural volumes (phantom, cloud), 8 to 4096.
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Position the temporal denoisers reproject with: `first-hit` or `features` (as
     /// for `dvr capture`; references do not depend on it).
@@ -89,9 +90,6 @@ pub struct EvalArgs {
 
 pub fn eval(args: &EvalArgs) -> Result<()> {
     let started = Instant::now();
-    if args.ref_spp == 0 {
-        bail!("--ref-spp must be at least 1");
-    }
     let mut methods: Vec<String> = Vec::new();
     for d in &args.denoiser {
         let d = d.trim();

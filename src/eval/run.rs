@@ -5,7 +5,7 @@
 use super::baseline::{self, BaselinePoint};
 use super::images::{write_display_png, write_flip_png};
 use super::progress::Progress;
-use super::reference::{frame_name, ReferenceCache, ReferenceKey};
+use super::reference::{frame_name, FillReport, ReferenceCache, ReferenceKey};
 use super::score::{score, FrameReference};
 use super::{scenes, EvalArgs, GPU_WARMUP_FRAMES};
 use crate::setup::Setup;
@@ -225,44 +225,33 @@ fn scene_args(args: &EvalArgs, name: &str) -> SceneArgs {
     }
 }
 
-fn ensure_references(
-    scene: &PlannedScene,
-    setup: &Setup,
+/// The eval's view of filling a scene's reference cache: notes under the progress
+/// line, and reference frames counted as progress.
+struct ReferenceProgress<'a> {
+    progress: &'a mut Progress,
+    label: &'a str,
     ref_spp: u32,
-    progress: &mut Progress,
-    label: &str,
-) -> Result<()> {
-    let refs = &scene.references;
-    let missing = refs.missing();
-    let reused = scene.frames as usize - missing.len();
-    if missing.is_empty() {
-        progress.newline();
-        eprintln!(
-            "{label}: reusing {reused} reference frame(s) in {}",
-            refs.dir.display()
+}
+
+impl FillReport for ReferenceProgress<'_> {
+    fn note(&mut self, text: Option<&str>) {
+        self.progress.newline();
+        if let Some(text) = text {
+            eprintln!("{}: {text}", self.label);
+        }
+    }
+
+    fn rendered(&mut self, done: usize, of: usize) {
+        let status = format!(
+            "{} | reference {done}/{of} ({} spp)",
+            self.label, self.ref_spp
         );
-        return Ok(());
+        if done == 0 {
+            self.progress.show(&status);
+        } else {
+            self.progress.advance(f64::from(self.ref_spp), &status);
+        }
     }
-    if let Some(note) = refs.prepare()? {
-        progress.newline();
-        eprintln!("{label}: {note}");
-    } else if reused > 0 {
-        progress.newline();
-        eprintln!(
-            "{label}: reusing {reused} reference frame(s), rendering {}",
-            missing.len()
-        );
-    }
-    // The same renderer set-up as `dvr reference`, so cached frames are identical to it.
-    let mut renderer = setup.renderer(&["none"])?;
-    let n = missing.len();
-    progress.show(&format!("{label} | reference 0/{n} ({ref_spp} spp)"));
-    for (i, &f) in missing.iter().enumerate() {
-        refs.render(setup, &mut renderer, f)?;
-        let status = format!("{label} | reference {}/{n} ({ref_spp} spp)", i + 1);
-        progress.advance(f64::from(ref_spp), &status);
-    }
-    Ok(())
 }
 
 pub fn evaluate_scene(
@@ -274,7 +263,14 @@ pub fn evaluate_scene(
 ) -> Result<SceneResult> {
     progress.show(&format!("{label} | loading"));
     let setup = Setup::new(&scene_args(args, &scene.name))?;
-    ensure_references(scene, &setup, args.ref_spp, progress, label)?;
+    scene.references.fill(
+        &setup,
+        &mut ReferenceProgress {
+            progress,
+            label,
+            ref_spp: args.ref_spp,
+        },
+    )?;
 
     let names: Vec<&str> = methods.iter().map(String::as_str).collect();
     let mut renderer = setup.renderer(&names)?;
