@@ -418,6 +418,16 @@ pub(crate) fn load_within_seconds(path: &Path, secs: u64) -> Result<Volume, Volu
         .unwrap_or_else(|_| panic!("loading {} took over {secs} s", path.display()))
 }
 
+/// Makes a FIFO at `path` (with `mkfifo`); false where that is not possible, and the
+/// test that wants one skips that part.
+#[cfg(test)]
+pub(crate) fn make_fifo(path: &Path) -> bool {
+    std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
 /// The volume name for a file: its name without the (double) extension.
 pub(crate) fn name_of(path: &Path) -> String {
     let file = path

@@ -672,11 +672,7 @@ sizes: 1 2 2 1\nspacings: nan 0.5 0.5 3\nencoding: raw\nmodality:=CT\n\n"
         assert!(err.to_string().contains("/dev/zero"), "{err}");
         // Used to block forever opening the FIFO.
         let fifo = dir.path().join("pipe.raw");
-        let made = std::process::Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .is_ok_and(|s| s.success());
-        if made {
+        if crate::volume::make_fifo(&fifo) {
             let p = header("fifo.nhdr", Some("pipe.raw"));
             let err = crate::volume::load_within_seconds(&p, 5).unwrap_err();
             assert!(err.to_string().contains("FIFO"), "{err}");
