@@ -19,6 +19,9 @@ pub enum ImageIoError {
 
 pub type Result<T> = std::result::Result<T, ImageIoError>;
 
+/// Largest EXR read (pixels of one layer): the largest frame `dvr` renders.
+pub const MAX_EXR_PIXELS: usize = 8192 * 8192;
+
 /// Exposure applied before the tone map for PNGs.
 pub const PNG_EXPOSURE: f32 = 1.0;
 
@@ -66,6 +69,20 @@ pub fn read_exr(path: &Path) -> Result<Rgb32Image> {
     };
     let (file, _) =
         crate::files::open_regular(path).map_err(|e| err(format!("cannot read EXR: {e}")))?;
+    let mut reader = std::io::BufReader::new(file);
+    // The header first: a corrupt one could ask for any size, and the pixels are
+    // allocated from it.
+    let meta = exr::meta::MetaData::read_from_buffered(&mut reader, false)
+        .map_err(|e| err(format!("cannot read EXR: {e}")))?;
+    for h in &meta.headers {
+        let (w, hgt) = (h.layer_size.width(), h.layer_size.height());
+        if w.saturating_mul(hgt) > MAX_EXR_PIXELS {
+            return Err(err(format!(
+                "a {w}x{hgt} layer; at most {MAX_EXR_PIXELS} pixels (8192x8192) are read"
+            )));
+        }
+    }
+    std::io::Seek::rewind(&mut reader).map_err(|e| err(format!("cannot read EXR: {e}")))?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -80,7 +97,7 @@ pub fn read_exr(path: &Path) -> Result<Rgb32Image> {
         )
         .first_valid_layer()
         .all_attributes()
-        .from_buffered(std::io::BufReader::new(file))
+        .from_buffered(reader)
         .map_err(|e| err(format!("cannot read EXR: {e}")))?;
     let size = image.layer_data.size;
     Ok(Rgb32Image {

@@ -249,7 +249,8 @@ impl ReferenceCache {
             }
             let problem = match self.load(f) {
                 Err(e) => Some((exr, format!("{e:#}"))),
-                Ok(_) => match image::image_dimensions(&png) {
+                // Decoded whole: a cut PNG keeps a valid header.
+                Ok(_) => match image::open(&png).map(|i| (i.width(), i.height())) {
                     Err(e) => Some((png, e.to_string())),
                     Ok(size) if size != (self.key.width, self.key.height) => Some((
                         png,

@@ -311,8 +311,20 @@ impl Animation {
             }
         }
         if let Some(o) = &self.orbit {
-            ctx.finite("animation.orbit.degrees_per_frame", o.degrees_per_frame)?;
-            ctx.finite("animation.orbit.start_degrees", o.start_degrees)?;
+            ctx.in_range(
+                "animation.orbit.degrees_per_frame",
+                o.degrees_per_frame,
+                -360.0,
+                360.0,
+                " degrees",
+            )?;
+            ctx.in_range(
+                "animation.orbit.start_degrees",
+                o.start_degrees,
+                -360.0,
+                360.0,
+                " degrees",
+            )?;
             if let Some(c) = o.center {
                 ctx.near_origin(
                     "animation.orbit.center",

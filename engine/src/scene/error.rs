@@ -78,14 +78,6 @@ impl Ctx<'_> {
         }
     }
 
-    pub fn finite(&self, field: &str, x: f64) -> Result<(), SceneError> {
-        if x.is_finite() {
-            Ok(())
-        } else {
-            Err(self.invalid(field, format!("{x} is not a finite number")))
-        }
-    }
-
     pub fn positive(&self, field: &str, x: f64) -> Result<(), SceneError> {
         if x.is_finite() && x > 0.0 {
             Ok(())
