@@ -108,17 +108,18 @@ enum Command {
 
 /// Exit status of a run that failed with an error (a bad file, value or device).
 pub const EXIT_ERROR: i32 = 1;
-/// Exit status of a command line clap could not parse (clap's own convention; clap
-/// exits with it itself).
-#[allow(dead_code)]
+/// Exit status of a command line that does not parse (clap's convention).
 pub const EXIT_USAGE: i32 = 2;
 /// Exit status when the Vulkan validation layer (`DVR_VALIDATION=1`) reported anything,
 /// even if the command otherwise succeeded.
 pub const EXIT_VALIDATION: i32 = 3;
 
 fn main() {
-    // A usage error exits with clap's status 2 (EXIT_USAGE); --help and --version 0.
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| {
+        let _ = e.print();
+        // --help and --version print to stdout and succeed.
+        std::process::exit(if e.use_stderr() { EXIT_USAGE } else { 0 })
+    });
     logger::init(cli.quiet);
     let result = run(cli);
     let validation_messages = dvr_engine::gpu::validation::message_count();
