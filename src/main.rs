@@ -40,7 +40,8 @@ pub struct SceneArgs {
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256", value_parser = setup::parse_size)]
     pub size: (u32, u32),
-    /// Samples per pixel per frame, 1 to 4 (default: the scene's, 2 for built-ins).
+    /// Samples per pixel per frame, 1 to 64; lavapipe takes up to 4 (default: the
+    /// scene's, 2 for built-ins).
     #[arg(long, value_parser = setup::parse_spp)]
     pub spp: Option<u32>,
     /// Edge length of procedural volumes (phantom, cloud), 8 to 4096.

@@ -35,7 +35,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// Parses `--spp`: samples per pixel per frame, as many as a scene's `render.spp` may
-/// ask for.
+/// ask for (the device may take fewer; the renderer says so).
 pub fn parse_spp(s: &str) -> Result<u32, String> {
     let max = dvr_engine::scene::render::MAX_SPP;
     match s.trim().parse::<u32>() {

@@ -35,7 +35,7 @@ const SLOTS: usize = 2;
 /// delta-tracking or ray-marching steps is silently cut short (measured: 128 samples in
 /// one dispatch came out 27% dark, 512 samples 73% dark). References accumulate batches
 /// of at most this many samples instead; per-frame rendering is limited to it.
-pub const MAX_SAMPLES_PER_DISPATCH: u32 = crate::scene::render::MAX_SPP;
+pub const MAX_SAMPLES_PER_DISPATCH: u32 = 4;
 
 /// Fixed settings of a renderer (changing them means a new renderer).
 #[derive(Clone, Debug)]

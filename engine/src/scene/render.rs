@@ -65,9 +65,11 @@ pub struct RenderSettings {
 /// Cap on `max_bounces`: far past any useful value, low enough to bound a frame's cost.
 pub const MAX_BOUNCES_LIMIT: u32 = 64;
 
-/// Samples per pixel per frame the path tracer takes in one dispatch (lavapipe's loop
-/// limiter cuts longer per-pixel loops short; see the renderer).
-pub const MAX_SPP: u32 = 4;
+/// Most samples per pixel per frame a scene (or `--spp`) may ask for: a real-time
+/// budget, far past the 1–2 the denoisers are made for; references take more through
+/// `--ref-spp`. A device may allow fewer: the renderer says so, naming it (lavapipe
+/// takes 4, see `renderer::MAX_SAMPLES_PER_DISPATCH`).
+pub const MAX_SPP: u32 = 64;
 
 /// Ray-march step range in voxels: below it a frame takes minutes, above it the march
 /// steps over the volume.

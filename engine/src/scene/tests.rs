@@ -509,8 +509,8 @@ fn nonsense_values_are_refused_with_their_range() {
             &["render.step_size", "1e9"],
         ),
         (
-            with("spp = 2", "spp = 16"),
-            &["render.spp", "1..=4"],
+            with("spp = 2", "spp = 512"),
+            &["render.spp", "1..=64", "--ref-spp"],
         ),
         (
             with("position = [1.0, 1.0, 1.0]", "position = [1e7, 1.0, 1.0]"),
