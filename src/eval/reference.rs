@@ -313,18 +313,19 @@ impl ReferenceCache {
         Ok(note)
     }
 
-    /// Renders frame `f` and stores it (each file written whole or not at all).
+    /// Renders frame `f` (see [`ReferenceCache::store`]).
     pub fn render(
         &self,
         setup: &Setup,
         renderer: &mut dvr_engine::renderer::Renderer,
         f: u32,
-    ) -> Result<()> {
+    ) -> Result<Rgb32Image> {
         let pixels = renderer.reference(&setup.inputs(f), self.key.ref_spp, BATCH)?;
-        self.store(f, &to_rgb(setup.width(), setup.height(), &pixels))
+        Ok(to_rgb(setup.width(), setup.height(), &pixels))
     }
 
-    /// Writes frame `f`'s files: PNG, then the EXR that [`ReferenceCache::load`] reads.
+    /// Writes frame `f`'s files, each whole or not at all (temporary name, fsync,
+    /// rename): PNG, then the EXR that [`ReferenceCache::load`] reads.
     pub fn store(&self, f: u32, img: &Rgb32Image) -> Result<()> {
         let (png, exr) = (self.png(f), self.exr(f));
         write_file(&png, &encode_png(&png, img)?, Durability::Synced)?;
@@ -380,7 +381,8 @@ impl ReferenceCache {
         let mut renderer = setup.renderer(&["none"])?;
         report.rendered(0, state.missing.len());
         for (i, &f) in state.missing.iter().enumerate() {
-            self.render(setup, &mut renderer, f)?;
+            let img = self.render(setup, &mut renderer, f)?;
+            self.store(f, &img)?;
             report.rendered(i + 1, state.missing.len());
         }
         Ok(())
