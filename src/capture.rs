@@ -3,12 +3,14 @@
 
 use crate::eval::reference::{FillReport, ReferenceCache, ReferenceKey};
 use crate::profile::{self, Profile};
+use crate::progress::{FrameRate, Progress};
 use crate::setup::Setup;
+use crate::video::{self, Track, VideoArgs};
 use crate::SceneArgs;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png};
-use dvr_engine::renderer::{FrameRequest, FrameResult};
+use dvr_engine::renderer::{FrameRequest, FrameResult, MAX_SAMPLES_PER_DISPATCH};
 use std::path::Path;
 use std::time::Instant;
 
@@ -27,10 +29,21 @@ fn write_frame(out: &Path, setup: &Setup, r: &FrameResult) -> Result<()> {
     Ok(())
 }
 
-pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()> {
+pub fn capture(
+    args: &SceneArgs,
+    denoisers: &[String],
+    out: &Path,
+    video: &VideoArgs,
+) -> Result<()> {
+    if video.video {
+        // Before anything renders: minutes of frames are no use without the encoder.
+        video::require_ffmpeg()?;
+    }
+    let denoisers = crate::setup::denoiser_list(denoisers)?;
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut renderer = setup.renderer(&names)?;
+    crate::setup::create_out_dir(out)?;
     for m in renderer.denoiser_names() {
         std::fs::create_dir_all(out.join(&m))
             .with_context(|| format!("creating {}", out.join(&m).display()))?;
@@ -41,18 +54,21 @@ pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()>
         readback: true,
         reset: false,
     };
+    let mut progress = Progress::new(f64::from(setup.frames));
+    let mut rate = FrameRate::default();
     for f in 0..setup.frames {
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
             write_frame(out, &setup, &done)?;
             timings.push(done.timings);
+            rate.finished();
         }
-        progress("capture", f + 1, setup.frames, started);
+        progress.advance(1.0, &frame_status("capture", f + 1, setup.frames, &rate));
     }
     for done in renderer.flush()? {
         write_frame(out, &setup, &done)?;
         timings.push(done.timings);
     }
-    eprintln!();
+    progress.finish();
     profile::write_json(
         &out.join("timings.json"),
         &serde_json::json!({
@@ -66,7 +82,17 @@ pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()>
         }),
     )?;
     let (passes, total) = profile::aggregate(&timings);
-    crate::setup::write_capture_page(out, &setup, &renderer.denoiser_names(), &passes, &total)?;
+    let methods = renderer.denoiser_names();
+    let videos = if video.video {
+        let tracks: Vec<Track> = methods
+            .iter()
+            .map(|m| Track::from_folder(m, &out.join(m), setup.frames))
+            .collect();
+        video::write_videos(out, &tracks, video.video_fps)?
+    } else {
+        Vec::new()
+    };
+    crate::setup::write_capture_page(out, &setup, &methods, &passes, &total, &videos)?;
     println!(
         "wrote {} frames × {} method(s) to {} ({:.1} s)",
         setup.frames,
@@ -80,14 +106,26 @@ pub fn capture(args: &SceneArgs, denoisers: &[String], out: &Path) -> Result<()>
 /// `dvr reference`: the same cache as `dvr eval`'s, in `out/reference/`, so a rerun with
 /// the same key reuses (or finishes) what is there.
 pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
+    // --spp above lavapipe's per-frame count most likely meant the reference's samples;
+    // counts the command line refuses (past MAX_SPP) already point to --ref-spp there.
+    if let Some(n) = args.spp.filter(|&n| n > MAX_SAMPLES_PER_DISPATCH) {
+        bail!(
+            "`dvr reference` takes its samples per pixel from --ref-spp: use --ref-spp {n} \
+             (--spp is the noisy input's samples per frame and does not change a reference)"
+        );
+    }
     let setup = Setup::new(args)?;
+    crate::setup::create_out_dir(out)?;
     let key = ReferenceKey::new(setup.scene(), args.size, spp, args.volume_size)?;
     let cache = ReferenceCache::new(out, key);
     let mut report = ReferenceReport {
-        started: Instant::now(),
+        progress: None,
         samples_per_frame: f64::from(spp) * f64::from(setup.width() * setup.height()),
     };
     cache.fill(&setup, &mut report)?;
+    if let Some(p) = &mut report.progress {
+        p.finish();
+    }
     println!(
         "wrote {} reference frames to {}",
         setup.frames,
@@ -96,31 +134,39 @@ pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
     Ok(())
 }
 
-/// `dvr reference`'s progress line: frames, Msamples/s, time left.
+/// `dvr reference`'s progress: frames and Msamples/s on the progress line (redrawn on a
+/// terminal, whole lines in a log), notes on lines of their own.
 struct ReferenceReport {
-    started: Instant,
+    /// Over the frames to render, from the first one on (none when all are reused).
+    progress: Option<Progress>,
     samples_per_frame: f64,
 }
 
 impl FillReport for ReferenceReport {
     fn note(&mut self, text: Option<&str>) {
+        if let Some(p) = &mut self.progress {
+            p.newline();
+        }
         if let Some(text) = text {
             eprintln!("reference: {text}");
         }
     }
 
     fn rendered(&mut self, done: usize, of: usize) {
+        let progress = self
+            .progress
+            .get_or_insert_with(|| Progress::new(of as f64));
+        let rate = if done == 0 {
+            String::new()
+        } else {
+            let per_s = done as f64 * self.samples_per_frame / progress.elapsed();
+            format!(" | {:.2} Msamples/s", per_s / 1e6)
+        };
+        let status = format!("reference: frame {done}/{of}{rate}");
         if done == 0 {
-            return;
-        }
-        let secs = self.started.elapsed().as_secs_f64();
-        eprint!(
-            "\rreference: frame {done}/{of} | {:.2} Msamples/s | {:.0} s left   ",
-            done as f64 * self.samples_per_frame / secs / 1e6,
-            secs / done as f64 * (of - done) as f64
-        );
-        if done == of {
-            eprintln!();
+            progress.show(&status);
+        } else {
+            progress.advance(1.0, &status);
         }
     }
 }
@@ -131,48 +177,63 @@ pub fn profile(
     json: Option<&Path>,
     trace: Option<&Path>,
 ) -> Result<()> {
+    let (report, window) = run_profile(args, denoisers)?;
+    print!("{}", profile::table(&report));
+    if let Some(p) = json {
+        profile::write_json(p, &report)?;
+    }
+    if let Some(p) = trace {
+        profile::write_json(
+            p,
+            &profile::chrome_trace(window.frames(), window.first(), &report.frames_note),
+        )?;
+    }
+    Ok(())
+}
+
+/// Renders the profile's frames: the report (streaming statistics of every frame, the
+/// measured peak bandwidth) and the window of raw frames for the trace.
+pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, profile::Window)> {
+    let denoisers = crate::setup::denoiser_list(denoisers)?;
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut renderer = setup.renderer(&names)?;
-    let started = Instant::now();
-    let mut frames: Vec<Vec<PassTiming>> = Vec::new();
+    let peak = dvr_engine::passes::bandwidth::measure(renderer.ctx())
+        .context("measuring the peak bandwidth")?;
+    // Streaming statistics and a bounded window of raw frames: memory stays flat
+    // however many frames run.
+    let mut stats = profile::Stats::new();
+    let mut window = profile::Window::new(profile::WINDOW_FRAMES);
+    let mut keep = |timings: Vec<PassTiming>| {
+        stats.add_frame(&timings);
+        window.push(timings);
+    };
     let request = FrameRequest::default();
+    let mut progress = Progress::new(f64::from(setup.frames));
+    let mut rate = FrameRate::default();
     for f in 0..setup.frames {
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
-            frames.push(done.timings);
+            keep(done.timings);
+            rate.finished();
         }
-        progress("profile", f + 1, setup.frames, started);
+        progress.advance(1.0, &frame_status("profile", f + 1, setup.frames, &rate));
     }
-    frames.extend(renderer.flush()?.into_iter().map(|r| r.timings));
-    eprintln!();
-    let (passes, total) = profile::aggregate(&frames);
-    let report = Profile {
+    for done in renderer.flush()? {
+        keep(done.timings);
+    }
+    progress.finish();
+    let run = profile::RunInfo {
         device: renderer.ctx().info.name.clone(),
         scene: setup.name.clone(),
         width: setup.width(),
         height: setup.height(),
         spp: setup.settings.spp,
         denoisers: renderer.denoiser_names(),
-        warmup_frames: profile::WARMUP_FRAMES,
-        passes,
-        total,
-        frames: frames.clone(),
     };
-    print!("{}", profile::table(&report));
-    if let Some(p) = json {
-        profile::write_json(p, &report)?;
-    }
-    if let Some(p) = trace {
-        profile::write_json(p, &profile::chrome_trace(&frames))?;
-    }
-    Ok(())
+    Ok((Profile::new(run, &stats, &window, Some(peak)), window))
 }
 
-fn progress(what: &str, done: u32, total: u32, started: Instant) {
-    let secs = started.elapsed().as_secs_f64();
-    let left = secs / done as f64 * (total - done) as f64;
-    eprint!(
-        "\r{what}: frame {done}/{total} | {:.1} fps | {left:.0} s left   ",
-        done as f64 / secs
-    );
+/// `capture: frame 12/60 | 3.4 fps`.
+fn frame_status(what: &str, submitted: u32, total: u32, rate: &FrameRate) -> String {
+    format!("{what}: frame {submitted}/{total} | {}", rate.text())
 }

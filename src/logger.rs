@@ -23,6 +23,9 @@ impl Log for Stderr {
             Level::Debug => "debug",
             Level::Trace => "trace",
         };
+        // A warning during a run starts a line of its own, not the end of the
+        // progress line a terminal is redrawing.
+        crate::progress::end_line();
         eprintln!("dvr: {level}: {}", record.args());
     }
 

@@ -1,14 +1,20 @@
 //! `dvr`: real-time Monte Carlo direct volume rendering with temporal denoising.
-//! Subcommands: explore (the interactive window), capture (offscreen sequences),
+//! Subcommands: demo (the main job: a small eval sized for the device), explore (the
+//! interactive window), capture (offscreen sequences),
 //! reference (high-sample references), eval (denoisers against references: metrics,
-//! plots, HTML), profile (per-pass GPU timing), scenes (the built-in scenes).
+//! plots, HTML), profile (per-pass GPU timing), bench (the one-call GPU benchmark), scenes
+//! (the built-in scenes).
 
+mod bench;
 mod capture;
+mod demo;
 mod eval;
 mod explore;
 mod logger;
 mod profile;
+mod progress;
 mod setup;
+mod video;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -35,7 +41,7 @@ pub struct SceneArgs {
     #[arg(long, default_value = setup::DEFAULT_SCENE)]
     pub scene: String,
     /// Frames of the animation to render (default: the scene's own length).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = crate::setup::parse_frames)]
     pub frames: Option<u32>,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256", value_parser = setup::parse_size)]
@@ -57,6 +63,10 @@ pub struct SceneArgs {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job (tools/run.sh): a small eval of the default scene sized for the
+    /// device (a discrete GPU: 1280x720 with 1024-spp references; otherwise about three
+    /// minutes on a 2-core CPU), with videos; opens nothing, prints the page's path.
+    Demo(demo::DemoArgs),
     /// Open a window: the path tracer and a denoiser live, with an orbit camera, a
     /// transfer-function editor, light and render controls and per-pass GPU timing.
     Explore(explore::ExploreArgs),
@@ -71,6 +81,8 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "out/capture")]
         out: PathBuf,
+        #[command(flatten)]
+        video: video::VideoArgs,
     },
     /// Render high-sample references of every frame: DIR/reference/NNNN.exr.
     Reference {
@@ -86,19 +98,26 @@ enum Command {
     /// Evaluate denoisers against cached references: metrics.csv, summary.csv, plots
     /// and an HTML results page.
     Eval(eval::EvalArgs),
-    /// Per-pass GPU timings over many frames: table, JSON and Chrome trace.
+    /// Per-pass GPU timings over many frames, with each pass's declared bytes, GB/s and
+    /// share of the peak bandwidth: table, JSON and Chrome trace.
     Profile {
         #[command(flatten)]
         scene: SceneArgs,
         #[arg(long, default_value = "none", value_delimiter = ',')]
         denoiser: Vec<String>,
-        /// Write the statistics and raw per-frame timings as JSON.
+        /// Write the statistics (per pass: times, bytes, GB/s, % of the measured peak
+        /// bandwidth) and the last 300 frames' raw timings as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
-        /// Write a Chrome trace-event file (Perfetto, chrome://tracing).
+        /// Write a Chrome trace-event file (Perfetto, chrome://tracing) of the last 300
+        /// frames.
         #[arg(long)]
         trace: Option<PathBuf>,
     },
+    /// The one-call GPU benchmark: profiles every denoiser at 256x256, 1280x720 and
+    /// 1920x1080 and runs the eval suite at 256x256 against 1024-spp references; writes
+    /// one small folder of CSV, JSON and plots (`tools/gpu-bench.sh` wraps it).
+    Bench(bench::BenchArgs),
     /// List the built-in scenes, or print one as a TOML scene file.
     Scenes {
         /// Print this scene as TOML (a starting point for your own).
@@ -125,6 +144,7 @@ fn main() {
     let result = run(cli);
     let validation_messages = dvr_engine::gpu::validation::message_count();
     if let Err(e) = result {
+        progress::end_line();
         eprintln!("dvr: error: {}", error_chain(&e));
         std::process::exit(EXIT_ERROR);
     }
@@ -152,24 +172,27 @@ fn error_chain(e: &anyhow::Error) -> String {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
+        Command::Demo(args) => demo::run(&args),
         Command::Explore(args) => explore::run(args),
         Command::Capture {
             scene,
             denoiser,
             out,
-        } => capture::capture(&scene, &denoiser, &out),
+            video,
+        } => capture::capture(&scene, &denoiser, &out, &video),
         Command::Reference {
             scene,
             ref_spp,
             out,
         } => capture::reference(&scene, ref_spp, &out),
-        Command::Eval(args) => eval::eval(&args),
+        Command::Eval(args) => eval::eval(&args).map(|_| ()),
         Command::Profile {
             scene,
             denoiser,
             json,
             trace,
         } => capture::profile(&scene, &denoiser, json.as_deref(), trace.as_deref()),
+        Command::Bench(args) => bench::run(&args),
         Command::Scenes { dump } => setup::list_scenes(dump.as_deref()),
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::profile::PassStats;
 use crate::SceneArgs;
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use dvr_engine::denoise::MotionSource;
 use dvr_engine::files::Durability;
 use dvr_engine::gpu::GpuContext;
@@ -47,6 +47,16 @@ pub fn parse_spp(s: &str) -> Result<u32, String> {
     }
 }
 
+/// Parses `--frames`: a whole number of at least 1.
+pub fn parse_frames(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "{s:?} is not a frame count (a whole number, at least 1)"
+        )),
+    }
+}
+
 /// The `--motion` every rendering command (and the explorer) defaults to.
 pub const DEFAULT_MOTION: &str = "features";
 
@@ -61,6 +71,65 @@ pub fn parse_motion(s: &str) -> Result<MotionSource, String> {
     }
 }
 
+/// Opens `--scene`: a built-in scene or a scene file. A name that is neither gets the
+/// built-in scenes that share its dataset or animation (or where to find them all),
+/// not the file system's "No such file or directory".
+pub fn open_scene(spec: &str) -> Result<Scene> {
+    let builtins = Scene::builtin_names();
+    if !builtins.iter().any(|n| n == spec) && !Path::new(spec).exists() {
+        let (dataset, animation) = spec.split_once('/').unwrap_or((spec, spec));
+        let close: Vec<&str> = builtins
+            .iter()
+            .map(String::as_str)
+            .filter(|n| {
+                let (d, a) = n.split_once('/').unwrap_or((n, n));
+                d == dataset || a == animation
+            })
+            .collect();
+        let hint = if close.is_empty() {
+            "`dvr scenes` lists the built-in scenes".to_string()
+        } else {
+            format!("built-in scenes like it: {}", close.join(", "))
+        };
+        bail!("{spec:?} is neither a built-in scene nor a scene file; {hint}");
+    }
+    Scene::open(spec).with_context(|| format!("opening scene {spec:?}"))
+}
+
+/// The methods a `--denoiser` list names: trimmed, each once, each one dvr has.
+pub fn denoiser_list(names: &[String]) -> Result<Vec<String>> {
+    let mut methods: Vec<String> = Vec::new();
+    for d in names {
+        let d = d.trim();
+        if d.is_empty() || methods.iter().any(|m| m == d) {
+            continue;
+        }
+        if !dvr_engine::denoise::NAMES.contains(&d) {
+            bail!(
+                "unknown denoiser {d:?}; available: {}",
+                dvr_engine::denoise::NAMES.join(", ")
+            );
+        }
+        methods.push(d.to_string());
+    }
+    if methods.is_empty() {
+        bail!("--denoiser names no method");
+    }
+    Ok(methods)
+}
+
+/// Creates the `--out` folder (and its parents); a file in the way is named as such,
+/// not as the system's "File exists".
+pub fn create_out_dir(out: &Path) -> Result<()> {
+    if out.exists() && !out.is_dir() {
+        bail!(
+            "--out {}: that is a file; --out names a folder",
+            out.display()
+        );
+    }
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))
+}
+
 /// A scene opened from the command line, made ready for rendering.
 pub struct Setup {
     pub name: String,
@@ -71,12 +140,7 @@ pub struct Setup {
 
 impl Setup {
     pub fn new(args: &SceneArgs) -> Result<Self> {
-        let mut scene = Scene::open(&args.scene).with_context(|| {
-            format!(
-                "opening scene {:?} (built-in scenes: `dvr scenes`)",
-                args.scene
-            )
-        })?;
+        let mut scene = open_scene(&args.scene)?;
         if let Some(n) = args.frames {
             scene = scene.with_frames(n)?;
         }
@@ -119,7 +183,7 @@ impl Setup {
 
 pub fn list_scenes(dump: Option<&str>) -> Result<()> {
     if let Some(name) = dump {
-        let scene = Scene::open(name)?;
+        let scene = open_scene(name)?;
         print!("{}", scene.to_toml()?);
         return Ok(());
     }
@@ -137,6 +201,7 @@ pub fn write_capture_page(
     methods: &[String],
     passes: &[PassStats],
     total: &PassStats,
+    videos: &[std::path::PathBuf],
 ) -> Result<()> {
     let mut html = String::new();
     html.push_str("<!doctype html><meta charset=utf-8><title>dvr capture</title>");
@@ -158,6 +223,18 @@ pub fn write_capture_page(
         let m = html_escape(m);
         html.push_str(&format!(
             "<figure><img class=seq data-m='{m}'><figcaption>{m}</figcaption></figure>"
+        ));
+    }
+    if !videos.is_empty() {
+        html.push_str("<h2>Videos</h2><p>");
+        for v in videos.iter().filter_map(|v| v.file_name()) {
+            // Denoiser names and fixed file names, escaped like every string on the page.
+            let name = html_escape(&v.to_string_lossy());
+            html.push_str(&format!("<a href='videos/{name}'>{name}</a> "));
+        }
+        html.push_str(&format!(
+            "</p><video controls loop src='videos/{}' style='max-width:100%'></video>",
+            crate::video::COMPARISON
         ));
     }
     html.push_str(

@@ -83,7 +83,7 @@ fn capture_writes_frames_timings_and_page_for_every_denoiser() {
         "motion",
         "accum",
         "ours.update",
-        "ours.spatial",
+        "ours.atrous2",
         "svgf.atrous4",
     ] {
         assert!(passes.contains(&want), "no timing for {want}: {passes:?}");
@@ -121,9 +121,26 @@ fn profile_prints_a_table_and_writes_json_and_a_chrome_trace() {
     let p: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("parses");
     assert!(p["total"]["mean_ms"].as_f64().expect("mean") > 0.0);
+    for row in ["MB", "GB/s", "% peak", "peak bandwidth"] {
+        assert!(table.contains(row), "table lacks {row}:\n{table}");
+    }
+    // Every pass carries its declared bytes, bandwidth and share of the measured peak.
+    assert!(p["peak_bandwidth"]["gb_per_s"].as_f64().expect("peak") > 0.0);
+    let update = p["passes"]
+        .as_array()
+        .expect("passes")
+        .iter()
+        .find(|r| r["pass"] == "ours.update")
+        .expect("ours.update row");
+    assert!(update["bytes"].as_f64().expect("bytes") > 0.0);
+    assert!(update["gb_per_s"].as_f64().expect("GB/s") > 0.0);
+    assert!(update["percent_of_peak"].as_f64().expect("% of peak") > 0.0);
+    assert_eq!(p["frames_rendered"], 6);
     let t: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&trace).expect("trace")).expect("parses");
-    assert!(t["traceEvents"].as_array().expect("events").len() >= 6 * 4);
+    let events = t["traceEvents"].as_array().expect("events");
+    assert!(events.len() >= 6 * 4);
+    assert!(events.iter().all(|e| e["args"]["bytes"].is_u64()));
 }
 
 #[test]
@@ -239,6 +256,27 @@ fn bad_inputs_get_clear_errors() {
         "[volume]\nbuiltin = \"cloud\"\nsize = 16\n[transfer]\na = \"bad-tf.toml\"\n[[light]]\nkind = \"point\"\nposition = [1.0, 1.0, 1.0]\nintensity = 1.0\n",
     );
     assert_error(&run(&scene), &["bad-tf.toml"]);
+}
+
+#[test]
+fn reference_samples_come_from_ref_spp() {
+    // `dvr reference --spp 512` means a 512-spp reference: the answer names --ref-spp
+    // (whether the command line or dvr rejects it).
+    let o = dvr(&[
+        "reference",
+        "--spp",
+        "512",
+        "--frames",
+        "1",
+        "--size",
+        "8x8",
+    ]);
+    let err = stderr(&o);
+    assert!(!o.status.success() && !err.contains("panicked"), "{err}");
+    assert!(
+        err.contains("--ref-spp"),
+        "should point to --ref-spp:\n{err}"
+    );
 }
 
 #[test]

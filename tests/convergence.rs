@@ -104,3 +104,29 @@ fn majorant_grid_matches_a_global_majorant_on_odd_sized_volumes() {
     assert!(((mg - mo) / mo).abs() < 0.02, "grid {mg} vs global {mo}");
     assert_validation_clean();
 }
+
+/// lavapipe is recognised by its driver ID (not only its name) and keeps its 4-sample
+/// dispatches; every other device renders references in as few dispatches as the
+/// per-dispatch budget allows, and counts their GPU time.
+#[test]
+fn reference_dispatches_follow_the_driver() {
+    use dvr_engine::renderer::{samples_per_dispatch, MAX_SAMPLES_PER_DISPATCH};
+    let (mut r, inputs) = phantom_renderer(3);
+    let info = r.ctx().info.clone();
+    let named_llvmpipe = info.name.to_lowercase().contains("llvmpipe");
+    assert_eq!(info.is_llvmpipe(), named_llvmpipe, "{info:?}");
+    if info.is_llvmpipe() {
+        assert_eq!(r.samples_per_dispatch(), MAX_SAMPLES_PER_DISPATCH);
+    } else {
+        assert_eq!(
+            r.samples_per_dispatch(),
+            samples_per_dispatch(&info, 16 * 16)
+        );
+    }
+    assert_eq!(r.gpu_ms(), 0.0);
+    let img = r.reference(&inputs, 8, u32::MAX).expect("render");
+    assert!(img.iter().all(|p| p.iter().all(|v| v.is_finite())));
+    assert!(r.gpu_ms() > 0.0, "reference passes are timed");
+    drop(r);
+    assert_validation_clean();
+}

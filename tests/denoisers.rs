@@ -144,9 +144,10 @@ fn ramp_lag(name: &str) -> f32 {
     err
 }
 
-/// The temporal feature earns its place where the signal changes gradually (a TF or
-/// light animation): the constant model lags a ramp, the feature model follows it, and
-/// `ours` selects the feature there.
+/// A gradual change with no scene to re-trace (so no temporal gradients): one pixel's
+/// residual stays within its 2-spp noise, so the paper's constant model averages the
+/// ramp in and lags; ours' pooled lag test sees the shared residual of the
+/// neighbourhood and follows it.
 #[test]
 fn ours_follows_a_slow_ramp_that_the_constant_model_lags() {
     let ours = ramp_lag("ours");

@@ -86,6 +86,17 @@ fn png_size(path: &Path) -> (u32, u32) {
     (img.width(), img.height())
 }
 
+/// Progress written to a file or pipe (as here) is whole lines, no carriage returns, at
+/// most one per 2 % of the run (plus the first).
+fn assert_log_progress(log: &str) {
+    assert!(!log.contains('\r'), "carriage return in the log:\n{log}");
+    let progress = log.lines().filter(|l| l.contains("% | ")).count();
+    assert!(
+        (1..=51).contains(&progress),
+        "{progress} progress lines:\n{log}"
+    );
+}
+
 fn num(s: &str, what: &str) -> f64 {
     s.parse()
         .unwrap_or_else(|_| panic!("{what}: {s:?} is not a number"))
@@ -223,6 +234,7 @@ fn tiny_eval_writes_tables_images_plots_and_reuses_references() {
         stderr(&first).contains("cloud/orbit"),
         "progress names the scene"
     );
+    assert_log_progress(&stderr(&first));
 
     // Same settings again: every reference is reused, untouched.
     let refs: Vec<PathBuf> = (0..3)
@@ -335,38 +347,58 @@ fn attr<'a>(dom: &'a str, marker: &str, attr: &str) -> &'a str {
     &tag[v..v + tag[v..].find('"').unwrap()]
 }
 
-#[test]
-fn results_page_works_in_headless_chromium() {
-    let Some(bin) = chromium() else {
+/// The page counted every image it showed as loaded, none failed or still pending.
+fn assert_all_images_loaded(dom: &str) {
+    assert_eq!(
+        attr(dom, "<body", "data-failed"),
+        "0",
+        "{}",
+        attr(dom, "<body", "data-failed-srcs")
+    );
+    assert_eq!(attr(dom, "<body", "data-pending"), "0");
+}
+
+/// Chromium, or `None` (the test is skipped) where it is not installed, except in CI.
+fn chromium_or_skip(test: &str) -> Option<PathBuf> {
+    let bin = chromium();
+    if bin.is_none() {
         assert!(
             std::env::var_os("CI").is_none(),
             "chromium is not installed, but CI is set: tools/setup.sh installs it"
         );
         eprintln!(
-            "SKIPPED results_page_works_in_headless_chromium: chromium is not installed \
-             (apt install chromium, or run tools/setup.sh)"
+            "SKIPPED {test}: chromium is not installed (apt install chromium, or run \
+             tools/setup.sh)"
         );
+    }
+    bin
+}
+
+#[test]
+fn results_page_works_in_headless_chromium() {
+    let Some(bin) = chromium_or_skip("results_page_works_in_headless_chromium") else {
         return;
     };
     let out = out_dir("page");
     eval(&out, 4, 16);
     let url = |hash: &str| format!("file://{}#{hash}", out.join("index.html").display());
 
-    // Without a hash: frame 0, the last method against the reference, side by side.
+    // Without a hash: the last frame, the last method against the reference, side by
+    // side.
     let dom = run_chromium(&bin, &["--dump-dom".into(), url("")]);
     assert_eq!(
         attr(&dom, "<body", "data-ready"),
         "1",
         "the page script ran"
     );
-    assert_eq!(attr(&dom, "<body", "data-frame"), "0");
+    assert_eq!(attr(&dom, "<body", "data-frame"), "3");
     assert_eq!(
         attr(&dom, "id=\"img-a\"", "src"),
-        "cloud_orbit/accum/0000.png"
+        "cloud_orbit/accum/0003.png"
     );
     assert_eq!(
         attr(&dom, "id=\"img-b\"", "src"),
-        "cloud_orbit/reference/0000.png"
+        "cloud_orbit/reference/0003.png"
     );
 
     // The hash drives the controls through their own handlers: the frame slider to
@@ -391,15 +423,9 @@ fn results_page_works_in_headless_chromium() {
     );
     assert!(attr(&dom, "id=\"wipe-a\"", "style").contains("inset(0px 75% 0px 0px)"));
     assert!(dom.contains("<title>dvr eval — cloud/orbit — none vs accum — frame 2</title>"));
-    // Every image the page shows loaded: 4 frames (side and wipe), 5 scene plots and
-    // the overall chart.
-    assert_eq!(
-        attr(&dom, "<body", "data-failed"),
-        "0",
-        "{}",
-        attr(&dom, "<body", "data-failed-srcs")
-    );
-    assert_eq!(attr(&dom, "<body", "data-pending"), "0");
+    // Every image the page shows loaded: 4 frames (side and wipe), the grid's 3 (the
+    // reference and both methods) and 5 scene plots.
+    assert_all_images_loaded(&dom);
     let loaded: usize = attr(&dom, "<body", "data-loaded").parse().unwrap();
     assert!(loaded >= 10, "only {loaded} images loaded");
     assert!(dom.contains("cloud_orbit/plots/speed_accuracy.svg"));
@@ -414,4 +440,106 @@ fn results_page_works_in_headless_chromium() {
         ],
     );
     assert_eq!(png_size(&shot), (1280, 1800));
+}
+
+#[test]
+fn scene_files_are_labelled_by_their_name_and_never_share_a_folder() {
+    let out = out_dir("names");
+    let files = out.with_file_name("names-scenes");
+    if files.exists() {
+        std::fs::remove_dir_all(&files).unwrap();
+    }
+    // Two files with the same stem in different folders, neither with a `name`.
+    let scene = "[volume]\nbuiltin = \"cloud\"\nsize = 16\n[transfer]\na = \"cloud\"\n\
+                 [[light]]\nkind = \"point\"\nposition = [1.0, 1.0, 1.0]\nintensity = 4.0\n";
+    let a = files.join("some/dir/my-scene.toml");
+    let b = files.join("other/my-scene.toml");
+    for p in [&a, &b] {
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, scene).unwrap();
+    }
+    let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
+        .args(["eval", "--scene"])
+        .arg(format!("{},{}", a.display(), b.display()))
+        .args([
+            "--frames",
+            "2",
+            "--size",
+            "16x16",
+            "--spp",
+            "1",
+            "--ref-spp",
+            "4",
+        ])
+        .args(["--denoiser", "none", "--volume-size", "16", "--out"])
+        .arg(&out)
+        .output()
+        .expect("running dvr");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary = read(&out.join("summary.csv"));
+    let scenes: Vec<&str> = summary
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert_eq!(scenes, ["my-scene", "my-scene-2"], "{summary}");
+    for dir in ["my-scene", "my-scene-2"] {
+        assert!(out.join(dir).join("reference/0001.png").is_file(), "{dir}");
+    }
+    let page = read(&out.join("index.html"));
+    assert!(page.contains("\"name\":\"my-scene\"") && !page.contains("some/dir"));
+}
+
+#[test]
+fn main_job_page_shows_the_reference_and_a_row_per_method() {
+    let Some(bin) = chromium_or_skip("main_job_page_shows_the_reference_and_a_row_per_method")
+    else {
+        return;
+    };
+    // `dvr demo` as tools/run.sh runs it, at a test's size.
+    let out = out_dir("demo");
+    let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
+        .args(["demo", "--size", "32x32", "--frames", "3", "--ref-spp", "8"])
+        .args(["--volume-size", "32", "--out"])
+        .arg(&out)
+        .output()
+        .expect("running dvr demo");
+    assert!(o.status.success(), "dvr demo failed:\n{}", stderr(&o));
+    assert_log_progress(&stderr(&o));
+    let methods = ["none", "taa", "svgf", "ours", "rae"];
+
+    let url = format!("file://{}", out.join("index.html").display());
+    let dom = run_chromium(&bin, &["--dump-dom".into(), url]);
+    assert_eq!(attr(&dom, "<body", "data-ready"), "1");
+    // The reference and every method at the last frame, all loaded.
+    assert_eq!(
+        attr(&dom, "id=\"grid-reference\"", "src"),
+        "phantom_orbit/reference/0002.png"
+    );
+    for m in methods {
+        let src = attr(&dom, &format!("id=\"grid-{m}\""), "src");
+        assert_eq!(src, format!("phantom_orbit/{m}/0002.png"));
+    }
+    assert_all_images_loaded(&dom);
+    // One metrics row per method, in the order they ran.
+    let start = dom.find("id=\"scene-table\"").expect("the metrics table");
+    let table = &dom[start..start + dom[start..].find("</table>").unwrap()];
+    let rows: Vec<&str> = table
+        .match_indices("<tr data-method=\"")
+        .map(|(i, m)| {
+            let v = &table[i + m.len()..];
+            &v[..v.find('"').unwrap()]
+        })
+        .collect();
+    assert_eq!(rows, methods, "metrics rows");
+    assert!(
+        dom.contains("The main job (tools/run.sh)"),
+        "the page says what ran"
+    );
+    if std::env::var_os("PATH")
+        .is_some_and(|p| std::env::split_paths(&p).any(|d| d.join("ffmpeg").is_file()))
+    {
+        assert!(out.join("phantom_orbit/videos/comparison.mp4").is_file());
+        assert!(dom.contains("phantom_orbit/videos/comparison.mp4"));
+    }
 }

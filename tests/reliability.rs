@@ -133,6 +133,9 @@ fn usage_errors_exit_2_and_leave_nothing_behind() {
         &["capture", "--spp", "0"],
         &["capture", "--frames", "0"],
         &["eval", "--ref-spp", "0"],
+        &["demo", "--ref-spp", "0"],
+        &["bench", "--ref-spp", "0"],
+        &["bench", "--frames", "0"],
         &["nonsense"],
     ] {
         let o = dvr(args);

@@ -159,3 +159,52 @@ fn a_volume_too_large_for_the_device_is_refused_before_allocation() {
         .to_string();
     assert!(err.contains("dimension"), "message: {err}");
 }
+
+#[test]
+fn a_timed_pass_reports_the_bytes_of_what_it_declares() {
+    use dvr_engine::gpu::timestamps::TimestampPool;
+    let ctx = context();
+    let mut graph = RenderGraph::new(&ctx).expect("graph");
+    let mut acc = Accumulate::new(&ctx).expect("pipeline");
+    let mut timestamps = TimestampPool::new(&ctx).expect("timestamps");
+    let input = graph
+        .image(
+            &ctx,
+            "input",
+            ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT),
+        )
+        .expect("image");
+    let size = Extent {
+        width: W,
+        height: H,
+    };
+    let mut f = Frame::new();
+    acc.add(&ctx, &mut graph, &mut f, "acc", input, 1.0, size)
+        .expect("add");
+    ctx.submit_and_wait(|cmd| {
+        timestamps.reset(&ctx, cmd);
+        graph.execute(&ctx, cmd, Some(&mut timestamps), f)
+    })
+    .expect("submit");
+    let timings = timestamps.read(&ctx).expect("timings");
+    // `accumulate` declares four rgba32f images of W×H: the input and last frame's sum
+    // read, this frame's sum and the mean written.
+    let image_bytes = u64::from(W * H) * 16;
+    assert_eq!(timings.len(), 1);
+    assert_eq!(timings[0].pass, "acc");
+    assert_eq!(timings[0].bytes, 4 * image_bytes);
+    assert!(timings[0].ms >= 0.0);
+    timestamps.destroy(&ctx);
+    acc.destroy(&ctx);
+    graph.destroy(&ctx);
+    assert_validation_clean();
+}
+
+#[test]
+fn peak_bandwidth_is_measured_with_a_copy_pass() {
+    let ctx = context();
+    let peak = dvr_engine::passes::bandwidth::measure(&ctx).expect("probe");
+    assert!(peak.gb_per_s > 0.0 && peak.gb_per_s.is_finite(), "{peak:?}");
+    assert!(peak.method.contains("measured"), "{peak:?}");
+    assert_validation_clean();
+}

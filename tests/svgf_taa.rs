@@ -111,7 +111,8 @@ impl Harness {
     fn new(name: &str) -> Self {
         let ctx = context();
         let graph = RenderGraph::new(&ctx).expect("graph");
-        let denoiser = denoise::create(&ctx, name, Default::default(), None).expect("denoiser");
+        let denoiser = denoise::create(&ctx, name, Default::default(), None, Default::default())
+            .expect("denoiser");
         Self {
             ctx,
             graph,
@@ -225,6 +226,7 @@ impl Harness {
             camera: Vec3::new(0.5, 0.5, 0.0),
             spp: 2,
             changes: Changes::default(),
+            retrace: None,
         };
         let out = self
             .denoiser

@@ -2,16 +2,17 @@
 # Installs what dvr needs on a fresh Debian 12 machine: the Vulkan loader, Mesa's
 # lavapipe (CPU Vulkan), the validation layers, glslang/shaderc/SPIRV-Tools (static
 # archives that build.rs links), Xvfb for window tests, a TrueType font for the plots of
-# `dvr eval` (fonts-dejavu-core) and Chromium, in which a test opens the eval's results
-# page headless. Idempotent: it installs only what is missing, so the README's commands
-# can call it every time.
+# `dvr eval` (fonts-dejavu-core), Chromium, in which a test opens the eval's results
+# page headless, and ffmpeg, which encodes the videos of `--video` and the main job.
+# Idempotent: it installs only what is missing, so the README's commands can call it
+# every time.
 set -euo pipefail
 
 packages=(
   mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers vulkan-tools
   libshaderc-dev glslang-dev glslang-tools spirv-tools
   pkg-config cmake
-  fonts-dejavu-core chromium
+  fonts-dejavu-core chromium ffmpeg
   xvfb libx11-xcb1 libxcursor1 libxi6 libxrandr2 libxkbcommon-x11-0
 )
 

@@ -1,8 +1,9 @@
 #version 460
 // Motion vectors to the previous frame, in pixels: where this pixel's surface was last
 // frame, from the closest first real collision (xy, the paper's choice) and from the
-// deterministic opacity-threshold position (zw). Pixels whose ray hit nothing use a point
-// far along the view ray, so camera rotation still moves the background correctly.
+// deterministic opacity-threshold position (zw; the collision where the threshold is never
+// reached). Pixels whose ray hit nothing use a point far along the view ray, so camera
+// rotation still moves the background correctly.
 #include "common.glsl"
 #include "frame.glsl"
 
@@ -46,7 +47,10 @@ void main() {
     vec4 hit = imageLoad(first_hit, ivec2(pixel));
     vec4 feat = imageLoad(feature_position, ivec2(pixel));
     vec3 p_hit = hit.w > 0.0 ? hit.xyz : far_point(centre);
-    vec3 p_feat = feat.w > 0.0 ? feat.xyz : far_point(centre);
+    // A ray through a thin semi-transparent fringe collides without ever reaching the
+    // features' opacity threshold: its content moves with the volume (the collision),
+    // not with the background, or the history drags the fringe out into a halo.
+    vec3 p_feat = feat.w > 0.0 ? feat.xyz : p_hit;
     vec2 m_hit = point_motion(p_hit);
     vec2 m_feat = point_motion(p_feat);
     imageStore(motion, ivec2(pixel), vec4(m_hit, m_feat));

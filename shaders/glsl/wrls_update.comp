@@ -7,6 +7,7 @@
 #include "common.glsl"
 #include "reproject.glsl"
 #include "wrls.glsl"
+#include "wrls_change.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -31,6 +32,14 @@ layout(binding = 16) uniform sampler2D constant_prev;
 layout(binding = 17) uniform sampler2D errors_prev;
 layout(binding = 18, rgba32f) uniform writeonly image2D constant_cur;
 layout(binding = 19, rgba32f) uniform writeonly image2D errors_cur;
+// This pixel's prediction after the update (rgb) and its variance per channel (a), what
+// the à-trous spatial filter (wrls_atrous.comp) starts from.
+layout(binding = 25, rgba32f) uniform writeonly image2D prediction;
+// Lag detection pooled over a neighbourhood (DRIFT): this frame's a-posteriori residual
+// per pixel (rgb; a its variance, negative where there is no history), which
+// wrls_drift.comp pools into last frame's drift estimate read back here.
+layout(binding = 26, rgba32f) uniform writeonly image2D residual;
+layout(binding = 27) uniform sampler2D drift_prev;
 
 layout(push_constant) uniform WrlsUpdatePush {
     vec4 camera;          // xyz camera position
@@ -44,8 +53,16 @@ layout(push_constant) uniform WrlsUpdatePush {
     float tolerance;      // disocclusion tolerance, relative to camera distance
     float change_ratio;   // residual / noise-level ratio that counts as a change
     float outlier_sigmas; // residual weights: k in exp(-r²/(k²·noise level))
+    uint gradient_valid;  // the gradient images were measured this frame
+    uint drift_valid;     // drift_prev holds last frame's pooled residuals
+    uint stratum;         // their stratum edge in pixels
+    float lambda_min;     // forgetting factor at a sudden change
+    float change_gain;    // relative change at which the history is forgotten: 1/gain
+    float shrink;         // squared standard errors of the gradient ratio that halve it
+    float drift_z;        // pooled residual, in standard errors, that starts to count
     float pad0;
     float pad1;
+    float pad2;
 } pc;
 
 const float P_MAX = 1e6;
@@ -80,21 +97,44 @@ void main() {
     float streak = 0.0;        // consecutive frames far above the noise level
     vec4 constant = vec4(0.0, 0.0, 0.0, pc.delta);
     vec3 errors = vec3(-1.0, -1.0, 0.0);  // a-priori errors (const, feature), const streak
+    SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink);
+    // Forgetting in proportion to the measured change: a still scene keeps λ, a sudden
+    // change falls to λ_min (what the scaling below did not explain is learned anew).
+    float lambda = mix(pc.lambda_min, pc.lambda, 1.0 - min(1.0, pc.change_gain * sc.change));
     if (r.valid) {
-        vec4 zq = texture(z_prev, r.uv);
-        z_hist = clamp(zq.rgb, lo, hi);
+        vec4 zq = history_fetch(z_prev, r);
+        z_hist = clamp(zq.rgb * sc.ratio, lo, hi);
         z = pc.alpha * z_hist + (1.0 - pc.alpha) * I;
         age = zq.w + 1.0;
-        beta[0] = texture(beta_r_prev, r.uv);
-        beta[1] = texture(beta_g_prev, r.uv);
-        beta[2] = texture(beta_b_prev, r.uv);
-        vec4 p2 = texture(p2_prev, r.uv);
-        P = unpack_p(texture(p0_prev, r.uv), texture(p1_prev, r.uv), p2);
+        beta[0] = history_fetch(beta_r_prev, r);
+        beta[1] = history_fetch(beta_g_prev, r);
+        beta[2] = history_fetch(beta_b_prev, r);
+        vec4 p2 = history_fetch(p2_prev, r);
+        P = unpack_p(history_fetch(p0_prev, r), history_fetch(p1_prev, r), p2);
         noise_level = p2.z;
         streak = p2.w;
         if (MODEL_SELECTION) {
-            constant = texture(constant_prev, r.uv);
-            errors = texture(errors_prev, r.uv).xyz;
+            constant = history_fetch(constant_prev, r);
+            errors = history_fetch(errors_prev, r).xyz;
+        }
+        // The scene changed: scale every model's prediction by the measured ratio (the
+        // feature's coefficients by the ratio of output to input channel, since the
+        // feature is scaled too), so the models follow the change instead of lagging.
+        for (int c = 0; c < 3; ++c) {
+            beta[c].x *= sc.ratio[c];
+            beta[c].yzw *= sc.ratio[c] / sc.ratio;
+        }
+        constant.rgb *= sc.ratio;
+        float ratio2 = dot(sc.ratio, vec3(1.0 / 3.0));
+        noise_level *= ratio2 * ratio2;
+        // Lag the pooled residuals revealed last frame: what the neighbourhood's models
+        // still miss on average, once it is clearly more than noise, is added to the
+        // constant term (a drift too slow for one pixel's change test, a view-dependent
+        // change under camera motion, a change the gradients did not see).
+        if (pc.drift_valid != 0u) {
+            vec3 d = significant_drift(history_fetch(drift_prev, r), pc.drift_z);
+            for (int c = 0; c < 3; ++c) beta[c].x += d[c];
+            constant.rgb += d;
         }
     } else {
         // A new surface: start the models over.
@@ -179,15 +219,21 @@ void main() {
             streak_c = 0.0;
         }
         errors.z = streak_c;
-        float qc = constant.a / (pc.lambda / wc + constant.a);
+        float qc = constant.a / (lambda / wc + constant.a);
         constant.rgb += qc * ec;
-        constant.a = clamp((constant.a - qc * constant.a) / pc.lambda, 1e-8, P_MAX);
+        constant.a = clamp((constant.a - qc * constant.a) / lambda, 1e-8, P_MAX);
         if (!all_finite(constant.rgb) || isnan(constant.a)) constant = vec4(I, pc.delta);
     }
     vec4 Px = P * x;
-    vec4 q = Px / (pc.lambda / w + dot(x, Px));
+    vec4 q = Px / (lambda / w + dot(x, Px));
     for (int c = 0; c < 3; ++c) beta[c] += q * e[c];
-    P = (P - outerProduct(q, Px)) / pc.lambda;
+    // The a-posteriori residual (what this frame's update left unexplained) and its
+    // variance, for the pooled lag test; fresh models have none.
+    float keep = 1.0 - dot(x, q);
+    imageStore(residual, p, r.valid && !fresh
+        ? vec4(keep * e, max(noise_level, 0.0) / 3.0 * keep * keep)
+        : vec4(0.0, 0.0, 0.0, -1.0));
+    P = (P - outerProduct(q, Px)) / lambda;
     // fp32 hygiene: keep P symmetric with a positive, bounded diagonal (wind-up guard
     // for predictors that stop exciting some direction on long static runs).
     P = 0.5 * (P + transpose(P));
@@ -203,6 +249,21 @@ void main() {
         beta[2] = vec4(I.b, 0, 0, 0);
         P = mat4(pc.delta);
     }
+    // The prediction of this frame's radiance by the updated models, and its variance:
+    // the residual noise per channel times xᵀPx (P00 for the constant model).
+    vec3 pred = vec3(dot(x, beta[0]), dot(x, beta[1]), dot(x, beta[2]));
+    float var = max(noise_level, 0.0) / 3.0 * max(dot(x, P * x), 0.0);
+    if (MODEL_SELECTION) {
+        float share = feature_share(errors.xy);
+        pred = mix(constant.rgb, pred, share);
+        var = mix(max(noise_level, 0.0) / 3.0 * constant.a, var, share);
+    }
+    if (!all_finite(pred) || isnan(var) || isinf(var)) {
+        pred = I;
+        var = max(noise_level, 0.0) / 3.0;
+    }
+    imageStore(prediction, p, vec4(max(pred, vec3(0.0)), var));
+
     vec4 a, b, c;
     pack_p(P, a, b, c);
     c.z = noise_level;

@@ -3,19 +3,19 @@
 //! path-trace time per sample of the evaluated frames times n, so it sits on the same
 //! axis as the denoisers (which pay path tracing at `--spp` plus their own passes).
 
-use super::progress::Progress;
+use super::overlap::Overlap;
 use super::reference::ReferenceCache;
 use super::score::{score, FrameReference};
+use super::timing::Timing;
+use crate::progress::Progress;
 use crate::setup::Setup;
 use anyhow::Result;
 use dvr_engine::image_io::to_rgb;
 use dvr_engine::renderer::Renderer;
+use std::sync::Arc;
 
 /// Largest sample count of the baseline curve.
 pub const MAX_SPP: u32 = 256;
-
-/// Samples per submission while accumulating.
-const BATCH: u32 = 32;
 
 /// Seed offset of the baseline's sample stream, so it is independent of the
 /// references' (which would otherwise share its first n samples and flatter it).
@@ -54,6 +54,7 @@ pub fn units(frame_count: u32, ref_spp: u32) -> f64 {
 
 /// Measures the curve with `renderer` (after the evaluated frames: it changes the
 /// renderer's seed).
+#[allow(clippy::too_many_arguments)]
 pub fn measure(
     renderer: &mut Renderer,
     setup: &Setup,
@@ -62,31 +63,37 @@ pub fn measure(
     ref_spp: u32,
     progress: &mut Progress,
     label: &str,
+    timing: &Arc<Timing>,
 ) -> Result<Vec<BaselinePoint>> {
     renderer.settings.seed = renderer.settings.seed.wrapping_add(SEED_OFFSET);
-    let mut points = Vec::new();
+    // Each level is scored on the pool while the GPU renders the next.
+    let mut jobs = Overlap::new(timing);
+    let (w, h) = (setup.width(), setup.height());
     for f in frames(setup.frames) {
-        let reference = FrameReference::new(&references.load(f)?);
+        let hdr = references.load(f)?;
+        let reference = Arc::new(timing.metrics.time(|| FrameReference::new(&hdr)));
         for n in levels(ref_spp) {
-            let pixels = renderer.reference(&setup.inputs(f), n, BATCH)?;
-            let s = score(
-                &reference,
-                &to_rgb(setup.width(), setup.height(), &pixels),
-                None,
-            );
-            points.push(BaselinePoint {
-                frame: f,
-                spp: n,
-                gpu_ms: path_trace_ms_per_spp * f64::from(n),
-                psnr: s.psnr,
-            });
+            let batch = renderer.samples_per_dispatch();
+            let pixels = renderer.reference(&setup.inputs(f), n, batch)?;
+            let (reference, job_timing) = (Arc::clone(&reference), Arc::clone(timing));
+            jobs.spawn(move || {
+                let s = job_timing
+                    .metrics
+                    .time(|| score(&reference, &to_rgb(w, h, &pixels), None));
+                Ok(BaselinePoint {
+                    frame: f,
+                    spp: n,
+                    gpu_ms: path_trace_ms_per_spp * f64::from(n),
+                    psnr: s.psnr,
+                })
+            })?;
             progress.advance(
                 f64::from(n),
                 &format!("{label} | baseline frame {f}, {n} spp"),
             );
         }
     }
-    Ok(points)
+    jobs.finish()
 }
 
 /// The curve averaged over the measured frames: (spp, mean GPU ms, mean PSNR).

@@ -108,6 +108,9 @@ pub fn page_data(info: &PageInfo, results: &[SceneResult], overall: &[Overall]) 
     json!({
         "device": info.device,
         "seconds": info.seconds,
+        "note": info.args.note,
+        "video": info.args.video.video,
+        "video_fps": info.args.video.video_fps,
         "settings": {
             "width": width,
             "height": height,

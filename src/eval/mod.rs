@@ -24,20 +24,25 @@
 //!
 //! One file per responsibility: [`scenes`] (which scenes, folder names, the event frame),
 //! [`reference`] (the cache), [`run`] (the frame loop), [`score`] (metrics of one frame),
-//! [`baseline`], [`csv`], [`plots`], [`html`], [`progress`].
+//! [`baseline`], [`csv`], [`plots`], [`html`]; progress lines come from
+//! [`crate::progress`].
 
 mod baseline;
 mod csv;
 mod html;
 mod images;
-mod plots;
-mod progress;
+mod overlap;
+pub mod plots;
 pub(crate) mod reference;
-mod run;
+pub mod run;
 mod scenes;
 mod score;
+pub mod timing;
+mod videos;
 
-use anyhow::{bail, Context, Result};
+pub use plots::init_font;
+
+use anyhow::{Context, Result};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -60,7 +65,7 @@ pub struct EvalArgs {
     #[arg(long, default_value = "suite")]
     pub scene: String,
     /// Frames of each animation (default: each scene's own length).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = crate::setup::parse_frames)]
     pub frames: Option<u32>,
     /// Samples per pixel per frame of the noisy input (default: the scene's, 2 for
     /// built-ins).
@@ -86,46 +91,47 @@ pub struct EvalArgs {
     /// for `dvr capture`; references do not depend on it).
     #[arg(long, default_value = "features", value_parser = crate::setup::parse_motion)]
     pub motion: dvr_engine::denoise::MotionSource,
+    #[command(flatten)]
+    pub video: crate::video::VideoArgs,
+    /// A paragraph shown at the top of the results page (what was run, and why).
+    #[arg(long)]
+    pub note: Option<String>,
 }
 
-pub fn eval(args: &EvalArgs) -> Result<()> {
+/// Runs the eval; returns where its time went.
+pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     let started = Instant::now();
-    let mut methods: Vec<String> = Vec::new();
-    for d in &args.denoiser {
-        let d = d.trim();
-        if d.is_empty() || methods.iter().any(|m| m == d) {
-            continue;
-        }
-        if !dvr_engine::denoise::NAMES.contains(&d) {
-            bail!(
-                "unknown denoiser {d:?}; available: {}",
-                dvr_engine::denoise::NAMES.join(", ")
-            );
-        }
-        methods.push(d.to_string());
-    }
-    if methods.is_empty() {
-        bail!("--denoiser names no method");
-    }
-    // Fail before hours of rendering, not after: the plots need a font.
+    let methods = crate::setup::denoiser_list(&args.denoiser)?;
+    // Fail before hours of rendering, not after: the plots need a font, videos ffmpeg.
     plots::init_font()?;
+    if args.video.video {
+        crate::video::require_ffmpeg()?;
+    }
     let names = scenes::select(&args.scene)?;
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    crate::setup::create_out_dir(&args.out)?;
     let plan = run::Plan::new(args, &names, &methods)?;
-    let mut progress = progress::Progress::new(plan.total_units());
+    let mut progress = crate::progress::Progress::new(plan.total_units());
+    let timing = timing::Timing::shared();
     let mut results = Vec::new();
     let mut device = String::new();
     for (i, scene) in plan.scenes.iter().enumerate() {
         let label = format!("[{}/{}] {}", i + 1, plan.scenes.len(), scene.name);
-        let r = run::evaluate_scene(args, &methods, scene, &label, &mut progress)
+        let r = run::evaluate_scene(args, &methods, scene, &label, &mut progress, &timing)
             .with_context(|| format!("evaluating {}", scene.name))?;
         device.clone_from(&r.device);
-        plots::scene_plots(&args.out, &r)?;
-        results.push(r);
-        // Everything is rewritten after each scene, so an interrupted eval leaves a
-        // consistent report of the scenes it finished.
-        write_reports(args, &methods, &results, &device, started)?;
+        timing.reports.time(|| -> Result<()> {
+            plots::scene_plots(&args.out, &r)?;
+            if args.video.video {
+                progress.newline();
+                let dir = crate::video::dir(&args.out.join(&r.dir));
+                eprintln!("{label}: writing videos to {}", dir.display());
+                videos::write_scene_videos(&args.out, &r, args.video.video_fps)?;
+            }
+            results.push(r);
+            // Everything is rewritten after each scene, so an interrupted eval leaves a
+            // consistent report of the scenes it finished.
+            write_reports(args, &methods, &results, &device, started)
+        })?;
     }
     progress.finish();
     let overall = csv::overall_summary(&results, &methods);
@@ -137,7 +143,9 @@ pub fn eval(args: &EvalArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         args.out.join("index.html").display()
     );
-    Ok(())
+    let wall = started.elapsed();
+    eprintln!("{}", timing.summary(wall));
+    Ok(timing.outcome(wall))
 }
 
 fn write_reports(

@@ -103,7 +103,7 @@ pub fn colour_hex(c: RGBColor) -> String {
 }
 
 /// Something that can draw itself on any plotters backend.
-trait Chart {
+pub(crate) trait Chart {
     fn draw<DB: DrawingBackend>(
         &self,
         root: &DrawingArea<DB, Shift>,
@@ -111,7 +111,7 @@ trait Chart {
 }
 
 /// Writes `chart` as `<stem>.svg` and `<stem>.png`.
-fn save(chart: &impl Chart, stem: &Path) -> Result<()> {
+pub(crate) fn save(chart: &impl Chart, stem: &Path) -> Result<()> {
     if let Some(dir) = stem.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }

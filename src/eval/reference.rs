@@ -19,9 +19,6 @@ use dvr_engine::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// Samples per reference batch (one submission).
-const BATCH: u32 = 32;
-
 /// What a reference frame depends on. Written before the first frame is rendered, so
 /// frames finished under it are reusable after an interruption.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -152,6 +149,7 @@ pub fn frame_name(f: u32) -> String {
 }
 
 /// One reference folder.
+#[derive(Clone, Debug)]
 pub struct ReferenceCache {
     pub dir: PathBuf,
     key: ReferenceKey,
@@ -313,19 +311,22 @@ impl ReferenceCache {
         Ok(note)
     }
 
-    /// Renders frame `f` (see [`ReferenceCache::store`]).
+    /// Renders frame `f` in as few dispatches as the device takes (one per frame on a
+    /// GPU at 256x256; lavapipe's loop limiter needs 4-sample ones).
     pub fn render(
         &self,
         setup: &Setup,
         renderer: &mut dvr_engine::renderer::Renderer,
         f: u32,
     ) -> Result<Rgb32Image> {
-        let pixels = renderer.reference(&setup.inputs(f), self.key.ref_spp, BATCH)?;
+        let batch = renderer.samples_per_dispatch();
+        let pixels = renderer.reference(&setup.inputs(f), self.key.ref_spp, batch)?;
         Ok(to_rgb(setup.width(), setup.height(), &pixels))
     }
 
     /// Writes frame `f`'s files, each whole or not at all (temporary name, fsync,
-    /// rename): PNG, then the EXR that [`ReferenceCache::load`] reads.
+    /// rename): PNG, then the EXR that [`ReferenceCache::load`] reads. `dvr eval` calls
+    /// it on a worker thread while the next frame renders.
     pub fn store(&self, f: u32, img: &Rgb32Image) -> Result<()> {
         let (png, exr) = (self.png(f), self.exr(f));
         write_file(&png, &encode_png(&png, img)?, Durability::Synced)?;
@@ -382,19 +383,29 @@ impl ReferenceCache {
         report.rendered(0, state.missing.len());
         for (i, &f) in state.missing.iter().enumerate() {
             let img = self.render(setup, &mut renderer, f)?;
-            self.store(f, &img)?;
+            report.store(self, f, img)?;
             report.rendered(i + 1, state.missing.len());
         }
-        Ok(())
+        report.finished(&renderer)
     }
 }
 
-/// How [`ReferenceCache::fill`] tells the user what it does.
+/// How [`ReferenceCache::fill`] tells the user what it does, and how it writes frames.
 pub trait FillReport {
     /// A line for the log (`None`: only end a progress line, a warning follows).
     fn note(&mut self, text: Option<&str>);
     /// `done` of `of` frames rendered.
     fn rendered(&mut self, done: usize, of: usize);
+    /// Writes rendered frame `f` through [`ReferenceCache::store`]: here at once;
+    /// `dvr eval` hands it to a worker thread while the next frame renders.
+    fn store(&mut self, cache: &ReferenceCache, f: u32, img: Rgb32Image) -> Result<()> {
+        cache.store(f, &img)
+    }
+    /// Every missing frame has been rendered by `renderer` (and handed to
+    /// [`FillReport::store`]): wait for writes still running, count GPU time.
+    fn finished(&mut self, _renderer: &dvr_engine::renderer::Renderer) -> Result<()> {
+        Ok(())
+    }
 }
 
 #[cfg(test)]

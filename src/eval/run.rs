@@ -4,10 +4,12 @@
 
 use super::baseline::{self, BaselinePoint};
 use super::images::{write_display_png, write_flip_png};
-use super::progress::Progress;
+use super::overlap::Overlap;
 use super::reference::{frame_name, FillReport, ReferenceCache, ReferenceKey};
-use super::score::{score, FrameReference};
+use super::score::{self, score, FrameReference};
+use super::timing::Timing;
 use super::{scenes, EvalArgs, GPU_WARMUP_FRAMES};
+use crate::progress::Progress;
 use crate::setup::Setup;
 use crate::SceneArgs;
 use anyhow::{Context, Result};
@@ -15,9 +17,9 @@ use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::image_io::{to_rgb, write_exr};
 use dvr_engine::metrics::Rgb32Image;
 use dvr_engine::renderer::{FrameRequest, FrameResult};
-use dvr_engine::scene::Scene;
-use std::collections::HashMap;
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The method whose frames are also kept as EXR: the noisy input, for external
 /// denoisers (`tools/oidn_eval.py`).
@@ -29,6 +31,11 @@ const UNCOUNTED_PREFIXES: [&str; 3] = ["upload_", "readback_", "host_read_"];
 
 /// One scene as planned before anything renders.
 pub struct PlannedScene {
+    /// What `--scene` named: a built-in name or a scene file's path (opened again for
+    /// rendering).
+    pub spec: String,
+    /// The label in tables, plots and the page: the scene's `name` (a file's own name or
+    /// its file stem, `dvr scenes`' name for a built-in), made unique within the eval.
     pub name: String,
     pub dir: PathBuf,
     pub frames: u32,
@@ -44,18 +51,23 @@ pub struct Plan {
 
 impl Plan {
     pub fn new(args: &EvalArgs, names: &[String], methods: &[String]) -> Result<Self> {
-        let mut scenes = Vec::new();
-        for name in names {
-            let mut scene = Scene::open(name).with_context(|| {
-                format!("opening scene {name:?} (built-in scenes: `dvr scenes`)")
-            })?;
+        let mut opened = Vec::new();
+        for spec in names {
+            let mut scene = crate::setup::open_scene(spec)?;
             if let Some(n) = args.frames {
                 scene = scene.with_frames(n)?;
             }
-            let dir = args.out.join(scenes::dir_name(name));
+            opened.push((spec, scene));
+        }
+        let labels: Vec<String> = opened.iter().map(|(_, s)| s.name.clone()).collect();
+        let mut scenes = Vec::new();
+        for ((spec, scene), (label, dir)) in opened.into_iter().zip(scenes::unique_labels(&labels))
+        {
+            let dir = args.out.join(dir);
             let key = ReferenceKey::new(&scene, args.size, args.ref_spp, args.volume_size)?;
             scenes.push(PlannedScene {
-                name: name.clone(),
+                spec: spec.clone(),
+                name: label,
                 frames: scene.frames,
                 spp: args.spp.unwrap_or(scene.render.spp),
                 references: ReferenceCache::new(&dir, key),
@@ -120,12 +132,19 @@ impl SceneResult {
     }
 }
 
+/// Whether `pass` is one of `method`'s own passes (named `<method>` or
+/// `<method>.<step>`).
+pub fn owned_by(pass: &str, method: &str) -> bool {
+    pass == method
+        || pass
+            .strip_prefix(method)
+            .is_some_and(|r| r.starts_with('.'))
+}
+
 /// GPU time of `method` in one frame: every pass no method owns (surface features,
 /// path trace, motion, …) plus the method's own passes, which are named after it
 /// (`accum`, `ours.update`, `ours.spatial`; `none` has none).
 pub fn method_gpu_ms(timings: &[PassTiming], method: &str, methods: &[String]) -> f64 {
-    let owned_by =
-        |pass: &str, m: &str| pass == m || pass.strip_prefix(m).is_some_and(|r| r.starts_with('.'));
     timings
         .iter()
         .filter(|t| !UNCOUNTED_PREFIXES.iter().any(|p| t.pass.starts_with(p)))
@@ -156,59 +175,114 @@ fn path_trace_ms_per_spp(timings: &[Vec<PassTiming>], spp: u32) -> f64 {
     ms.iter().sum::<f64>() / ms.len() as f64 / f64::from(spp.max(1))
 }
 
+/// A finished frame's outputs, (method, rgba pixels) in the renderer's order, shared
+/// with the scoring jobs.
+type Images = Arc<Vec<(String, Vec<[f32; 4]>)>>;
+
+/// The scoring of one finished frame, run on the thread pool: every method against the
+/// frame's reference (methods in parallel), its PNGs (and the noisy EXR) written.
+struct ScoreJob {
+    scene: String,
+    dir: PathBuf,
+    frame: u32,
+    size: (u32, u32),
+    images: Images,
+    /// GPU ms of each method, in the order of `images`.
+    gpu_ms: Vec<f64>,
+    reference: Arc<Rgb32Image>,
+    /// The previous frame's outputs and reference (temporal error), if any.
+    previous: Option<(Images, Arc<Rgb32Image>)>,
+    timing: Arc<Timing>,
+}
+
+impl ScoreJob {
+    fn run(self) -> Result<Vec<MetricRow>> {
+        let (w, h) = self.size;
+        let (reference, previous_reference) = self.timing.metrics.time(|| {
+            let previous = self.previous.as_ref().map(|(_, r)| score::display(r));
+            (FrameReference::new(&self.reference), previous)
+        });
+        self.images
+            .par_iter()
+            .zip(&self.gpu_ms)
+            .map(|((method, pixels), &gpu_ms)| {
+                let hdr = to_rgb(w, h, pixels);
+                let s = self.timing.metrics.time(|| {
+                    // The method's previous frame as displayed, tone-mapped again: the
+                    // same values the previous job scored with.
+                    let previous = self
+                        .previous
+                        .as_ref()
+                        .and_then(|(images, _)| images.iter().find(|(m, _)| m == method))
+                        .map(|(_, p)| score::display(&to_rgb(w, h, p)));
+                    score(
+                        &reference,
+                        &hdr,
+                        previous.as_ref().zip(previous_reference.as_ref()),
+                    )
+                });
+                let dir = self.dir.join(method);
+                let f = self.frame;
+                write_display_png(&dir.join(format!("{}.png", frame_name(f))), &s.display)?;
+                write_flip_png(
+                    &dir.join(format!("flip_{}.png", frame_name(f))),
+                    w,
+                    h,
+                    &s.flip_map,
+                )?;
+                if method == NOISY_METHOD {
+                    write_exr(&dir.join(format!("{}.exr", frame_name(f))), &hdr)?;
+                }
+                Ok(MetricRow {
+                    scene: self.scene.clone(),
+                    method: method.clone(),
+                    frame: f,
+                    psnr: s.psnr,
+                    ssim: s.ssim,
+                    flip: s.flip,
+                    temporal_error: s.temporal_error,
+                    gpu_ms,
+                })
+            })
+            .collect()
+    }
+}
+
 /// What the frame loop keeps between frames.
 struct FrameState<'a> {
     scene: &'a PlannedScene,
     setup: &'a Setup,
     methods: &'a [String],
-    /// Displayed previous frame of each method, and of the reference.
-    previous: HashMap<String, Rgb32Image>,
-    previous_reference: Option<Rgb32Image>,
-    rows: Vec<MetricRow>,
+    previous: Option<(Images, Arc<Rgb32Image>)>,
+    jobs: Overlap<Vec<MetricRow>>,
     timings: Vec<Vec<PassTiming>>,
+    timing: Arc<Timing>,
 }
 
 impl FrameState<'_> {
-    fn method_dir(&self, method: &str) -> PathBuf {
-        self.scene.dir.join(method)
-    }
-
-    /// Scores and writes one finished frame (frames arrive in order).
+    /// Hands one finished frame (frames arrive in order) to the scoring jobs.
     fn process(&mut self, done: FrameResult) -> Result<()> {
         let f = done.index as u32;
-        let reference = FrameReference::new(&self.scene.references.load(f)?);
-        let (w, h) = (self.setup.width(), self.setup.height());
-        for (method, pixels) in &done.images {
-            let hdr = to_rgb(w, h, pixels);
-            let previous = self
-                .previous
-                .get(method)
-                .zip(self.previous_reference.as_ref());
-            let s = score(&reference, &hdr, previous);
-            let dir = self.method_dir(method);
-            write_display_png(&dir.join(format!("{}.png", frame_name(f))), &s.display)?;
-            write_flip_png(
-                &dir.join(format!("flip_{}.png", frame_name(f))),
-                w,
-                h,
-                &s.flip_map,
-            )?;
-            if method == NOISY_METHOD {
-                write_exr(&dir.join(format!("{}.exr", frame_name(f))), &hdr)?;
-            }
-            self.rows.push(MetricRow {
-                scene: self.scene.name.clone(),
-                method: method.clone(),
-                frame: f,
-                psnr: s.psnr,
-                ssim: s.ssim,
-                flip: s.flip,
-                temporal_error: s.temporal_error,
-                gpu_ms: method_gpu_ms(&done.timings, method, self.methods),
-            });
-            self.previous.insert(method.clone(), s.display);
-        }
-        self.previous_reference = Some(reference.display);
+        let reference = Arc::new(self.scene.references.load(f)?);
+        let gpu_ms = done
+            .images
+            .iter()
+            .map(|(m, _)| method_gpu_ms(&done.timings, m, self.methods))
+            .collect();
+        let images: Images = Arc::new(done.images);
+        let job = ScoreJob {
+            scene: self.scene.name.clone(),
+            dir: self.scene.dir.clone(),
+            frame: f,
+            size: (self.setup.width(), self.setup.height()),
+            images: Arc::clone(&images),
+            gpu_ms,
+            reference: Arc::clone(&reference),
+            previous: self.previous.take(),
+            timing: Arc::clone(&self.timing),
+        };
+        self.jobs.spawn(move || job.run())?;
+        self.previous = Some((images, reference));
         self.timings.push(done.timings);
         Ok(())
     }
@@ -226,11 +300,14 @@ fn scene_args(args: &EvalArgs, name: &str) -> SceneArgs {
 }
 
 /// The eval's view of filling a scene's reference cache: notes under the progress
-/// line, and reference frames counted as progress.
+/// line, reference frames counted as progress, each frame written on the pool while the
+/// GPU renders the next, and the renderer's GPU time counted.
 struct ReferenceProgress<'a> {
     progress: &'a mut Progress,
     label: &'a str,
     ref_spp: u32,
+    timing: &'a Arc<Timing>,
+    writes: Option<Overlap<()>>,
 }
 
 impl FillReport for ReferenceProgress<'_> {
@@ -252,6 +329,21 @@ impl FillReport for ReferenceProgress<'_> {
             self.progress.advance(f64::from(self.ref_spp), &status);
         }
     }
+
+    fn store(&mut self, cache: &ReferenceCache, f: u32, img: Rgb32Image) -> Result<()> {
+        let cache = cache.clone();
+        self.writes
+            .get_or_insert_with(|| Overlap::new(self.timing))
+            .spawn(move || cache.store(f, &img))
+    }
+
+    fn finished(&mut self, renderer: &dvr_engine::renderer::Renderer) -> Result<()> {
+        if let Some(writes) = self.writes.take() {
+            writes.finish()?;
+        }
+        self.timing.add_gpu_ms(renderer.gpu_ms());
+        Ok(())
+    }
 }
 
 pub fn evaluate_scene(
@@ -260,17 +352,22 @@ pub fn evaluate_scene(
     scene: &PlannedScene,
     label: &str,
     progress: &mut Progress,
+    timing: &Arc<Timing>,
 ) -> Result<SceneResult> {
     progress.show(&format!("{label} | loading"));
-    let setup = Setup::new(&scene_args(args, &scene.name))?;
-    scene.references.fill(
-        &setup,
-        &mut ReferenceProgress {
-            progress,
-            label,
-            ref_spp: args.ref_spp,
-        },
-    )?;
+    let setup = Setup::new(&scene_args(args, &scene.spec))?;
+    timing.references.time(|| {
+        scene.references.fill(
+            &setup,
+            &mut ReferenceProgress {
+                progress,
+                label,
+                ref_spp: args.ref_spp,
+                timing,
+                writes: None,
+            },
+        )
+    })?;
 
     let names: Vec<&str> = methods.iter().map(String::as_str).collect();
     let mut renderer = setup.renderer(&names)?;
@@ -282,10 +379,10 @@ pub fn evaluate_scene(
         scene,
         setup: &setup,
         methods,
-        previous: HashMap::new(),
-        previous_reference: None,
-        rows: Vec::new(),
+        previous: None,
+        jobs: Overlap::new(timing),
         timings: Vec::new(),
+        timing: Arc::clone(timing),
     };
     let request = FrameRequest {
         readback: true,
@@ -299,6 +396,7 @@ pub fn evaluate_scene(
             setup.frames
         )
     };
+    let frames_started = std::time::Instant::now();
     for f in 0..setup.frames {
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
             state.process(done)?;
@@ -308,17 +406,23 @@ pub fn evaluate_scene(
     for done in renderer.flush()? {
         state.process(done)?;
     }
+    let rows: Vec<MetricRow> = state.jobs.finish()?.into_iter().flatten().collect();
+    timing.frames.add(frames_started.elapsed());
 
     let ms_per_spp = path_trace_ms_per_spp(&state.timings, setup.settings.spp);
-    let baseline = baseline::measure(
-        &mut renderer,
-        &setup,
-        &scene.references,
-        ms_per_spp,
-        args.ref_spp,
-        progress,
-        label,
-    )?;
+    let baseline = timing.baseline.time(|| {
+        baseline::measure(
+            &mut renderer,
+            &setup,
+            &scene.references,
+            ms_per_spp,
+            args.ref_spp,
+            progress,
+            label,
+            timing,
+        )
+    })?;
+    timing.add_gpu_ms(renderer.gpu_ms());
     let device = renderer.ctx().info.name.clone();
     crate::profile::write_json(
         &scene.dir.join("timings.json"),
@@ -341,7 +445,7 @@ pub fn evaluate_scene(
         spp: setup.settings.spp,
         methods: methods.to_vec(),
         event_frame,
-        rows: state.rows,
+        rows,
         baseline,
         path_trace_ms_per_spp: ms_per_spp,
         device,
@@ -363,6 +467,7 @@ mod tests {
             pass: pass.into(),
             start_ms: 0.0,
             ms,
+            bytes: 0,
         }
     }
 

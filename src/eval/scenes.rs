@@ -61,6 +61,26 @@ pub fn dir_name(scene: &str) -> String {
     }
 }
 
+/// Makes `labels` (the scenes' names, in order) unique, and gives each a folder name
+/// inside the eval folder that is unique too: a repeated label gets `-2`, `-3`, … (two
+/// scene files both named `head` become `head` and `head-2`), and a folder that another
+/// label already sanitised to (`a/b` and `a_b` both give `a_b`) gets the same suffix.
+/// Returns (label, folder) per scene.
+pub fn unique_labels(labels: &[String]) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = Vec::new();
+    for label in labels {
+        let taken = |l: &str, d: &str| out.iter().any(|(ol, od)| ol == l || od == d);
+        let mut unique = (label.clone(), dir_name(label));
+        let mut n = 2;
+        while taken(&unique.0, &unique.1) {
+            unique = (format!("{label}-{n}"), format!("{}-{n}", dir_name(label)));
+            n += 1;
+        }
+        out.push(unique);
+    }
+    out
+}
+
 /// True for scenes with one sudden change (a TF or light jump).
 pub fn has_sudden_change(scene: &str) -> bool {
     SUDDEN_ANIMATIONS.contains(&animation(scene))
@@ -115,6 +135,25 @@ mod tests {
         assert_eq!(dir_name("mri/tf-jump"), "mri_tf-jump");
         assert_eq!(dir_name("../x y"), "_x_y");
         assert_eq!(dir_name(".."), "scene");
+    }
+
+    #[test]
+    fn labels_and_folders_are_unique() {
+        let l = |v: &[&str]| unique_labels(&v.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+        assert_eq!(
+            l(&["cloud/orbit", "head"]),
+            vec![
+                ("cloud/orbit".to_string(), "cloud_orbit".to_string()),
+                ("head".to_string(), "head".to_string())
+            ]
+        );
+        let twice = l(&["head", "head", "head"]);
+        assert_eq!(twice[1], ("head-2".to_string(), "head-2".to_string()));
+        assert_eq!(twice[2], ("head-3".to_string(), "head-3".to_string()));
+        // Different labels, one sanitised folder name.
+        let clash = l(&["a/scene", "a_scene"]);
+        assert_eq!(clash[0].1, "a_scene");
+        assert_eq!(clash[1], ("a_scene-2".to_string(), "a_scene-2".to_string()));
     }
 
     #[test]

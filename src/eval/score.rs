@@ -12,9 +12,14 @@ pub struct FrameReference {
     flip: FlipReference,
 }
 
+/// A linear HDR frame as the metrics and the page see it: tone-mapped at [`EXPOSURE`].
+pub fn display(hdr: &Rgb32Image) -> Rgb32Image {
+    tonemap_srgb(hdr, EXPOSURE)
+}
+
 impl FrameReference {
     pub fn new(hdr: &Rgb32Image) -> Self {
-        let display = tonemap_srgb(hdr, EXPOSURE);
+        let display = display(hdr);
         let flip = FlipReference::new(&display, DEFAULT_PPD);
         Self { display, flip }
     }
@@ -41,7 +46,7 @@ pub fn score(
     hdr: &Rgb32Image,
     previous: Option<(&Rgb32Image, &Rgb32Image)>,
 ) -> Scores {
-    let display = tonemap_srgb(hdr, EXPOSURE);
+    let display = display(hdr);
     let flip = reference.flip.compare(&display);
     Scores {
         psnr: psnr(&reference.display, &display).min(PSNR_CAP),

@@ -132,12 +132,7 @@ pub fn run(args: ExploreArgs) -> Result<()> {
     if !has_display() {
         bail!("{NO_DISPLAY} (neither DISPLAY nor WAYLAND_DISPLAY is set)");
     }
-    let mut scene = Scene::open(&args.scene).with_context(|| {
-        format!(
-            "opening scene {:?} (built-in scenes: `dvr scenes`)",
-            args.scene
-        )
-    })?;
+    let mut scene = crate::setup::open_scene(&args.scene)?;
     if let Some(path) = &args.volume {
         scene.volume.source = VolumeSource::File {
             path: path.clone(),

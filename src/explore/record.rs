@@ -227,12 +227,14 @@ pub fn session_scene(
     if let (Some(&a), Some(&b), true) = (edits.first(), edits.last(), s.tf_b.is_some()) {
         animation.tf.push(TfKey {
             frame: a - 1,
-            blend: 0.0,
+            blend: Some(0.0),
+            shift: None,
             interpolation: Interpolation::Linear,
         });
         animation.tf.push(TfKey {
             frame: b,
-            blend: 1.0,
+            blend: Some(1.0),
+            shift: None,
             interpolation: Interpolation::Linear,
         });
     }

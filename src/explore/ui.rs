@@ -559,6 +559,7 @@ mod tests {
             pass: pass.into(),
             start_ms,
             ms,
+            bytes: 0,
         };
         let timings = [t("a", 0.0, 0.01), t("b", 40.0, 0.01), t("c", 41.0, 2.0)];
         assert_eq!(gpu_span_ms(&timings), 43.0);

@@ -27,7 +27,8 @@ impl Harness {
     pub fn new(name: &str, width: u32, height: u32) -> Self {
         let ctx = super::context();
         let graph = RenderGraph::new(&ctx).expect("graph");
-        let denoiser = denoise::create(&ctx, name, Default::default(), None).expect("denoiser");
+        let denoiser = denoise::create(&ctx, name, Default::default(), None, Default::default())
+            .expect("denoiser");
         Self {
             ctx,
             graph,
@@ -149,6 +150,7 @@ impl Harness {
                 lights: false,
                 transfer_function: false,
             },
+            retrace: None,
         };
         let out = self
             .denoiser

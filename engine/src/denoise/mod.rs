@@ -19,8 +19,9 @@ pub use wrls::{Wrls, WrlsVariant};
 use crate::error::{EngineError, Result};
 use crate::gpu::GpuContext;
 use crate::graph::{Bind, BufferHandle, Frame, History, ImageHandle, PassBuilder, RenderGraph};
+use crate::passes::path_trace::PathTraceFeatures;
 use crate::passes::surface_features::FeatureImages;
-use crate::passes::Extent;
+use crate::passes::{Extent, SceneBindings};
 
 /// Disocclusion tolerance of the shared reprojection (include/reproject.glsl): how far,
 /// in pixels, last frame's surface may land from this pixel when projected back.
@@ -82,6 +83,22 @@ pub struct DenoiseInputs {
     pub camera: glam::Vec3,
     pub spp: u32,
     pub changes: Changes,
+    /// Last frame's samples as this frame's scene can re-trace them; `None` on the first
+    /// frame, after a reset, and where there is no scene (synthetic inputs).
+    pub retrace: Option<Retrace>,
+}
+
+/// What re-tracing last frame's samples in this frame's scene needs (ours' temporal
+/// gradients): the scene, last frame's camera and sample stream, and what it measured.
+#[derive(Clone, Copy, Debug)]
+pub struct Retrace {
+    pub scene: SceneBindings,
+    /// Last frame's noisy radiance.
+    pub radiance_prev: ImageHandle,
+    pub inv_view_proj_prev: glam::Mat4,
+    pub camera_prev: glam::Vec3,
+    /// Last frame's index (its random numbers).
+    pub frame_prev: u32,
 }
 
 impl DenoiseInputs {
@@ -169,6 +186,10 @@ pub const NAMES: &[&str] = &[
     "taa",
     "svgf",
     "ours",
+    "ours-feature",
+    "ours-no-gradient",
+    "ours-no-atrous",
+    "ours-no-drift",
     "ours-fixed-lambda",
     "wrls-paper",
     "rls",
@@ -181,12 +202,14 @@ pub const NAMES: &[&str] = &[
 ];
 
 /// Builds a denoiser by name. `dataset` is the built-in dataset the scene's volume is, if
-/// any (learned denoisers pick their network by it).
+/// any (learned denoisers pick their network by it); `features` what the path tracer is
+/// specialised for (denoisers that trace paths again must trace the same ones).
 pub fn create(
     ctx: &GpuContext,
     name: &str,
     motion: MotionSource,
     dataset: Option<&str>,
+    features: PathTraceFeatures,
 ) -> Result<Box<dyn Denoiser>> {
     if let Some((net, precision)) = rae::resolve(name, dataset) {
         return Ok(Box::new(Rae::new(
@@ -197,7 +220,7 @@ pub fn create(
         )?));
     }
     if let Some(variant) = WrlsVariant::from_name(name) {
-        return Ok(Box::new(Wrls::new(ctx, name, variant, motion)?));
+        return Ok(Box::new(Wrls::new(ctx, name, variant, motion, features)?));
     }
     Ok(match name {
         "none" => Box::new(Passthrough),

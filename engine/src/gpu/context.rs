@@ -17,6 +17,9 @@ const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 pub struct DeviceInfo {
     pub name: String,
     pub device_type: vk::PhysicalDeviceType,
+    /// `VkPhysicalDeviceDriverProperties::driverID`: which driver this is, as the
+    /// driver itself says (e.g. `MESA_LLVMPIPE` for lavapipe), not guessed from the name.
+    pub driver_id: vk::DriverId,
     /// Nanoseconds per timestamp tick.
     pub timestamp_period: f64,
     pub max_image_dimension_3d: u32,
@@ -296,6 +299,7 @@ fn pick_device(
         let info = DeviceInfo {
             name,
             device_type: props.device_type,
+            driver_id: driver_id(instance, p),
             timestamp_period: props.limits.timestamp_period as f64,
             max_image_dimension_3d: props.limits.max_image_dimension3_d,
             max_memory_allocation_size: max_allocation(instance, p),
@@ -335,6 +339,21 @@ fn largest_device_heap(instance: &ash::Instance, p: vk::PhysicalDevice) -> u64 {
         .map(|h| h.size)
         .max()
         .unwrap_or(0)
+}
+
+fn driver_id(instance: &ash::Instance, p: vk::PhysicalDevice) -> vk::DriverId {
+    let mut driver = vk::PhysicalDeviceDriverProperties::default();
+    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+    unsafe { instance.get_physical_device_properties2(p, &mut props2) };
+    driver.driver_id
+}
+
+impl DeviceInfo {
+    /// lavapipe (Mesa's llvmpipe driver), whose shader loops run under an iteration
+    /// limiter (see `renderer::MAX_SAMPLES_PER_DISPATCH`).
+    pub fn is_llvmpipe(&self) -> bool {
+        self.driver_id == vk::DriverId::MESA_LLVMPIPE
+    }
 }
 
 fn max_allocation(instance: &ash::Instance, p: vk::PhysicalDevice) -> u64 {

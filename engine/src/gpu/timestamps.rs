@@ -26,11 +26,32 @@ pub struct PassTiming {
     /// Start, relative to the first timestamp of the frame, in milliseconds.
     pub start_ms: f64,
     pub ms: f64,
+    /// Bytes the pass's declared accesses touch (the render graph's count; see
+    /// `RenderGraph::declared_bytes`): with `ms`, the bandwidth it achieved.
+    #[serde(default)]
+    pub bytes: u64,
+}
+
+impl PassTiming {
+    /// Achieved bandwidth in GB/s (10^9 bytes per second) of the declared bytes.
+    pub fn gb_per_s(&self) -> f64 {
+        gb_per_s(self.bytes as f64, self.ms)
+    }
+}
+
+/// GB/s (10^9 bytes per second) of `bytes` moved in `ms` milliseconds; 0 for no time.
+pub fn gb_per_s(bytes: f64, ms: f64) -> f64 {
+    if ms > 0.0 {
+        bytes / (ms * 1e6)
+    } else {
+        0.0
+    }
 }
 
 pub struct TimestampPool {
     pool: vk::QueryPool,
-    names: Vec<String>,
+    /// Name and declared bytes of each pass timed in the recorded frame.
+    names: Vec<(String, u64)>,
     period_ns: f64,
 }
 
@@ -56,14 +77,20 @@ impl TimestampPool {
         };
     }
 
-    /// Writes the opening timestamp of `pass`; returns false when the pool is full
-    /// (the pass then runs untimed).
-    pub fn begin(&mut self, ctx: &GpuContext, cmd: vk::CommandBuffer, pass: &str) -> bool {
+    /// Writes the opening timestamp of `pass`, which touches `bytes` (reported with its
+    /// time); returns false when the pool is full (the pass then runs untimed).
+    pub fn begin(
+        &mut self,
+        ctx: &GpuContext,
+        cmd: vk::CommandBuffer,
+        pass: &str,
+        bytes: u64,
+    ) -> bool {
         let index = self.names.len() as u32;
         if index >= MAX_TIMED_PASSES {
             return false;
         }
-        self.names.push(pass.to_string());
+        self.names.push((pass.to_string(), bytes));
         self.write(ctx, cmd, index * QUERIES_PER_PASS);
         true
     }
@@ -109,10 +136,11 @@ impl TimestampPool {
             .names
             .iter()
             .enumerate()
-            .map(|(i, name)| PassTiming {
+            .map(|(i, (name, bytes))| PassTiming {
                 pass: name.clone(),
                 start_ms: to_ms(raw[n * i].saturating_sub(t0)),
                 ms: to_ms(raw[n * i + 2].saturating_sub(raw[n * i])),
+                bytes: *bytes,
             })
             .collect())
     }

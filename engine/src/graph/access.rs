@@ -90,6 +90,23 @@ impl Access {
         }
     }
 
+    /// How many times a pass moves a resource it declares with this access: once per
+    /// direction (read, write), so a read-modify-write counts its size twice. Accesses
+    /// that record no GPU work (a host read after the fence, the hand-over to
+    /// presentation) move nothing. The profiler's per-pass bytes come from this.
+    pub fn traffic_count(self) -> u64 {
+        match self {
+            Access::Sampled
+            | Access::StorageRead
+            | Access::StorageWrite
+            | Access::Uniform
+            | Access::TransferSrc
+            | Access::TransferDst => 1,
+            Access::StorageReadWrite | Access::ColorAttachment => 2,
+            Access::HostRead | Access::Present => 0,
+        }
+    }
+
     pub fn is_storage(self) -> bool {
         matches!(
             self,
@@ -225,6 +242,17 @@ mod tests {
     use vk::AccessFlags2 as A;
     use vk::ImageLayout as L;
     use vk::PipelineStageFlags2 as S;
+
+    #[test]
+    fn traffic_counts_each_direction_once() {
+        assert_eq!(Access::StorageRead.traffic_count(), 1);
+        assert_eq!(Access::Sampled.traffic_count(), 1);
+        assert_eq!(Access::StorageWrite.traffic_count(), 1);
+        assert_eq!(Access::TransferDst.traffic_count(), 1);
+        assert_eq!(Access::StorageReadWrite.traffic_count(), 2);
+        assert_eq!(Access::HostRead.traffic_count(), 0);
+        assert_eq!(Access::Present.traffic_count(), 0);
+    }
 
     #[test]
     fn first_write_transitions_from_undefined() {

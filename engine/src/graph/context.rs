@@ -244,6 +244,31 @@ impl<'a> PassContext<'a> {
         Ok(())
     }
 
+    /// Copies the whole of a declared buffer (TransferSrc) into another (TransferDst) of
+    /// at least its size.
+    pub fn copy_buffer(&mut self, src: BufferHandle, dst: BufferHandle) -> Result<()> {
+        let (from, to) = (self.buffer(src)?, self.buffer(dst)?);
+        let size = self.graph.buffer_ref(src).size;
+        let region = vk::BufferCopy::default().size(size);
+        unsafe {
+            self.ctx
+                .device
+                .cmd_copy_buffer(self.cmd, from, to, &[region])
+        };
+        Ok(())
+    }
+
+    /// Fills a declared buffer (TransferDst) with a repeated 32-bit value.
+    pub fn fill_buffer(&mut self, dst: BufferHandle, value: u32) -> Result<()> {
+        let buffer = self.buffer(dst)?;
+        unsafe {
+            self.ctx
+                .device
+                .cmd_fill_buffer(self.cmd, buffer, 0, vk::WHOLE_SIZE, value)
+        };
+        Ok(())
+    }
+
     /// Copies a declared image (TransferSrc) into a declared buffer (TransferDst).
     pub fn copy_image_to_buffer(&mut self, src: ImageHandle, dst: BufferHandle) -> Result<()> {
         let image = self.image(src)?;

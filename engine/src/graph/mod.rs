@@ -15,6 +15,7 @@ pub use context::{Bind, PassContext};
 pub use resources::{BufferHandle, History, ImageHandle, Res};
 
 use crate::error::{EngineError, Result};
+use crate::gpu::resources::format_size;
 use crate::gpu::timestamps::TimestampPool;
 use crate::gpu::{GpuBuffer, GpuContext, GpuImage, ImageDesc};
 use ash::vk;
@@ -340,6 +341,30 @@ impl RenderGraph {
         &self.images[h.0 as usize].name
     }
 
+    /// Bytes of a graph resource: the image's texels times their size, or the buffer's
+    /// size.
+    pub fn resource_bytes(&self, r: Res) -> u64 {
+        match r {
+            Res::Image(h) => {
+                let desc = self.images[h.0 as usize].image.desc;
+                desc.texel_count() * format_size(desc.format)
+            }
+            Res::Buffer(h) => self.buffers[h.0 as usize].buffer.size,
+        }
+    }
+
+    /// The bytes a pass's declared accesses touch: each resource's size once per
+    /// direction it is declared to move (see [`Access::traffic_count`]). A lower bound
+    /// on the pass's memory traffic when it touches all of what it declares (the
+    /// image-space passes); for a pass that samples sparsely (the path tracer's volume)
+    /// an upper estimate of what it needs.
+    pub fn declared_bytes(&self, accesses: &[(Res, Access)]) -> u64 {
+        accesses
+            .iter()
+            .map(|&(r, a)| a.traffic_count() * self.resource_bytes(r))
+            .sum()
+    }
+
     fn res_name(&self, r: Res) -> &str {
         match r {
             Res::Image(h) => &self.images[h.0 as usize].name,
@@ -448,9 +473,10 @@ impl RenderGraph {
                 continue;
             };
             begin_label(ctx, cmd, &pass.name);
+            let bytes = self.declared_bytes(&pass.accesses);
             let timed = timestamps
                 .as_deref_mut()
-                .is_some_and(|t| t.begin(ctx, cmd, &pass.name));
+                .is_some_and(|t| t.begin(ctx, cmd, &pass.name, bytes));
             let mut pc = PassContext::new(
                 ctx,
                 cmd,

@@ -2,6 +2,7 @@
 //! owns its pipeline and adds itself to a frame, declaring exactly what it touches.
 
 pub mod accumulate;
+pub mod bandwidth;
 pub mod motion;
 pub mod path_trace;
 pub mod present;
@@ -53,4 +54,10 @@ impl SceneBindings {
 pub struct Extent {
     pub width: u32,
     pub height: u32,
+}
+
+impl Extent {
+    pub fn pixels(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
 }

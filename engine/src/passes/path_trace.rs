@@ -20,13 +20,37 @@ pub struct PathTraceFeatures {
     pub environment_map: bool,
 }
 
+/// The specialisation constants of a pipeline that traces paths (include/path.glsl):
+/// the path tracer's, and ours' temporal-gradient pass, which must trace the same paths.
+pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue); 4] {
+    let estimator = match features.estimator {
+        Estimator::Delta => 0,
+        Estimator::RayMarch => 1,
+    };
+    let phase = match features.phase {
+        Phase::Isotropic => 0,
+        Phase::Hg => 1,
+        Phase::Hybrid => 2,
+    };
+    [
+        ("ESTIMATOR", SpecValue::I32(estimator)),
+        ("PHASE", SpecValue::I32(phase)),
+        ("USE_EMISSION", SpecValue::Bool(features.emission)),
+        ("HAS_ENV_MAP", SpecValue::Bool(features.environment_map)),
+    ]
+}
+
 pub struct PathTrace {
     pipeline: ComputePipeline,
 }
 
 #[derive(Clone, Copy, Debug)]
 pub struct PathTraceOutputs {
+    /// This frame's radiance (`radiance_history.cur`).
     pub radiance: ImageHandle,
+    /// This and last frame's radiance (ours' temporal gradients re-trace last frame's
+    /// samples and compare).
+    pub radiance_history: History,
     pub moments: ImageHandle,
     /// World position of the closest first real collision (w = 1 where hit); `prev`
     /// holds last frame's, for disocclusion tests.
@@ -35,25 +59,7 @@ pub struct PathTraceOutputs {
 
 impl PathTrace {
     pub fn new(ctx: &GpuContext, features: PathTraceFeatures) -> Result<Self> {
-        let estimator = match features.estimator {
-            Estimator::Delta => 0,
-            Estimator::RayMarch => 1,
-        };
-        let phase = match features.phase {
-            Phase::Isotropic => 0,
-            Phase::Hg => 1,
-            Phase::Hybrid => 2,
-        };
-        let pipeline = ComputePipeline::new(
-            ctx,
-            "path_trace",
-            &[
-                ("ESTIMATOR", SpecValue::I32(estimator)),
-                ("PHASE", SpecValue::I32(phase)),
-                ("USE_EMISSION", SpecValue::Bool(features.emission)),
-                ("HAS_ENV_MAP", SpecValue::Bool(features.environment_map)),
-            ],
-        )?;
+        let pipeline = ComputePipeline::new(ctx, "path_trace", &specialization(features))?;
         Ok(Self { pipeline })
     }
 
@@ -71,8 +77,10 @@ impl PathTrace {
         spp: u32,
     ) -> Result<PathTraceOutputs> {
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let radiance_history = graph.history(ctx, &format!("{name}.radiance"), desc)?;
         let out = PathTraceOutputs {
-            radiance: graph.image(ctx, &format!("{name}.radiance"), desc)?,
+            radiance: radiance_history.cur,
+            radiance_history,
             moments: graph.image(ctx, &format!("{name}.moments"), desc)?,
             first_hit: graph.history(ctx, &format!("{name}.first_hit"), desc)?,
         };

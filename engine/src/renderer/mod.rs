@@ -8,7 +8,7 @@ pub mod scene_gpu;
 pub mod scene_setup;
 pub mod uniforms;
 
-use crate::denoise::{self, Changes, DenoiseInputs, Denoiser};
+use crate::denoise::{self, Changes, DenoiseInputs, Denoiser, Retrace};
 use crate::error::{EngineError, Result, VkContext};
 use crate::gpu::timestamps::{PassTiming, TimestampPool};
 use crate::gpu::GpuContext;
@@ -29,13 +29,33 @@ use uniforms::{FrameUniforms, GpuLight, MAX_LIGHTS};
 
 const SLOTS: usize = 2;
 
-/// Most samples one path-tracing dispatch takes per pixel. llvmpipe (lavapipe) guards
+/// Most samples one path-tracing dispatch takes per pixel on lavapipe. llvmpipe guards
 /// every shader loop with an iteration limiter (65535) whose count is not reset when an
 /// inner loop is re-entered, so a dispatch whose per-pixel sample loop runs many
 /// delta-tracking or ray-marching steps is silently cut short (measured: 128 samples in
-/// one dispatch came out 27% dark, 512 samples 73% dark). References accumulate batches
-/// of at most this many samples instead; per-frame rendering is limited to it.
+/// one dispatch came out 27% dark, 512 samples 73% dark). There, references accumulate
+/// batches of at most this many samples and per-frame rendering is limited to it; other
+/// devices have no such limiter (see [`samples_per_dispatch`]).
 pub const MAX_SAMPLES_PER_DISPATCH: u32 = 4;
+
+/// Pixel-samples one path-tracing dispatch may take on a device without llvmpipe's loop
+/// limiter: 256×256 at 1024 spp (a suite reference in one dispatch). It keeps one
+/// dispatch short (about 20 ms on an H200, well under a second on a small GPU) so no
+/// display watchdog fires and the queue stays responsive; larger images split their
+/// references into a few dispatches.
+pub const PIXEL_SAMPLES_PER_DISPATCH: u64 = 1 << 26;
+
+/// Most samples per pixel one path-tracing dispatch of `pixels` pixels takes on the
+/// device described by `info`: [`MAX_SAMPLES_PER_DISPATCH`] on lavapipe (detected by
+/// its driver ID), else as many as [`PIXEL_SAMPLES_PER_DISPATCH`] allows, never fewer
+/// than lavapipe's.
+pub fn samples_per_dispatch(info: &crate::gpu::DeviceInfo, pixels: u64) -> u32 {
+    if info.is_llvmpipe() {
+        return MAX_SAMPLES_PER_DISPATCH;
+    }
+    let n = PIXEL_SAMPLES_PER_DISPATCH / pixels.max(1);
+    n.clamp(u64::from(MAX_SAMPLES_PER_DISPATCH), u64::from(u32::MAX)) as u32
+}
 
 /// Fixed settings of a renderer (changing them means a new renderer).
 #[derive(Clone, Debug)]
@@ -185,6 +205,8 @@ pub struct Renderer {
     slots: Vec<Slot>,
     pool: vk::CommandPool,
     frame_index: u64,
+    /// GPU time of every pass collected so far (frames and references), ms.
+    gpu_ms: f64,
     // Declared last: dropped after the Drop impl has released everything above. Shared
     // so an application can keep the device (and its window's swapchain) across
     // renderers, e.g. when a setting that specialises the pipelines changes.
@@ -219,13 +241,14 @@ impl Renderer {
         denoisers: &[&str],
         lut_size: u32,
     ) -> Result<Self> {
-        if settings.spp == 0 || settings.spp > MAX_SAMPLES_PER_DISPATCH {
+        let max_spp = samples_per_dispatch(&ctx.info, settings.size.pixels());
+        if settings.spp == 0 || settings.spp > max_spp {
             return Err(EngineError::Pass {
                 pass: "path_trace".into(),
                 problem: format!(
-                    "{} samples per pixel per frame; 1 to {MAX_SAMPLES_PER_DISPATCH} are \
-                     supported (use `dvr reference` or the accum denoiser for more)",
-                    settings.spp
+                    "{} samples per pixel per frame; 1 to {max_spp} are supported on {} \
+                     (use `dvr reference` or the accum denoiser for more)",
+                    settings.spp, ctx.info.name
                 ),
             });
         }
@@ -239,7 +262,15 @@ impl Renderer {
         };
         let denoisers = denoisers
             .iter()
-            .map(|n| denoise::create(&ctx, n, settings.motion_source, settings.dataset))
+            .map(|n| {
+                denoise::create(
+                    &ctx,
+                    n,
+                    settings.motion_source,
+                    settings.dataset,
+                    settings.features,
+                )
+            })
             .collect::<Result<Vec<_>>>()?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
@@ -297,6 +328,7 @@ impl Renderer {
             slots,
             pool,
             frame_index: 0,
+            gpu_ms: 0.0,
             ctx,
         })
     }
@@ -308,6 +340,18 @@ impl Renderer {
     /// The shared context (to keep the device alive beyond this renderer).
     pub fn shared_ctx(&self) -> Arc<GpuContext> {
         Arc::clone(&self.ctx)
+    }
+
+    /// Most samples per pixel one path-tracing dispatch takes on this device at this
+    /// size (see [`samples_per_dispatch`]).
+    pub fn samples_per_dispatch(&self) -> u32 {
+        samples_per_dispatch(&self.ctx.info, self.settings.size.pixels())
+    }
+
+    /// GPU time of every pass this renderer has collected results of (frames and
+    /// references), in ms: the work the device did for it.
+    pub fn gpu_ms(&self) -> f64 {
+        self.gpu_ms
     }
 
     pub fn denoiser_names(&self) -> Vec<String> {
@@ -330,6 +374,7 @@ impl Renderer {
                     n,
                     self.settings.motion_source,
                     self.settings.dataset,
+                    self.settings.features,
                 )
             })
             .collect::<Result<Vec<_>>>()?;
@@ -450,6 +495,23 @@ impl Renderer {
             features.map(|f| f.position.cur),
             size,
         )?;
+        // Last frame's samples can be traced again in this frame's scene (ours' temporal
+        // gradients) when the scene changed and last frame's radiance is still valid.
+        let retrace = match &self.last_inputs {
+            Some(last)
+                if noisy.radiance_history.valid
+                    && (changes.lights || changes.transfer_function) =>
+            {
+                Some(Retrace {
+                    scene,
+                    radiance_prev: noisy.radiance_history.prev,
+                    inv_view_proj_prev: (last.camera.proj * last.camera.view).inverse(),
+                    camera_prev: last.camera.position,
+                    frame_prev: self.frame_index.wrapping_sub(1) as u32,
+                })
+            }
+            _ => None,
+        };
         let input = DenoiseInputs {
             uniforms: scene.uniforms,
             noisy: noisy.radiance,
@@ -461,6 +523,7 @@ impl Renderer {
             camera: inputs.camera.position,
             spp: self.settings.spp,
             changes,
+            retrace,
         };
         let mut outputs: Vec<(String, ImageHandle)> = Vec::new();
         for d in &self.denoisers {
@@ -576,6 +639,7 @@ impl Renderer {
         };
         let screenshot = slot.pending_screenshot.take();
         let timings = slot.timestamps.read(&self.ctx)?;
+        self.gpu_ms += timings.iter().map(|t| t.ms).sum::<f64>();
         let mut images = Vec::new();
         for (name, buffer) in readbacks {
             images.push((name, read_pixels(&self.graph, buffer)?));
@@ -605,8 +669,9 @@ impl Renderer {
     }
 
     /// Renders a high-sample reference of one animation frame: `spp` samples accumulated
-    /// in batches of `batch`, from a sample stream of its own (independent of the
-    /// per-frame noise the denoisers see).
+    /// in dispatches of at most `batch` (and at most what the device takes in one, see
+    /// [`Renderer::samples_per_dispatch`]), from a sample stream of its own (independent
+    /// of the per-frame noise the denoisers see).
     pub fn reference(
         &mut self,
         inputs: &FrameInputs,
@@ -621,7 +686,7 @@ impl Renderer {
                 problem: "a reference needs at least 1 sample per pixel".into(),
             });
         }
-        let batch = batch.clamp(1, spp.clamp(1, MAX_SAMPLES_PER_DISPATCH));
+        let batch = batch.clamp(1, spp.clamp(1, self.samples_per_dispatch()));
         self.graph.reset_history("reference.");
         let mut done = 0;
         let mut image = Vec::new();
@@ -666,7 +731,13 @@ impl Renderer {
             } else {
                 Vec::new()
             };
-            ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, frame))?;
+            // Timed with slot 0's pool, idle after the flush above.
+            let timestamps = &mut self.slots[0].timestamps;
+            ctx.submit_and_wait(|cmd| {
+                timestamps.reset(ctx, cmd);
+                graph.execute(ctx, cmd, Some(timestamps), frame)
+            })?;
+            self.gpu_ms += timestamps.read(ctx)?.iter().map(|t| t.ms).sum::<f64>();
             graph.end_frame();
             if let Some((_, buffer)) = readbacks.first() {
                 image = read_pixels(graph, *buffer)?;
@@ -794,5 +865,44 @@ impl Drop for Renderer {
             p.destroy(ctx);
         }
         self.graph.destroy(ctx);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::DeviceInfo;
+
+    fn device(driver_id: vk::DriverId) -> DeviceInfo {
+        DeviceInfo {
+            name: "a device".into(),
+            device_type: vk::PhysicalDeviceType::DISCRETE_GPU,
+            driver_id,
+            timestamp_period: 1.0,
+            max_image_dimension_3d: 2048,
+            max_memory_allocation_size: 1 << 30,
+            max_storage_buffer_range: 1 << 27,
+            max_push_constants_size: 128,
+            device_local_heap: 1 << 30,
+            storage_write_without_format: true,
+        }
+    }
+
+    #[test]
+    fn only_llvmpipe_caps_samples_per_dispatch() {
+        let lavapipe = device(vk::DriverId::MESA_LLVMPIPE);
+        assert_eq!(
+            samples_per_dispatch(&lavapipe, 64 * 64),
+            MAX_SAMPLES_PER_DISPATCH
+        );
+        let gpu = device(vk::DriverId::NVIDIA_PROPRIETARY);
+        // A suite reference (256x256, 1024 spp) in one dispatch; 720p in 15.
+        assert_eq!(samples_per_dispatch(&gpu, 256 * 256), 1024);
+        assert_eq!(samples_per_dispatch(&gpu, 1280 * 720), 72);
+        // Never fewer than lavapipe's, however large the image.
+        assert_eq!(
+            samples_per_dispatch(&gpu, 8192 * 8192),
+            MAX_SAMPLES_PER_DISPATCH
+        );
     }
 }

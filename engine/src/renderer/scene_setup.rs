@@ -108,6 +108,14 @@ impl SceneSetup {
             }
             _ => &self.lut_a,
         };
+        if state.tf_shift != 0.0 {
+            return inputs_for(
+                &state.camera,
+                aspect,
+                &state.lights,
+                &lut.shifted(state.tf_shift),
+            );
+        }
         inputs_for(&state.camera, aspect, &state.lights, lut)
     }
 }

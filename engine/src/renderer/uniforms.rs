@@ -90,8 +90,75 @@ pub struct WrlsUpdatePush {
     pub tolerance: f32,
     pub change_ratio: f32,
     pub outlier_sigmas: f32,
+    pub gradient_valid: u32,
+    pub drift_valid: u32,
+    pub stratum: u32,
+    pub lambda_min: f32,
+    pub change_gain: f32,
+    pub shrink: f32,
+    pub drift_z: f32,
     pub pad0: f32,
     pub pad1: f32,
+    pub pad2: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct WrlsConstantPush {
+    pub camera: Vec4,
+    pub width: u32,
+    pub height: u32,
+    pub history_valid: u32,
+    pub lambda: f32,
+    pub delta: f32,
+    pub tolerance: f32,
+    pub change_ratio: f32,
+    pub outlier_sigmas: f32,
+    pub gradient_valid: u32,
+    pub drift_valid: u32,
+    pub stratum: u32,
+    pub lambda_min: f32,
+    pub change_gain: f32,
+    pub shrink: f32,
+    pub drift_z: f32,
+    pub spp: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct WrlsDriftPush {
+    pub width: u32,
+    pub height: u32,
+    pub radius: i32,
+    pub pad0: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct WrlsAtrousPush {
+    pub width: u32,
+    pub height: u32,
+    pub step: i32,
+    pub kappa: f32,
+    pub last: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct WrlsGradientPush {
+    pub prev_inv_view_proj: Mat4,
+    pub prev_camera: Vec4,
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub prev_frame: u32,
+    pub stratum: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 #[repr(C)]
@@ -316,8 +383,83 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 tolerance,
                 change_ratio,
                 outlier_sigmas,
+                gradient_valid,
+                drift_valid,
+                stratum,
+                lambda_min,
+                change_gain,
+                shrink,
+                drift_z,
                 pad0,
-                pad1
+                pad1,
+                pad2
+            }),
+        ),
+        (
+            "wrls_constant",
+            "push",
+            std::mem::size_of::<WrlsConstantPush>(),
+            field_offsets!(WrlsConstantPush {
+                camera,
+                width,
+                height,
+                history_valid,
+                lambda,
+                delta,
+                tolerance,
+                change_ratio,
+                outlier_sigmas,
+                gradient_valid,
+                drift_valid,
+                stratum,
+                lambda_min,
+                change_gain,
+                shrink,
+                drift_z,
+                spp
+            }),
+        ),
+        (
+            "wrls_drift",
+            "push",
+            std::mem::size_of::<WrlsDriftPush>(),
+            field_offsets!(WrlsDriftPush {
+                width,
+                height,
+                radius,
+                pad0
+            }),
+        ),
+        (
+            "wrls_atrous",
+            "push",
+            std::mem::size_of::<WrlsAtrousPush>(),
+            field_offsets!(WrlsAtrousPush {
+                width,
+                height,
+                step,
+                kappa,
+                last,
+                pad0,
+                pad1,
+                pad2
+            }),
+        ),
+        (
+            "wrls_gradient",
+            "push",
+            std::mem::size_of::<WrlsGradientPush>(),
+            field_offsets!(WrlsGradientPush {
+                prev_inv_view_proj,
+                prev_camera,
+                width,
+                height,
+                spp,
+                prev_frame,
+                stratum,
+                pad0,
+                pad1,
+                pad2
             }),
         ),
         (

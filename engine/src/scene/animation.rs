@@ -88,12 +88,19 @@ pub struct LightKey {
     pub interpolation: Interpolation,
 }
 
-/// `[[animation.tf]]`: the blend between `transfer.a` (0) and `transfer.b` (1).
+/// `[[animation.tf]]`: sets either or both of the blend between `transfer.a` (0) and
+/// `transfer.b` (1), and the shift: the TF slides along the density axis by `shift` (a
+/// fraction of the density range, −1 to 1; the TF at density d is the blended TF at
+/// d − shift), so a positive shift moves every feature of the TF to higher densities,
+/// like a window sliding up.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TfKey {
     pub frame: u32,
-    pub blend: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blend: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shift: Option<f64>,
     #[serde(default, skip_serializing_if = "Interpolation::is_linear")]
     pub interpolation: Interpolation,
 }
@@ -258,8 +265,16 @@ impl Animation {
                 return duplicate("light", i, j, k.frame);
             }
         }
+        // Blend and shift are tracks of their own (a key may set either or both, each
+        // key with its own interpolation): two keys on one frame clash only when both
+        // set the same value.
         for (j, k) in self.tf.iter().enumerate() {
-            if let Some(i) = self.tf[..j].iter().position(|o| o.frame == k.frame) {
+            let same = |o: &TfKey| {
+                o.frame == k.frame
+                    && ((o.blend.is_some() && k.blend.is_some())
+                        || (o.shift.is_some() && k.shift.is_some()))
+            };
+            if let Some(i) = self.tf[..j].iter().position(same) {
                 return duplicate("tf", i, j, k.frame);
             }
         }
@@ -399,15 +414,28 @@ impl Animation {
         }
         for (i, k) in self.tf.iter().enumerate() {
             let field = |name: &str| format!("animation.tf[{i}].{name}");
-            if !has_tf_b {
-                return Err(ctx.invalid(
-                    field("blend"),
-                    "TF keyframes need a blend target: set transfer.b",
-                ));
-            }
             frame_ok(field("frame"), k.frame)?;
-            if !(0.0..=1.0).contains(&k.blend) {
-                return Err(ctx.invalid(field("blend"), format!("{} is outside [0, 1]", k.blend)));
+            if k.blend.is_none() && k.shift.is_none() {
+                return Err(ctx.invalid(field("blend"), "a TF keyframe sets blend, shift or both"));
+            }
+            if let Some(blend) = k.blend {
+                if !has_tf_b {
+                    return Err(ctx.invalid(
+                        field("blend"),
+                        "TF blend keyframes need a blend target: set transfer.b",
+                    ));
+                }
+                if !(0.0..=1.0).contains(&blend) {
+                    return Err(ctx.invalid(field("blend"), format!("{blend} is outside [0, 1]")));
+                }
+            }
+            if let Some(shift) = k.shift {
+                if !(-1.0..=1.0).contains(&shift) {
+                    return Err(ctx.invalid(
+                        field("shift"),
+                        format!("{shift} is outside [-1, 1] (a fraction of the density range)"),
+                    ));
+                }
             }
         }
         Ok(())

@@ -1,23 +1,25 @@
 //! The built-in scenes: every dataset × every scripted animation, generated from two
-//! small tables (a look per dataset, a script per animation) so all 24 share one camera,
+//! small tables (a look per dataset, a script per animation) so all 30 share one camera,
 //! one lighting set-up and one look per dataset, and differ only in what moves.
 //!
 //! Names are `<dataset>/<animation>`; `dvr scenes --dump NAME` prints one as TOML
 //! ([`Scene::to_toml`]), which is also the quickest way to start a scene file.
 //!
-//! | dataset   | TF `a` → `b`                              | density_scale | max_bounces |
-//! | --------- | ----------------------------------------- | ------------- | ----------- |
-//! | `phantom` | `phantom-layered` → `phantom-layered-edit` | 150          | 4           |
-//! | `mri`     | `mri-opaque` → `mri-opaque-edit`           | 150          | 4           |
-//! | `cloud`   | `cloud` → `cloud-edit`                     | 20           | 8           |
+//! | dataset   | TF `a` → `b`                              | density_scale | max_bounces | sweep        |
+//! | --------- | ----------------------------------------- | ------------- | ----------- | ------------ |
+//! | `phantom` | `phantom-layered` → `phantom-layered-edit` | 150          | 4           | −0.1 → 0.1   |
+//! | `mri`     | `mri-opaque` → `mri-opaque-edit`           | 150          | 4           | −0.12 → 0.18 |
+//! | `cloud`   | `cloud` → `cloud-edit`                     | 20           | 8           | 0 → 0.3      |
 //!
 //! | animation     | what changes (at 60 frames)                          | stresses                         |
 //! | ------------- | ---------------------------------------------------- | -------------------------------- |
 //! | `orbit`       | camera orbits 1.5°/frame (translation + rotation)    | reprojection                     |
 //! | `point-light` | point light sweeps a 180° arc in front of the volume | shading change, static geometry  |
 //! | `area-light`  | a 0.5 × 0.5 area light (facing the centre) sweeps a similar arc | soft shadows          |
-//! | `light-color` | light colour warm white → orange → blue → warm white | non-linear radiance change       |
+//! | `light-color` | light colour warm white → red → green → blue → warm white (a hue cycle) | colour drift          |
 //! | `tf-edit`     | TF blends `a` → `b` over the whole sequence          | appearance change, no motion     |
+//! | `tf-sweep`    | TF `a` slides along density (a window sweep; the range is the look's) | surfaces move without motion |
+//! | `dolly`       | camera moves straight in, to 0.8 of its distance     | slow zoom, magnification         |
 //! | `tf-jump`     | TF switches `a` → `b` at the middle frame            | recovery after a sudden change   |
 //! | `light-jump`  | point light jumps from upper left to lower right at the middle frame | recovery         |
 //! | `fast-orbit`  | camera orbits 8°/frame                               | disocclusion, ghosting           |
@@ -32,7 +34,9 @@
 
 use glam::{DVec2, DVec3};
 
-use super::animation::{Animation, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES};
+use super::animation::{
+    Animation, CameraKey, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES,
+};
 use super::camera::CameraSpec;
 use super::error::{Ctx, SceneError};
 use super::light::{AreaLight, EnvSource, EnvironmentLight, Facing, Light, PointLight};
@@ -42,12 +46,14 @@ use super::volume::{BuiltinVolume, VolumeSource, VolumeSpec};
 use super::Scene;
 
 /// The scripted animations, in the order they are listed.
-pub const ANIMATIONS: [&str; 8] = [
+pub const ANIMATIONS: [&str; 10] = [
     "orbit",
     "point-light",
     "area-light",
     "light-color",
     "tf-edit",
+    "tf-sweep",
+    "dolly",
     "tf-jump",
     "light-jump",
     "fast-orbit",
@@ -59,6 +65,9 @@ struct Look {
     tf_a: &'static str,
     tf_b: &'static str,
     max_bounces: u32,
+    /// The TF shift at the first and last frame of `tf-sweep`: the window slides over
+    /// the dataset's tissues without filling empty space (density 0 stays transparent).
+    sweep: (f64, f64),
 }
 
 fn look(dataset: BuiltinVolume) -> Look {
@@ -69,6 +78,7 @@ fn look(dataset: BuiltinVolume) -> Look {
             tf_a: "phantom-layered",
             tf_b: "phantom-layered-edit",
             max_bounces: 4,
+            sweep: (-0.1, 0.1),
         },
         // An opaque cortex, like the paper's opaque-looking datasets.
         BuiltinVolume::Mri => Look {
@@ -76,6 +86,7 @@ fn look(dataset: BuiltinVolume) -> Look {
             tf_a: "mri-opaque",
             tf_b: "mri-opaque-edit",
             max_bounces: 4,
+            sweep: (-0.12, 0.18),
         },
         // Albedo ~0.97: light survives many scattering events.
         BuiltinVolume::Cloud => Look {
@@ -83,6 +94,7 @@ fn look(dataset: BuiltinVolume) -> Look {
             tf_a: "cloud",
             tf_b: "cloud-edit",
             max_bounces: 8,
+            sweep: (0.0, 0.3),
         },
     }
 }
@@ -156,8 +168,8 @@ fn light_key(frame: u32) -> LightKey {
     }
 }
 
-/// Lights and animation of one animation name, at [`DEFAULT_FRAMES`].
-fn script(animation: &str) -> Option<(Vec<Light>, Animation)> {
+/// Lights and animation of one animation name, at [`DEFAULT_FRAMES`], for a dataset's look.
+fn script(animation: &str, look: &Look) -> Option<(Vec<Light>, Animation)> {
     let last = DEFAULT_FRAMES - 1;
     let mid = DEFAULT_FRAMES / 2;
     let mut a = Animation::default();
@@ -190,8 +202,9 @@ fn script(animation: &str) -> Option<(Vec<Light>, Animation)> {
         "light-color" => {
             let colours = [
                 (0, WARM_WHITE),
-                (20, DVec3::new(1.0, 0.55, 0.2)),
-                (40, DVec3::new(0.3, 0.55, 1.0)),
+                (last / 4, DVec3::new(1.0, 0.3, 0.2)),
+                (last / 2, DVec3::new(0.3, 1.0, 0.35)),
+                (3 * last / 4, DVec3::new(0.3, 0.45, 1.0)),
                 (last, WARM_WHITE),
             ];
             a.light = colours
@@ -219,26 +232,50 @@ fn script(animation: &str) -> Option<(Vec<Light>, Animation)> {
             a.tf = vec![
                 TfKey {
                     frame: 0,
-                    blend: 0.0,
+                    blend: Some(0.0),
+                    shift: None,
                     interpolation: Interpolation::Linear,
                 },
                 TfKey {
                     frame: last,
-                    blend: 1.0,
+                    blend: Some(1.0),
+                    shift: None,
                     interpolation: Interpolation::Linear,
                 },
             ];
+        }
+        "tf-sweep" => {
+            a.tf = [(0, look.sweep.0), (last, look.sweep.1)]
+                .into_iter()
+                .map(|(frame, shift)| TfKey {
+                    frame,
+                    blend: None,
+                    shift: Some(shift),
+                    interpolation: Interpolation::Linear,
+                })
+                .collect();
+        }
+        "dolly" => {
+            a.camera = vec![CameraKey {
+                frame: last,
+                position: Some(CameraSpec::default().position * 0.8),
+                target: None,
+                fov_y_degrees: None,
+                interpolation: Interpolation::Linear,
+            }];
         }
         "tf-jump" => {
             a.tf = vec![
                 TfKey {
                     frame: 0,
-                    blend: 0.0,
+                    blend: Some(0.0),
+                    shift: None,
                     interpolation: Interpolation::Step,
                 },
                 TfKey {
                     frame: mid,
-                    blend: 1.0,
+                    blend: Some(1.0),
+                    shift: None,
                     interpolation: Interpolation::Linear,
                 },
             ];
@@ -268,8 +305,8 @@ pub(crate) fn build(name: &str) -> Result<Scene, SceneError> {
         .into_iter()
         .find(|d| d.name() == dataset)
         .ok_or_else(unknown)?;
-    let (lights, animation) = script(animation).ok_or_else(unknown)?;
     let look = look(dataset);
+    let (lights, animation) = script(animation, &look).ok_or_else(unknown)?;
     let origin = format!("built-in scene {name}");
     let ctx = Ctx {
         origin: &origin,

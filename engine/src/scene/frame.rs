@@ -36,6 +36,8 @@ pub struct FrameState {
     /// Blend between `transfer.a` (0) and `transfer.b` (1): the TF in effect is
     /// `TfLut::lerp(a, b, tf_blend)`. Always 0 without `transfer.b`.
     pub tf_blend: f32,
+    /// How far that TF slides along the density axis (`TfLut::shifted`).
+    pub tf_shift: f32,
 }
 
 /// What differs between two frame states.
@@ -59,7 +61,7 @@ pub fn changed(a: &FrameState, b: &FrameState) -> Change {
     Change {
         camera: a.camera != b.camera,
         lights: a.lights != b.lights,
-        tf: a.tf_blend != b.tf_blend,
+        tf: a.tf_blend != b.tf_blend || a.tf_shift != b.tf_shift,
     }
 }
 
@@ -94,7 +96,10 @@ impl Scene {
         }
 
         let tf_blend = if self.tf_b.is_some() {
-            let keys = anim.tf.iter().map(|k| (k.frame, k.interpolation, k.blend));
+            let keys = anim
+                .tf
+                .iter()
+                .filter_map(|k| Some((k.frame, k.interpolation, k.blend?)));
             track(0.0, keys, f)
         } else {
             0.0
@@ -105,6 +110,14 @@ impl Scene {
             camera: self.camera_at(f).camera(),
             lights,
             tf_blend: tf_blend.clamp(0.0, 1.0) as f32,
+            tf_shift: track(
+                0.0,
+                anim.tf
+                    .iter()
+                    .filter_map(|k| Some((k.frame, k.interpolation, k.shift?))),
+                f,
+            )
+            .clamp(-1.0, 1.0) as f32,
         }
     }
 

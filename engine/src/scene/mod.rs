@@ -1,7 +1,7 @@
 //! Scenes: what to render (volume, transfer functions, camera, lights, render settings)
 //! and how it moves over a scripted sequence of frames.
 //!
-//! A scene is a TOML file, or one of the 24 built-in scenes (`<dataset>/<animation>`,
+//! A scene is a TOML file, or one of the 30 built-in scenes (`<dataset>/<animation>`,
 //! see [`builtin`]). The renderer never reads the file itself: it asks a [`Scene`] for
 //! the [`FrameState`] of each frame (camera with its matrices, lights, TF blend),
 //! uploads the TF LUTs from [`Scene::tf_luts`], specialises its pipeline from
@@ -176,10 +176,11 @@ impl Scene {
         (a, b)
     }
 
-    /// The LUT in effect at a blend (a [`FrameState::tf_blend`]).
-    pub fn tf_lut(&self, blend: f32) -> TfLut {
+    /// The LUT in effect at a blend and shift ([`FrameState::tf_blend`],
+    /// [`FrameState::tf_shift`]).
+    pub fn tf_lut(&self, blend: f32, shift: f32) -> TfLut {
         let (a, b) = self.tf_luts();
-        TfLut::lerp(&a, &b, blend)
+        TfLut::lerp(&a, &b, blend).shifted(shift)
     }
 
     pub(crate) fn check(&self, ctx: &Ctx) -> Result<(), SceneError> {

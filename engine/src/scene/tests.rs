@@ -43,9 +43,9 @@ fn parse_err(text: &str) -> String {
 }
 
 #[test]
-fn there_are_24_builtins_and_all_are_valid() {
+fn there_are_30_builtins_and_all_are_valid() {
     let names = Scene::builtin_names();
-    assert_eq!(names.len(), 24);
+    assert_eq!(names.len(), 30);
     for dataset in ["phantom", "mri", "cloud"] {
         for anim in builtin::ANIMATIONS {
             assert!(names.contains(&format!("{dataset}/{anim}")));
@@ -177,8 +177,8 @@ fn tf_edit_blends_smoothly_and_the_lut_follows() {
     assert_eq!(*blends.last().expect("frames"), 1.0);
     assert!(blends.windows(2).all(|w| w[1] > w[0] && w[1] - w[0] < 0.05));
     let (a, b) = s.tf_luts();
-    assert_eq!(s.tf_lut(0.0), a);
-    assert_eq!(s.tf_lut(1.0), b);
+    assert_eq!(s.tf_lut(0.0, 0.0), a);
+    assert_eq!(s.tf_lut(1.0, 0.0), b);
     assert!(s.features().tf_blend);
     assert!(!builtin("phantom/orbit").features().tf_blend);
 }
@@ -365,6 +365,16 @@ fn errors_name_the_file_and_the_field() {
         ("b = \"cloud-edit\"", "", "bad.toml: animation.tf[0].blend:|transfer.b"),
         (
             "frames = 10",
+            "frames = 10\n[[animation.tf]]\nframe = 1\nshift = 1.5",
+            "bad.toml: animation.tf[0].shift:|[-1, 1]",
+        ),
+        (
+            "frames = 10",
+            "frames = 10\n[[animation.tf]]\nframe = 1",
+            "bad.toml: animation.tf[0].blend:|blend, shift or both",
+        ),
+        (
+            "frames = 10",
             "frames = 10\n[animation.orbit]\ndegrees_per_frame = 2\n[[animation.camera]]\nframe = 0\nposition = [1, 1, 1]",
             "bad.toml: animation.camera[0].position:|orbit",
         ),
@@ -548,6 +558,13 @@ fn nonsense_values_are_refused_with_their_range() {
             ),
             &["animation.tf[1].frame"],
         ),
+        (
+            with(
+                "frames = 10",
+                "frames = 10\n[[animation.tf]]\nframe = 3\nshift = 0.1\n[[animation.tf]]\nframe = 3\nblend = 1.0\nshift = 0.2",
+            ),
+            &["animation.tf[1].frame", "also the frame of animation.tf[0]"],
+        ),
     ] {
         let msg = parse_err(&text);
         assert!(msg.starts_with("bad.toml: "), "{msg}");
@@ -555,6 +572,21 @@ fn nonsense_values_are_refused_with_their_range() {
             assert!(msg.contains(n), "message should mention {n:?}: {msg}");
         }
     }
+}
+
+/// A blend keyframe and a shift keyframe on one frame set different tracks (each with
+/// its own interpolation), so both hold whatever their order in the file.
+#[test]
+fn tf_blend_and_shift_keys_may_share_a_frame() {
+    let text = MINIMAL.replacen(
+        "frames = 10",
+        "frames = 10\n[[animation.tf]]\nframe = 4\nblend = 1.0\ninterpolation = \"step\"\n\
+         [[animation.tf]]\nframe = 4\nshift = 0.25",
+        1,
+    );
+    let scene = Scene::from_toml_str(&text, "ok.toml").expect("blend and shift keys");
+    let s = scene.frame_state(4);
+    assert_eq!((s.tf_blend, s.tf_shift), (1.0, 0.25));
 }
 
 #[test]

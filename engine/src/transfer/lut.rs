@@ -90,6 +90,33 @@ impl TfLut {
         }
     }
 
+    /// The same table slid along the density axis by `shift` (a fraction of the density
+    /// range): entry `d` holds this table at `d − shift`, linearly interpolated and held
+    /// at the ends, so a positive shift moves every feature to higher densities (a
+    /// window sliding up). This is how a window sweep is animated.
+    pub fn shifted(&self, shift: f32) -> Self {
+        let n = self.len();
+        if n < 2 || shift == 0.0 || !shift.is_finite() {
+            return self.clone();
+        }
+        let last = (n - 1) as f32;
+        let row = |x: &[[f32; 4]]| -> Vec<[f32; 4]> {
+            (0..n)
+                .map(|i| {
+                    let at = ((i as f32 / last - shift) * last).clamp(0.0, last);
+                    let k = (at.floor() as usize).min(n - 2);
+                    let t = at - k as f32;
+                    std::array::from_fn(|c| x[k][c] * (1.0 - t) + x[k + 1][c] * t)
+                })
+                .collect()
+        };
+        Self {
+            diffuse_opacity: row(&self.diffuse_opacity),
+            specular_roughness: row(&self.specular_roughness),
+            emissive: row(&self.emissive),
+        }
+    }
+
     /// The largest absolute difference between corresponding entries (infinite if the
     /// lengths differ). For tests and tolerances.
     pub fn max_abs_diff(&self, other: &Self) -> f32 {
@@ -131,6 +158,39 @@ mod tests {
         let h = TfLut::lerp(&a, &b, 0.5);
         assert!((h.diffuse_opacity[LUT_SIZE - 1][3] - 0.7).abs() < 1e-6);
         assert!((h.diffuse_opacity[7][0] - 0.6).abs() < 1e-6);
+    }
+
+    #[test]
+    fn shifting_slides_the_table_along_density() {
+        let ramp = TransferFunction {
+            name: "ramp".into(),
+            points: vec![
+                ControlPoint::new(0.0, 0.0, [1.0; 3]),
+                ControlPoint::new(0.5, 0.0, [1.0; 3]),
+                ControlPoint::new(0.6, 1.0, [1.0; 3]),
+                ControlPoint::new(1.0, 1.0, [1.0; 3]),
+            ],
+        }
+        .lut();
+        assert_eq!(ramp.shifted(0.0), ramp);
+        let up = ramp.shifted(0.2);
+        let opacity_at = |l: &TfLut, d: f32| l.diffuse_opacity[(d * 255.0).round() as usize][3];
+        // The edge moves from 0.5–0.6 to 0.7–0.8; the ends are held.
+        assert!(opacity_at(&up, 0.69) < 1e-3, "{}", opacity_at(&up, 0.69));
+        assert!(
+            (opacity_at(&up, 0.75) - 0.5).abs() < 0.02,
+            "{}",
+            opacity_at(&up, 0.75)
+        );
+        assert!((opacity_at(&up, 0.81) - 1.0).abs() < 1e-3);
+        assert_eq!(opacity_at(&up, 1.0), 1.0);
+        let down = ramp.shifted(-0.2);
+        assert!(
+            (opacity_at(&down, 0.35) - 0.5).abs() < 0.02,
+            "{}",
+            opacity_at(&down, 0.35)
+        );
+        assert_eq!(opacity_at(&down, 0.0), 0.0);
     }
 
     #[test]

@@ -19,8 +19,11 @@ layout(binding = 22) uniform sampler2D position_prev;
 layout(constant_id = 8) const int MOTION_SOURCE = 0;
 
 struct Reprojection {
-    vec2 uv;     // last frame's texture coordinate of this pixel's surface
-    bool valid;  // on screen, same surface, history exists
+    vec2 uv;        // last frame's texture coordinate of this pixel's surface
+    bool valid;     // on screen, same surface, history exists
+    ivec2 tap;      // the first (lower-left) texel of the bilinear footprint at uv
+    vec4 weights;   // bilinear weights of taps (0,0) (1,0) (0,1) (1,1), zero for a tap
+                    // that is not this pixel's surface, renormalised (see history_fetch)
 };
 
 vec2 to_pixel(mat4 view_proj, vec3 world, ivec2 size) {
@@ -28,16 +31,36 @@ vec2 to_pixel(mat4 view_proj, vec3 world, ivec2 size) {
     return (clip.xy / max(clip.w, 1e-6) * 0.5 + 0.5) * vec2(size);
 }
 
-// Disocclusion by a screen-space round trip: what was at the reprojected place last
-// frame must have moved on screen as this pixel's surface did (within `tolerance`
-// pixels). Unlike comparing world positions, this tolerates the stochastic depth and the
-// jittered sample position of the first real collision in semi-transparent media (with a
-// still camera every point's motion is zero; under motion a depth error only changes it
-// by its parallax), and it also tests pixels whose ray missed this frame: a background
-// pixel where the object was last frame compares the object's motion with the
-// background's, so no colour is dragged into the background. Where last frame's ray
-// missed but this one hit, only a still pixel keeps its history (a semi-transparent
-// pixel whose first collision comes and goes), anything moving is a disocclusion.
+// Whether last frame's texel `tap` showed this pixel's surface: a screen-space round
+// trip. What was there last frame must have moved on screen as this pixel's surface did
+// (within `tolerance` pixels). Unlike comparing world positions, this tolerates the
+// stochastic depth and the jittered sample position of the first real collision in
+// semi-transparent media (with a still camera every point's motion is zero; under motion
+// a depth error only changes it by its parallax), and it also tests pixels whose ray
+// missed this frame: a background pixel where the object was last frame compares the
+// object's motion with the background's, so no colour is dragged into the background.
+// Where last frame's ray missed but this one hit, only a still pixel keeps its history
+// (a semi-transparent pixel whose first collision comes and goes), anything moving is a
+// disocclusion.
+bool same_surface(ivec2 tap, vec2 delta, bool hit_now, float tolerance, ivec2 size) {
+    vec4 prev = texelFetch(position_prev, tap, 0);
+    if (prev.w > 0.0) {
+        // Compare displacements, not places: that point's own motion must carry it from
+        // where it was last frame to where it is now as this pixel's motion does. The
+        // first real collision comes from a jittered sample (the pixel filter reaches
+        // beyond the pixel), so comparing places would reject still pixels at random;
+        // with a deterministic position the two tests agree.
+        vec2 was = to_pixel(frame.prev_view_proj, prev.xyz, size);
+        vec2 back = to_pixel(frame.view_proj, prev.xyz, size);
+        return length(back - was + delta) <= tolerance;
+    }
+    return !hit_now || length(delta) <= tolerance;
+}
+
+// Where this pixel's surface was last frame and which texels of the bilinear footprint
+// there still show it. Each tap is tested on its own, so a footprint straddling a
+// silhouette fetches only the texels of this pixel's side (a plain bilinear fetch there
+// leaks the other side's history a little every frame: a halo that trails the motion).
 Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, float tolerance) {
     Reprojection r;
     vec4 m = imageLoad(motion, p);
@@ -45,23 +68,35 @@ Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, flo
     vec2 q = vec2(p) + 0.5 + delta;
     r.uv = q / vec2(size);
     r.valid = history_valid && all(greaterThanEqual(q, vec2(0.0))) && all(lessThan(q, vec2(size)));
-    if (r.valid) {
-        vec4 cur = imageLoad(position_cur, p);
-        vec4 prev = texelFetch(position_prev, ivec2(q), 0);
-        if (prev.w > 0.0) {
-            // Compare displacements, not places: that point's own motion must carry it
-            // from where it was last frame to where it is now as this pixel's motion
-            // does. The first real collision comes from a jittered sample (the pixel
-            // filter reaches beyond the pixel), so comparing places would reject still
-            // pixels at random; with a deterministic position the two tests agree.
-            vec2 was = to_pixel(frame.prev_view_proj, prev.xyz, size);
-            vec2 back = to_pixel(frame.view_proj, prev.xyz, size);
-            r.valid = length(back - was + delta) <= tolerance;
-        } else if (cur.w > 0.0) {
-            r.valid = length(delta) <= tolerance;
-        }
+    r.tap = ivec2(floor(q - 0.5));
+    r.weights = vec4(0.0);
+    if (!r.valid) return r;
+    bool hit_now = imageLoad(position_cur, p).w > 0.0;
+    vec2 f = q - 0.5 - vec2(r.tap);
+    vec4 bilinear = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    const ivec2 offsets[4] = ivec2[](ivec2(0, 0), ivec2(1, 0), ivec2(0, 1), ivec2(1, 1));
+    for (int i = 0; i < 4; ++i) {
+        ivec2 t = r.tap + offsets[i];
+        bool inside = all(greaterThanEqual(t, ivec2(0))) && all(lessThan(t, size));
+        if (inside && same_surface(t, delta, hit_now, tolerance, size)) r.weights[i] = bilinear[i];
     }
+    float total = dot(r.weights, vec4(1.0));
+    // The nearest texel decides whether there is a history at all (as a nearest-texel
+    // test would); the weights then use whichever taps agree.
+    r.valid = total > 0.0 && same_surface(ivec2(q), delta, hit_now, tolerance, size);
+    r.weights = r.valid ? r.weights / total : vec4(0.0);
     return r;
+}
+
+// A history texel blend over the taps of `r` that show this pixel's surface.
+vec4 history_fetch(sampler2D history, Reprojection r) {
+    const ivec2 offsets[4] = ivec2[](ivec2(0, 0), ivec2(1, 0), ivec2(0, 1), ivec2(1, 1));
+    ivec2 hi = textureSize(history, 0) - 1;
+    vec4 sum = vec4(0.0);
+    for (int i = 0; i < 4; ++i) {
+        if (r.weights[i] > 0.0) sum += r.weights[i] * texelFetch(history, clamp(r.tap + offsets[i], ivec2(0), hi), 0);
+    }
+    return sum;
 }
 
 #endif
