@@ -6,6 +6,7 @@
 
 pub mod denoise;
 pub mod error;
+pub mod files;
 pub mod gpu;
 pub mod graph;
 pub mod image_io;

@@ -33,7 +33,7 @@ mod html;
 mod images;
 mod overlap;
 pub mod plots;
-mod reference;
+pub(crate) mod reference;
 pub mod run;
 mod scenes;
 mod score;
@@ -42,7 +42,7 @@ mod videos;
 
 pub use plots::init_font;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -69,10 +69,11 @@ pub struct EvalArgs {
     pub frames: Option<u32>,
     /// Samples per pixel per frame of the noisy input (default: the scene's, 2 for
     /// built-ins).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::setup::parse_spp)]
     pub spp: Option<u32>,
-    /// Samples per pixel of the references.
-    #[arg(long = "ref-spp", default_value_t = 1024)]
+    /// Samples per pixel of the references (at least 1).
+    #[arg(long = "ref-spp", default_value_t = 1024,
+          value_parser = clap::value_parser!(u32).range(1..))]
     pub ref_spp: u32,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256", value_parser = crate::setup::parse_size)]
@@ -83,8 +84,8 @@ pub struct EvalArgs {
     /// Output folder (references in it are reused when their settings match).
     #[arg(long, default_value = "out/eval")]
     pub out: PathBuf,
-    /// Edge length of procedural volumes (phantom, cloud).
-    #[arg(long, default_value_t = 128)]
+    /// Edge length of procedural volumes (phantom, cloud), 8 to 4096.
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Position the temporal denoisers reproject with: `first-hit` or `features` (as
     /// for `dvr capture`; references do not depend on it).
@@ -100,9 +101,6 @@ pub struct EvalArgs {
 /// Runs the eval; returns where its time went.
 pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     let started = Instant::now();
-    if args.ref_spp == 0 {
-        bail!("--ref-spp must be at least 1");
-    }
     let methods = crate::setup::denoiser_list(&args.denoiser)?;
     // Fail before hours of rendering, not after: the plots need a font, videos ffmpeg.
     plots::init_font()?;

@@ -90,10 +90,10 @@ pub struct ExploreArgs {
     #[arg(long)]
     pub script: Option<String>,
     /// Samples per pixel per frame (default: the scene's).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::setup::parse_spp)]
     pub spp: Option<u32>,
-    /// Edge length of procedural volumes (phantom, cloud).
-    #[arg(long, default_value_t = 128)]
+    /// Edge length of procedural volumes (phantom, cloud), 8 to 4096.
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Where motion vectors come from: `features` (opacity-threshold surface) or
     /// `first-hit` (closest first real collision), as for the other commands.
@@ -769,14 +769,9 @@ fn save_screenshot(path: &Path, s: &Screenshot) -> Result<()> {
         .chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])
         .collect();
-    image::save_buffer(
-        path,
-        &rgb,
-        s.width,
-        s.height,
-        image::ExtendedColorType::Rgb8,
-    )
-    .with_context(|| format!("writing {}", path.display()))
+    let png = dvr_engine::image_io::encode_srgb8_png(path, s.width, s.height, &rgb)?;
+    dvr_engine::image_io::write_file(path, &png, dvr_engine::files::Durability::Renamed)
+        .with_context(|| format!("writing {}", path.display()))
 }
 
 impl ApplicationHandler for Explorer {

@@ -415,7 +415,7 @@ impl Renderer {
                 self.bricks.brick as i32,
             ),
             counts: glam::IVec4::new(
-                inputs.lights.len().min(MAX_LIGHTS) as i32,
+                inputs.lights.len() as i32,
                 self.frame_index as i32,
                 s.spp as i32,
                 s.max_bounces as i32,
@@ -451,6 +451,7 @@ impl Renderer {
         request: &FrameRequest,
         present: Option<&PresentTarget<'_>>,
     ) -> Result<Option<FrameResult>> {
+        check_light_count(inputs)?;
         let slot = (self.frame_index % SLOTS as u64) as usize;
         let completed = self.wait_slot(slot)?;
         if present.is_some() && self.passes.present.is_none() {
@@ -678,6 +679,13 @@ impl Renderer {
         batch: u32,
     ) -> Result<Vec<[f32; 4]>> {
         self.flush()?;
+        check_light_count(inputs)?;
+        if spp == 0 {
+            return Err(EngineError::Pass {
+                pass: "reference.path_trace".into(),
+                problem: "a reference needs at least 1 sample per pixel".into(),
+            });
+        }
         let batch = batch.clamp(1, spp.clamp(1, self.samples_per_dispatch()));
         self.graph.reset_history("reference.");
         let mut done = 0;
@@ -737,6 +745,21 @@ impl Renderer {
         }
         Ok(image)
     }
+}
+
+/// The light array of the frame uniforms holds [`MAX_LIGHTS`]: more is an error, never
+/// a silent drop (scenes are checked against the same limit when loaded).
+fn check_light_count(inputs: &FrameInputs) -> Result<()> {
+    if inputs.lights.len() > MAX_LIGHTS {
+        return Err(EngineError::Pass {
+            pass: "path_trace".into(),
+            problem: format!(
+                "{} lights; the path tracer takes at most {MAX_LIGHTS}",
+                inputs.lights.len()
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// The rgba32f pixels of a host-visible readback buffer.

@@ -5,8 +5,8 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{IVec4, Mat4, UVec4, Vec4};
 
-/// Mirrors `frame.glsl`'s MAX_LIGHTS.
-pub const MAX_LIGHTS: usize = 4;
+/// Mirrors `frame.glsl`'s MAX_LIGHTS (scenes are checked against the same number).
+pub use crate::scene::light::MAX_LIGHTS;
 pub const LIGHT_POINT: f32 = 0.0;
 pub const LIGHT_AREA: f32 = 1.0;
 pub const LIGHT_ENV: f32 = 2.0;

@@ -65,6 +65,17 @@ pub struct RenderSettings {
 /// Cap on `max_bounces`: far past any useful value, low enough to bound a frame's cost.
 pub const MAX_BOUNCES_LIMIT: u32 = 64;
 
+/// Most samples per pixel per frame a scene (or `--spp`) may ask for: a real-time
+/// budget, far past the 1–2 the denoisers are made for; references take more through
+/// `--ref-spp`. A device may allow fewer: the renderer says so, naming it (lavapipe
+/// takes 4, see `renderer::MAX_SAMPLES_PER_DISPATCH`).
+pub const MAX_SPP: u32 = 64;
+
+/// Ray-march step range in voxels: below it a frame takes minutes, above it the march
+/// steps over the volume.
+pub const MIN_STEP_VOXELS: f64 = 0.05;
+pub const MAX_STEP_VOXELS: f64 = 10.0;
+
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
@@ -82,8 +93,24 @@ impl Default for RenderSettings {
 
 impl RenderSettings {
     pub(crate) fn check(&self, ctx: &Ctx) -> Result<(), SceneError> {
-        if self.spp == 0 {
-            return Err(ctx.invalid("render.spp", "must be at least 1"));
+        if !(1..=MAX_SPP).contains(&self.spp) {
+            return Err(ctx.invalid(
+                "render.spp",
+                format!(
+                    "{} is outside 1..={MAX_SPP} samples per pixel per frame (references take \
+                     more through `--ref-spp`)",
+                    self.spp
+                ),
+            ));
+        }
+        if self.russian_roulette_depth > MAX_BOUNCES_LIMIT {
+            return Err(ctx.invalid(
+                "render.russian_roulette_depth",
+                format!(
+                    "{} is outside 0..={MAX_BOUNCES_LIMIT} (the bounce limit)",
+                    self.russian_roulette_depth
+                ),
+            ));
         }
         if self.max_bounces > MAX_BOUNCES_LIMIT {
             return Err(ctx.invalid(
@@ -97,6 +124,12 @@ impl RenderSettings {
         if !(self.hg_g.is_finite() && self.hg_g > -1.0 && self.hg_g < 1.0) {
             return Err(ctx.invalid("render.hg_g", format!("{} must be in (-1, 1)", self.hg_g)));
         }
-        ctx.positive("render.step_size", self.step_size)
+        ctx.in_range(
+            "render.step_size",
+            self.step_size,
+            MIN_STEP_VOXELS,
+            MAX_STEP_VOXELS,
+            " voxels (ray-march step; 0.5 is the default)",
+        )
     }
 }

@@ -8,10 +8,8 @@
 //! normalisation. 4D files are read only when the extra dimensions have size 1. The
 //! orientation (qform/sform) is ignored: voxels keep the file's index order.
 
-use std::io::Read;
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
-
-use flate2::read::MultiGzDecoder;
 
 use super::error::VolumeError;
 use super::samples::{Affine, Rescale, SampleKind, Samples, Stored};
@@ -32,12 +30,22 @@ struct Header {
     rescale: Affine,
 }
 
-/// Loads a `.nii` or `.nii.gz` file.
+/// Loads a `.nii` or `.nii.gz` file. The header is read and checked first; the data
+/// after it is read only up to what the header's dims promise (one byte more, to tell a
+/// too-long file), so a huge or endless file costs no more memory than its volume.
 pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
-    let file = io::read_all(path)?;
-    let gz = file.starts_with(&[0x1f, 0x8b]);
+    let (file, len) = io::open_regular(path)?;
+    let io_err = |source| VolumeError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut reader = BufReader::new(file);
+    let gz = reader
+        .fill_buf()
+        .map_err(io_err)?
+        .starts_with(&[0x1f, 0x8b]);
     let (header, data) = if gz {
-        let mut dec = MultiGzDecoder::new(file.as_slice());
+        let mut dec = io::GzMembers::new(reader);
         let mut head = vec![0u8; HEADER_LEN];
         dec.read_exact(&mut head).map_err(|e| match e.kind() {
             std::io::ErrorKind::UnexpectedEof => short_header(path),
@@ -49,15 +57,29 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         let header = parse_header(path, &head)?;
         let expected = io::expected_bytes(header.dims, header.kind);
         let skip = header.vox_offset - HEADER_LEN as u64;
-        let data = io::read_bounded(path, dec, skip, expected)?;
+        let past_end = |got: u64| offset_past_end(path, header.vox_offset, HEADER_LEN as u64 + got);
+        let data = io::read_bounded(path, &mut dec, skip, expected, &past_end)?;
+        if data.len() as u64 == expected {
+            io::note_trailing_bytes(path, &dec);
+        }
         (header, data)
     } else {
-        let head = file.get(..HEADER_LEN).ok_or_else(|| short_header(path))?;
-        let header = parse_header(path, head)?;
-        let start = usize::try_from(header.vox_offset)
-            .unwrap_or(usize::MAX)
-            .min(file.len());
-        (header, file[start..].to_vec())
+        let mut head = Vec::with_capacity(HEADER_LEN);
+        (&mut reader)
+            .take(HEADER_LEN as u64)
+            .read_to_end(&mut head)
+            .map_err(io_err)?;
+        let header = parse_header(path, &head)?;
+        if header.vox_offset >= len {
+            return Err(offset_past_end(path, header.vox_offset, len));
+        }
+        // Check the size before reading, so a wrong header on a huge file fails fast.
+        io::check_len(path, header.dims, header.kind, len - header.vox_offset)?;
+        let expected = io::expected_bytes(header.dims, header.kind);
+        let skip = header.vox_offset - HEADER_LEN as u64;
+        let past_end = |got: u64| offset_past_end(path, header.vox_offset, HEADER_LEN as u64 + got);
+        let data = io::read_bounded(path, reader, skip, expected, &past_end)?;
+        (header, data)
     };
     io::check_len(path, header.dims, header.kind, data.len() as u64)?;
     let stored = Stored {
@@ -66,6 +88,17 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         rescale: Rescale::Uniform(header.rescale),
     };
     Volume::from_stored(path, name_of(path), header.dims, header.spacing, stored)
+}
+
+/// `vox_offset` at or past the end of the (decompressed) file of `len` bytes.
+fn offset_past_end(path: &Path, vox_offset: u64, len: u64) -> VolumeError {
+    VolumeError::MalformedHeader {
+        path: path.to_path_buf(),
+        field: "vox_offset".into(),
+        problem: format!(
+            "the voxel data would start at byte {vox_offset}, but the file ends at byte {len}"
+        ),
+    }
 }
 
 fn short_header(path: &Path) -> VolumeError {
@@ -378,6 +411,90 @@ mod tests {
             b[48..50].copy_from_slice(&2i16.to_le_bytes());
         });
         assert!(matches!(err, VolumeError::Unsupported { .. }), "{err}");
+    }
+
+    #[test]
+    fn header_is_checked_before_the_data_is_read() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("t4.nii");
+        write::nifti(
+            &path,
+            [5, 4, 3],
+            [1.0; 3],
+            &NiftiData::U8(vec![7; 60]),
+            None,
+        );
+        let mut b = std::fs::read(&path).expect("read");
+        b[40..42].copy_from_slice(&4i16.to_le_bytes());
+        b[48..50].copy_from_slice(&20i16.to_le_bytes());
+        write::bytes(&path, &b);
+        // An 8 GiB (sparse) 4-D file: the loader used to read all of it first.
+        let f = std::fs::OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .expect("open");
+        f.set_len(8 << 30).expect("sparse file");
+        let err = crate::volume::load_within_seconds(&path, 5).unwrap_err();
+        assert!(matches!(err, VolumeError::Unsupported { .. }), "{err}");
+        assert!(err.to_string().contains("4D NIfTI"), "{err}");
+    }
+
+    #[test]
+    fn clear_messages_for_vox_offset_pixdim_and_trailing_gzip_bytes() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        for name in ["off.nii", "off.nii.gz"] {
+            let path = dir.path().join(name);
+            let plain = dir.path().join("plain.nii");
+            write::nifti(
+                &plain,
+                [5, 4, 3],
+                [1.0; 3],
+                &NiftiData::U8(vec![7; 60]),
+                None,
+            );
+            let mut b = std::fs::read(&plain).expect("read");
+            b[108..112].copy_from_slice(&1000f32.to_le_bytes());
+            if name.ends_with(".gz") {
+                let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+                std::io::Write::write_all(&mut e, &b).expect("gzip");
+                b = e.finish().expect("gzip");
+            }
+            write::bytes(&path, &b);
+            // Used to say "truncated: expected 60 bytes of voxel data, found 0".
+            let err = Volume::load(&path, None).unwrap_err();
+            let msg = err.to_string();
+            assert!(
+                msg.contains(name) && msg.contains("vox_offset") && msg.contains("1000"),
+                "{msg}"
+            );
+        }
+
+        // pixdim 3e38 used to load (and render black).
+        let path = dir.path().join("px.nii");
+        write::nifti(
+            &path,
+            [5, 4, 3],
+            [1.0, 3e38, 1.0],
+            &NiftiData::U8(vec![7; 60]),
+            None,
+        );
+        let msg = Volume::load(&path, None).unwrap_err().to_string();
+        assert!(msg.contains("pixdim") && msg.contains("1e6"), "{msg}");
+
+        // Valid gzip followed by other bytes used to fail with "invalid gzip header".
+        let path = dir.path().join("tail.nii.gz");
+        write::nifti(
+            &path,
+            [5, 4, 3],
+            [1.0; 3],
+            &NiftiData::U8(vec![7; 60]),
+            None,
+        );
+        let mut b = std::fs::read(&path).expect("read");
+        b.extend_from_slice(&[0; 100]);
+        write::bytes(&path, &b);
+        let v = Volume::load(&path, None).expect("complete data with trailing zeros");
+        assert_eq!(v.data, VolumeData::U8(vec![7; 60]));
     }
 
     #[test]
