@@ -47,6 +47,10 @@ layout(push_constant) uniform WrlsConstantPush {
     float shrink;         // squared standard errors of the gradient ratio that halve it
     float drift_z;        // pooled residual, in standard errors, that starts to count
     float spp;            // samples per pixel of the noisy frame
+    float lambda_moving;  // forgetting factor of a pixel whose surface moved on screen
+    float pad0;
+    float pad1;
+    float pad2;
 } pc;
 
 const float P_MAX = 1e6;
@@ -60,7 +64,10 @@ void main() {
     if (!all_finite(I)) I = vec3(0.0);
 
     Reprojection r = reproject(p, size, pc.history_valid != 0u, pc.camera.xyz, pc.tolerance);
-    float lambda = pc.lambda;
+    // A moving pixel's history is only approximately the same radiance: through a
+    // semi-transparent volume the path of its ray changes with the view, so a long
+    // memory under camera motion accumulates the difference. It keeps a shorter one.
+    float lambda = length(r.motion) > 0.01 ? min(pc.lambda, pc.lambda_moving) : pc.lambda;
 
     vec3 beta = vec3(0.0);
     float P = pc.delta;
@@ -83,7 +90,7 @@ void main() {
         // under a moving light keeps a short history, a dim, noisy one a longer one.
         float sigma = sqrt(max(noise_level, 0.0) / 3.0);
         float forget = min(1.0, pc.change_gain * sc.change * luminance(beta) / (sigma + 1e-6));
-        lambda = mix(pc.lambda, pc.lambda_min, forget);
+        lambda = mix(lambda, pc.lambda_min, forget);
         if (pc.drift_valid != 0u) {
             vec4 drift = history_fetch(drift_prev, r);
             beta += significant_drift(drift, pc.drift_z);

@@ -122,6 +122,10 @@ pub struct WrlsConstantPush {
     pub shrink: f32,
     pub drift_z: f32,
     pub spp: f32,
+    pub lambda_moving: f32,
+    pub pad0: f32,
+    pub pad1: f32,
+    pub pad2: f32,
 }
 
 #[repr(C)]
@@ -416,7 +420,11 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 change_gain,
                 shrink,
                 drift_z,
-                spp
+                spp,
+                lambda_moving,
+                pad0,
+                pad1,
+                pad2
             }),
         ),
         (

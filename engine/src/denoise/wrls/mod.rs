@@ -32,6 +32,8 @@ use ash::vk;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WrlsParams {
     pub lambda: f32,
+    /// Ours' forgetting factor for a pixel whose surface moved on screen (camera motion).
+    pub lambda_moving: f32,
     pub alpha: f32,
     /// Bandwidth of the paper's relative-distance weights (`wrls-paper` only).
     pub h: f32,
@@ -76,6 +78,7 @@ impl Default for WrlsParams {
     fn default() -> Self {
         Self {
             lambda: 0.998,
+            lambda_moving: 0.9,
             alpha: 0.75,
             h: 0.75,
             delta: 100.0,
@@ -115,6 +118,7 @@ impl WrlsParams {
                 .map_err(|e| bad(format!("not a number ({e})")))?;
             let field = match name.trim() {
                 "lambda" => &mut self.lambda,
+                "lambda_moving" => &mut self.lambda_moving,
                 "alpha" => &mut self.alpha,
                 "kappa" => &mut self.kappa,
                 "change_ratio" => &mut self.change_ratio,

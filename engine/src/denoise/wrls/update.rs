@@ -69,6 +69,10 @@ impl Wrls {
             shrink: p.shrink,
             drift_z: p.drift_z,
             spp: input.spp as f32,
+            lambda_moving: p.lambda_moving,
+            pad0: 0.0,
+            pad1: 0.0,
+            pad2: 0.0,
         };
         let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
         frame.add_pass(
