@@ -1,6 +1,7 @@
 //! The offscreen commands: capture (sequences), reference (high-sample frames) and the
 //! render loop behind profile.
 
+use crate::eval::reference::{FillReport, ReferenceCache, ReferenceKey};
 use crate::profile::{self, Profile};
 use crate::progress::{FrameRate, Progress};
 use crate::setup::Setup;
@@ -102,44 +103,72 @@ pub fn capture(
     Ok(())
 }
 
+/// `dvr reference`: the same cache as `dvr eval`'s, in `out/reference/`, so a rerun with
+/// the same key reuses (or finishes) what is there.
 pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
+    // --spp above lavapipe's per-frame count most likely meant the reference's samples;
+    // counts the command line refuses (past MAX_SPP) already point to --ref-spp there.
     if let Some(n) = args.render.spp.filter(|&n| n > MAX_SAMPLES_PER_DISPATCH) {
         bail!(
             "`dvr reference` takes its samples per pixel from --ref-spp: use --ref-spp {n} \
-             (--spp is the noisy input's 1 to {MAX_SAMPLES_PER_DISPATCH} samples per frame and \
-             does not change a reference)"
+             (--spp is the noisy input's samples per frame and does not change a reference)"
         );
     }
     let setup = Setup::new(args)?;
-    let mut renderer = setup.renderer(&["none"])?;
     crate::setup::create_out_dir(out)?;
-    let dir = out.join("reference");
-    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    let started = Instant::now();
-    // As few dispatches per frame as the device takes.
-    let batch = renderer.samples_per_dispatch();
-    let mut progress = Progress::new(f64::from(setup.frames));
-    for f in 0..setup.frames {
-        let pixels = renderer.reference(&setup.inputs(f), spp, batch)?;
-        let img = to_rgb(setup.width(), setup.height(), &pixels);
-        write_exr(&dir.join(format!("{}.exr", frame_name(f as u64))), &img)?;
-        write_png(&dir.join(format!("{}.png", frame_name(f as u64))), &img)?;
-        let samples = (f + 1) as f64 * spp as f64 * setup.width() as f64 * setup.height() as f64;
-        let status = format!(
-            "reference: frame {}/{} | {:.2} Msamples/s",
-            f + 1,
-            setup.frames,
-            samples / started.elapsed().as_secs_f64() / 1e6
-        );
-        progress.advance(1.0, &status);
+    let key = ReferenceKey::new(setup.scene(), args.size, spp, args.render.volume_size)?;
+    let cache = ReferenceCache::new(out, key);
+    let mut report = ReferenceReport {
+        progress: None,
+        samples_per_frame: f64::from(spp) * f64::from(setup.width() * setup.height()),
+    };
+    cache.fill(&setup, &mut report)?;
+    if let Some(p) = &mut report.progress {
+        p.finish();
     }
-    progress.finish();
     println!(
         "wrote {} reference frames to {}",
         setup.frames,
-        dir.display()
+        cache.dir.display()
     );
     Ok(())
+}
+
+/// `dvr reference`'s progress: frames and Msamples/s on the progress line (redrawn on a
+/// terminal, whole lines in a log), notes on lines of their own.
+struct ReferenceReport {
+    /// Over the frames to render, from the first one on (none when all are reused).
+    progress: Option<Progress>,
+    samples_per_frame: f64,
+}
+
+impl FillReport for ReferenceReport {
+    fn note(&mut self, text: Option<&str>) {
+        if let Some(p) = &mut self.progress {
+            p.newline();
+        }
+        if let Some(text) = text {
+            eprintln!("reference: {text}");
+        }
+    }
+
+    fn rendered(&mut self, done: usize, of: usize) {
+        let progress = self
+            .progress
+            .get_or_insert_with(|| Progress::new(of as f64));
+        let rate = if done == 0 {
+            String::new()
+        } else {
+            let per_s = done as f64 * self.samples_per_frame / progress.elapsed();
+            format!(" | {:.2} Msamples/s", per_s / 1e6)
+        };
+        let status = format!("reference: frame {done}/{of}{rate}");
+        if done == 0 {
+            progress.show(&status);
+        } else {
+            progress.advance(1.0, &status);
+        }
+    }
 }
 
 pub fn profile(

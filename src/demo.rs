@@ -26,11 +26,11 @@ pub struct DemoArgs {
     /// Frames of the animation (default: by device).
     #[arg(long, value_parser = crate::setup::parse_frames)]
     pub frames: Option<u32>,
-    /// Samples per pixel of the references (default: by device).
-    #[arg(long = "ref-spp")]
+    /// Samples per pixel of the references (default: by device; at least 1).
+    #[arg(long = "ref-spp", value_parser = clap::value_parser!(u32).range(1..))]
     pub ref_spp: Option<u32>,
-    /// Edge length of the procedural volume.
-    #[arg(long, default_value_t = 128)]
+    /// Edge length of the procedural volume, 8 to 4096.
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Comma-separated denoisers, all fed the same noisy frames.
     #[arg(long, default_value = "none,taa,svgf,ours,rae", value_delimiter = ',')]

@@ -10,6 +10,7 @@ mod capture;
 mod demo;
 mod eval;
 mod explore;
+mod logger;
 mod profile;
 mod progress;
 mod setup;
@@ -26,6 +27,9 @@ use std::path::PathBuf;
     about = "Monte Carlo direct volume rendering with temporal denoising"
 )]
 struct Cli {
+    /// Show only errors (no warnings). `DVR_LOG=info|debug` shows more instead.
+    #[arg(long, global = true)]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -49,11 +53,13 @@ pub struct SceneArgs {
 /// How every rendering command (and the explorer) renders a scene.
 #[derive(clap::Args, Clone, Debug)]
 pub struct RenderArgs {
-    /// Samples per pixel per frame (default: the scene's, 2 for built-ins).
-    #[arg(long)]
+    /// Samples per pixel per frame, 1 to 64; lavapipe takes up to 4 (default: the
+    /// scene's, 2 for built-ins).
+    #[arg(long, value_parser = setup::parse_spp)]
     pub spp: Option<u32>,
-    /// Edge length of procedural volumes (phantom, cloud).
-    #[arg(long, default_value_t = RenderArgs::default().volume_size)]
+    /// Edge length of procedural volumes (phantom, cloud), 8 to 4096.
+    #[arg(long, default_value_t = RenderArgs::default().volume_size,
+          value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Position the temporal denoisers reproject with: `features` (opacity-threshold
     /// surface, or the expected first collision through semi-transparent layers; measured
@@ -101,8 +107,9 @@ enum Command {
     Reference {
         #[command(flatten)]
         scene: SceneArgs,
-        /// Samples per pixel of the reference.
-        #[arg(long = "ref-spp", alias = "samples", default_value_t = 1024)]
+        /// Samples per pixel of the reference (at least 1).
+        #[arg(long = "ref-spp", alias = "samples", default_value_t = 1024,
+              value_parser = clap::value_parser!(u32).range(1..))]
         ref_spp: u32,
         #[arg(long, default_value = "out/reference")]
         out: PathBuf,
@@ -138,18 +145,31 @@ enum Command {
     },
 }
 
+/// Exit status of a run that failed with an error (a bad file, value or device).
+pub const EXIT_ERROR: i32 = 1;
+/// Exit status of a command line that does not parse (clap's convention).
+pub const EXIT_USAGE: i32 = 2;
+/// Exit status when the Vulkan validation layer (`DVR_VALIDATION=1`) reported anything,
+/// even if the command otherwise succeeded.
+pub const EXIT_VALIDATION: i32 = 3;
+
 fn main() {
-    let cli = Cli::parse();
+    let cli = Cli::try_parse().unwrap_or_else(|e| {
+        let _ = e.print();
+        // --help and --version print to stdout and succeed.
+        std::process::exit(if e.use_stderr() { EXIT_USAGE } else { 0 })
+    });
+    logger::init(cli.quiet);
     let result = run(cli);
     let validation_messages = dvr_engine::gpu::validation::message_count();
     if let Err(e) = result {
         progress::end_line();
         eprintln!("dvr: error: {}", error_chain(&e));
-        std::process::exit(1);
+        std::process::exit(EXIT_ERROR);
     }
     if validation_messages > 0 {
         eprintln!("dvr: the Vulkan validation layer reported {validation_messages} message(s)");
-        std::process::exit(2);
+        std::process::exit(EXIT_VALIDATION);
     }
 }
 

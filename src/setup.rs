@@ -5,6 +5,7 @@ use crate::profile::PassStats;
 use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
 use dvr_engine::denoise::registry;
+use dvr_engine::files::Durability;
 use dvr_engine::gpu::GpuContext;
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
@@ -31,6 +32,18 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("size {s:?} must be between 1x1 and 8192x8192"));
     }
     Ok((w, h))
+}
+
+/// Parses `--spp`: samples per pixel per frame, as many as a scene's `render.spp` may
+/// ask for (the settings' own check; the device may take fewer: the renderer says so).
+pub fn parse_spp(s: &str) -> Result<u32, String> {
+    let n = s.trim().parse::<u32>().map_err(|_| {
+        format!("{s:?} is not a sample count per frame (references take more through --ref-spp)")
+    })?;
+    RenderSettings::default()
+        .set_spp(n)
+        .map_err(|e| format!("--spp {e}"))?;
+    Ok(n)
 }
 
 /// Parses `--frames`: a whole number of at least 1.
@@ -124,6 +137,11 @@ impl Setup {
         })
     }
 
+    /// The scene, after `--frames`.
+    pub fn scene(&self) -> &Scene {
+        &self.inner.scene
+    }
+
     pub fn width(&self) -> u32 {
         self.inner.config.size.width
     }
@@ -169,7 +187,7 @@ pub fn write_capture_page(
     html.push_str("<style>body{font-family:sans-serif;background:#222;color:#eee}img{image-rendering:pixelated;width:384px}figure{display:inline-block;margin:8px}td,th{padding:2px 10px;text-align:right}</style>");
     html.push_str(&format!(
         "<h1>{}</h1><p>{}×{}, {} spp/frame, {} frames</p>",
-        setup.name,
+        html_escape(&setup.name),
         setup.width(),
         setup.height(),
         setup.settings.spp(),
@@ -181,15 +199,16 @@ pub fn write_capture_page(
         setup.frames.saturating_sub(1)
     ));
     for m in methods {
+        let m = html_escape(m);
         html.push_str(&format!(
             "<figure><img class=seq data-m='{m}'><figcaption>{m}</figcaption></figure>"
         ));
     }
     if !videos.is_empty() {
-        // Denoiser names and fixed file names: nothing here needs escaping.
         html.push_str("<h2>Videos</h2><p>");
         for v in videos.iter().filter_map(|v| v.file_name()) {
-            let name = v.to_string_lossy();
+            // Denoiser names and fixed file names, escaped like every string on the page.
+            let name = html_escape(&v.to_string_lossy());
             html.push_str(&format!("<a href='videos/{name}'>{name}</a> "));
         }
         html.push_str(&format!(
@@ -203,13 +222,47 @@ pub fn write_capture_page(
     for p in passes.iter().chain(std::iter::once(total)) {
         html.push_str(&format!(
             "<tr><td style=text-align:left>{}<td>{:.3}<td>{:.3}<td>{:.3}</tr>",
-            p.pass, p.mean_ms, p.median_ms, p.p95_ms
+            html_escape(&p.pass),
+            p.mean_ms,
+            p.median_ms,
+            p.p95_ms
         ));
     }
     html.push_str(
         "</table><script>const f=document.getElementById('f'),n=document.getElementById('n');",
     );
     html.push_str("function show(){const i=String(f.value).padStart(4,'0');n.textContent=f.value;for(const im of document.querySelectorAll('img.seq'))im.src=im.dataset.m+'/'+i+'.png';}f.oninput=show;show();</script>");
-    std::fs::write(out.join("index.html"), html)
-        .with_context(|| format!("writing {}", out.join("index.html").display()))
+    let path = out.join("index.html");
+    dvr_engine::files::write_atomic(&path, html.as_bytes(), Durability::Renamed)
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// Text as HTML that shows exactly it: a scene's `name` is anyone's string, and a name
+/// like `</h1><script>…` must not run in the page.
+pub fn html_escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::html_escape;
+
+    #[test]
+    fn html_escape_leaves_no_markup() {
+        assert_eq!(
+            html_escape("a</script><script>alert('x')&\""),
+            "a&lt;/script&gt;&lt;script&gt;alert(&#39;x&#39;)&amp;&quot;"
+        );
+    }
 }

@@ -53,7 +53,7 @@ fn white_furnace_returns_the_environment() {
     let mut s = settings(8, 1);
     s.config.density_scale = 4.0;
     s.settings.set_max_bounces(1000).expect("bounces");
-    s.settings.set_russian_roulette_depth(4);
+    s.settings.set_russian_roulette_depth(4).expect("roulette");
     let volume = constant_volume(8, 1.0);
     let mut r = renderer(context(), s, &volume, &["none"]);
     let inputs = inputs(
@@ -108,7 +108,7 @@ fn henyey_greenstein_white_furnace_conserves_energy() {
     let mut s = settings(8, 1);
     s.config.density_scale = 4.0;
     s.settings.set_max_bounces(1000).expect("bounces");
-    s.settings.set_russian_roulette_depth(4);
+    s.settings.set_russian_roulette_depth(4).expect("roulette");
     s.settings.set_hg_g(0.7).expect("g");
     s.settings.set_phase(Phase::Hg);
     let volume = constant_volume(8, 1.0);

@@ -50,7 +50,7 @@ fn out_dir(name: &str) -> PathBuf {
 }
 
 /// Runs the tiny eval into `out`; fails the test if dvr fails (a validation message
-/// with DVR_VALIDATION=1 makes it exit with status 2).
+/// with DVR_VALIDATION=1 makes it exit with status 3).
 fn eval(out: &Path, frames: u32, ref_spp: u32) -> Output {
     let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
         .args(tiny_args(frames, ref_spp))

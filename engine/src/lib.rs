@@ -8,6 +8,7 @@
 pub mod assets;
 pub mod denoise;
 pub mod error;
+pub mod files;
 pub mod gpu;
 pub mod graph;
 pub mod image_io;

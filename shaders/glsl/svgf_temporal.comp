@@ -82,8 +82,8 @@ void main() {
     vec2 moments = m;
     float n = 1.0;
     if (r.valid) {
-        vec4 hc = texture(color_prev, r.uv);
-        vec4 hm = texture(moments_prev, r.uv);
+        vec4 hc = history_fetch(color_prev, r);
+        vec4 hm = history_fetch(moments_prev, r);
         if (all_finite(hc.rgb) && all_finite(hm.xyz) && hm.z >= 1.0) {
             n = min(hm.z, MAX_HISTORY) + 1.0;
             float ac = max(pc.color_alpha, 1.0 / n);

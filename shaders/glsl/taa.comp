@@ -58,7 +58,7 @@ void main() {
         }
         vec3 mean = m1 / 9.0;
         vec3 sigma = sqrt(max(m2 / 9.0 - mean * mean, vec3(0.0)));
-        vec3 history = texture(history_prev, r.uv).rgb;
+        vec3 history = history_fetch(history_prev, r).rgb;
         if (all_finite(history)) {
             // Clip the segment mean → history to the box mean ± gamma·σ.
             vec3 h = rgb_to_ycocg(history);

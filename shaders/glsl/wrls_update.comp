@@ -7,6 +7,7 @@
 #include "common.glsl"
 #include "reproject.glsl"
 #include "wrls.glsl"
+#include "wrls_change.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -31,10 +32,6 @@ layout(binding = 16) uniform sampler2D constant_prev;
 layout(binding = 17) uniform sampler2D errors_prev;
 layout(binding = 18, rgba32f) uniform writeonly image2D constant_cur;
 layout(binding = 19, rgba32f) uniform writeonly image2D errors_cur;
-// Temporal gradients (wrls_gradient.comp), per S×S stratum of last frame's image: last
-// frame's samples re-traced in this frame's scene, and what they measured last frame.
-layout(binding = 23, rgba32f) uniform readonly image2D gradient_new;
-layout(binding = 24, rgba32f) uniform readonly image2D gradient_old;
 // This pixel's prediction after the update (rgb) and its variance per channel (a), what
 // the à-trous spatial filter (wrls_atrous.comp) starts from.
 layout(binding = 25, rgba32f) uniform writeonly image2D prediction;
@@ -70,55 +67,6 @@ layout(push_constant) uniform WrlsUpdatePush {
 
 const float P_MAX = 1e6;
 
-// What the temporal gradients say about the scene around last frame's texture coordinate
-// `uv`: per channel, the ratio of this frame's radiance to last frame's (the same paths
-// traced in both scenes, summed over the 3×3 strata around it), and the relative change
-// of luminance. No measurement: ratio 1, change 0.
-struct SceneChange {
-    vec3 ratio;
-    float change;
-};
-
-SceneChange scene_change(vec2 uv, ivec2 size) {
-    SceneChange sc;
-    sc.ratio = vec3(1.0);
-    sc.change = 0.0;
-    if (pc.gradient_valid == 0u) return sc;
-    ivec2 strata = imageSize(gradient_new);
-    ivec2 centre = ivec2(floor(uv * vec2(size) / float(pc.stratum)));
-    vec3 sum_new = vec3(0.0), sum_old = vec3(0.0);
-    float nn = 0.0, no = 0.0, oo = 0.0;  // sums of products of the luminances
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-            ivec2 k = clamp(centre + ivec2(dx, dy), ivec2(0), strata - 1);
-            vec3 n = imageLoad(gradient_new, k).rgb, o = imageLoad(gradient_old, k).rgb;
-            sum_new += n;
-            sum_old += o;
-            float yn = luminance(n), yo = luminance(o);
-            nn += yn * yn;
-            no += yn * yo;
-            oo += yo * yo;
-        }
-    }
-    float y_new = luminance(sum_new), y_old = luminance(sum_old);
-    float y_max = max(y_new, y_old);
-    if (y_max <= 1e-6 || y_old <= 1e-6) return sc;
-    // The luminance ratio and its standard error from the strata's scatter about it
-    // (a ratio estimator's sandwich variance): a ratio within its noise of 1 is shrunk
-    // towards 1, so noise is not mistaken for change and the history is kept.
-    float R = y_new / y_old;
-    float scatter = max(nn - 2.0 * R * no + R * R * oo, 0.0);
-    float var_r = scatter / (y_old * y_old) * (9.0 / 8.0);
-    float t2 = (R - 1.0) * (R - 1.0);
-    float keep = t2 / (t2 + pc.shrink * var_r + 1e-12);
-    sc.change = keep * abs(y_new - y_old) / y_max;
-    // Channels far darker than the luminance are damped towards no change.
-    float eps = 0.01 * y_max;
-    vec3 ratio = clamp((sum_new + eps) / (sum_old + eps), vec3(0.25), vec3(4.0));
-    sc.ratio = mix(vec3(1.0), ratio, keep);
-    return sc;
-}
-
 // P of a model that has seen nothing: δ·I over the predictor's dimensions.
 mat4 initial_p() {
     return USE_FEATURE ? mat4(pc.delta) : mat4(pc.delta, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0);
@@ -149,7 +97,7 @@ void main() {
     float streak = 0.0;        // consecutive frames far above the noise level
     vec4 constant = vec4(0.0, 0.0, 0.0, pc.delta);
     vec3 errors = vec3(-1.0, -1.0, 0.0);  // a-priori errors (const, feature), const streak
-    SceneChange sc = scene_change(r.uv, size);
+    SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink);
     // Forgetting in proportion to the measured change: a still scene keeps λ, a sudden
     // change falls to λ_min (what the scaling below did not explain is learned anew).
     float lambda = mix(pc.lambda_min, pc.lambda, 1.0 - min(1.0, pc.change_gain * sc.change));
@@ -184,11 +132,9 @@ void main() {
         // constant term (a drift too slow for one pixel's change test, a view-dependent
         // change under camera motion, a change the gradients did not see).
         if (pc.drift_valid != 0u) {
-            vec4 d = history_fetch(drift_prev, r);
-            float z2 = dot(d.rgb, d.rgb) / 3.0 / max(d.a, 1e-12);
-            float s = smoothstep(pc.drift_z * pc.drift_z, 4.0 * pc.drift_z * pc.drift_z, z2);
-            for (int c = 0; c < 3; ++c) beta[c].x += s * d[c];
-            constant.rgb += s * d.rgb;
+            vec3 d = significant_drift(history_fetch(drift_prev, r), pc.drift_z);
+            for (int c = 0; c < 3; ++c) beta[c].x += d[c];
+            constant.rgb += d;
         }
     } else {
         // A new surface: start the models over.

@@ -43,7 +43,7 @@ pub struct BenchArgs {
     #[arg(long, default_value = crate::setup::DEFAULT_SCENE)]
     pub scene: String,
     /// Frames per profile.
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, value_parser = crate::setup::parse_frames)]
     pub frames: u32,
     /// Denoisers to profile and evaluate (default: every one).
     #[arg(long, value_delimiter = ',')]
@@ -55,13 +55,14 @@ pub struct BenchArgs {
     #[arg(long, default_value = "256x256", value_parser = crate::setup::parse_size)]
     pub eval_size: (u32, u32),
     /// Frames of each eval scene (default: each scene's own length).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::setup::parse_frames)]
     pub eval_frames: Option<u32>,
-    /// Samples per pixel of the eval's references.
-    #[arg(long = "ref-spp", default_value_t = 1024)]
+    /// Samples per pixel of the eval's references (at least 1).
+    #[arg(long = "ref-spp", default_value_t = 1024,
+          value_parser = clap::value_parser!(u32).range(1..))]
     pub ref_spp: u32,
-    /// Edge length of procedural volumes (phantom, cloud).
-    #[arg(long, default_value_t = 128)]
+    /// Edge length of procedural volumes (phantom, cloud), 8 to 4096.
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Profile only.
     #[arg(long)]
@@ -211,7 +212,12 @@ fn run_eval<'a>(args: &'a BenchArgs, denoisers: &[String]) -> Result<EvalRecord<
 }
 
 fn write(path: &Path, text: &str) -> Result<()> {
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+    dvr_engine::files::write_atomic(
+        path,
+        text.as_bytes(),
+        dvr_engine::files::Durability::Renamed,
+    )
+    .with_context(|| format!("writing {}", path.display()))
 }
 
 fn opt(v: Option<f64>) -> String {

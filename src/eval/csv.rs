@@ -153,9 +153,12 @@ fn opt(v: Option<f64>, digits: usize) -> String {
 
 fn write(path: &Path, text: &str) -> Result<()> {
     // Write then rename: a reader (or an interruption) never sees half a table.
-    let tmp = path.with_extension("csv.partial");
-    std::fs::write(&tmp, text).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))
+    dvr_engine::files::write_atomic(
+        path,
+        text.as_bytes(),
+        dvr_engine::files::Durability::Renamed,
+    )
+    .with_context(|| format!("writing {}", path.display()))
 }
 
 pub fn metrics_csv(results: &[SceneResult]) -> String {

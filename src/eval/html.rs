@@ -152,8 +152,13 @@ pub fn write_page(
     results: &[SceneResult],
     overall: &[Overall],
 ) -> Result<()> {
-    std::fs::write(path, page(info, results, overall))
-        .with_context(|| format!("writing {}", path.display()))
+    let html = page(info, results, overall);
+    dvr_engine::files::write_atomic(
+        path,
+        html.as_bytes(),
+        dvr_engine::files::Durability::Renamed,
+    )
+    .with_context(|| format!("writing {}", path.display()))
 }
 
 #[cfg(test)]
@@ -215,5 +220,29 @@ mod tests {
             .as_str()
             .unwrap()
             .ends_with("/plots/psnr.svg"));
+    }
+
+    /// Scene names come from scene files: every place the page's script puts a data
+    /// string into HTML escapes it (the JSON itself is script-safe, see above).
+    #[test]
+    fn the_script_escapes_every_data_string_it_puts_into_html() {
+        assert!(TEMPLATE.contains("function esc(v)"));
+        for used in [
+            "${esc(s.name)}",
+            "${esc(m)}",
+            "${esc(r.method)}",
+            "${esc(text)}",
+            "${esc(DATA.device)}",
+        ] {
+            assert!(TEMPLATE.contains(used), "{used}");
+        }
+        for raw in [
+            ">${s.name}</option>",
+            "</span>${r.method}</td>",
+            "device ${DATA.device}",
+            ">${m}</option>",
+        ] {
+            assert!(!TEMPLATE.contains(raw), "{raw} unescaped");
+        }
     }
 }

@@ -15,7 +15,9 @@ pub fn write_flip_png(path: &Path, width: u32, height: u32, map: &[f32]) -> Resu
     save_rgb8(path, width, height, &bytes)
 }
 
+/// Writes 8-bit sRGB pixels as a PNG, atomically.
 pub fn save_rgb8(path: &Path, width: u32, height: u32, bytes: &[u8]) -> Result<()> {
-    image::save_buffer(path, bytes, width, height, image::ExtendedColorType::Rgb8)
+    let png = dvr_engine::image_io::encode_srgb8_png(path, width, height, bytes)?;
+    dvr_engine::image_io::write_file(path, &png, dvr_engine::files::Durability::Renamed)
         .with_context(|| format!("writing {}", path.display()))
 }

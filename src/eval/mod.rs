@@ -33,7 +33,7 @@ mod html;
 mod images;
 mod overlap;
 pub mod plots;
-mod reference;
+pub(crate) mod reference;
 pub mod run;
 mod scenes;
 mod score;
@@ -42,7 +42,7 @@ mod videos;
 
 pub use plots::init_font;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -67,8 +67,9 @@ pub struct EvalArgs {
     /// Frames of each animation (default: each scene's own length).
     #[arg(long, value_parser = crate::setup::parse_frames)]
     pub frames: Option<u32>,
-    /// Samples per pixel of the references.
-    #[arg(long = "ref-spp", default_value_t = 1024)]
+    /// Samples per pixel of the references (at least 1).
+    #[arg(long = "ref-spp", default_value_t = 1024,
+          value_parser = clap::value_parser!(u32).range(1..))]
     pub ref_spp: u32,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256", value_parser = crate::setup::parse_size)]
@@ -91,9 +92,6 @@ pub struct EvalArgs {
 /// Runs the eval; returns where its time went.
 pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     let started = Instant::now();
-    if args.ref_spp == 0 {
-        bail!("--ref-spp must be at least 1");
-    }
     let methods = crate::setup::denoiser_list(&args.denoiser)?;
     // Fail before hours of rendering, not after: the plots need a font, videos ffmpeg.
     plots::init_font()?;

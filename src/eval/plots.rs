@@ -124,7 +124,12 @@ pub(crate) fn save(chart: &impl Chart, stem: &Path) -> Result<()> {
             .and_then(|_| root.present())
             .map_err(|e| anyhow!("drawing {}: {e}", svg_path.display()))?;
     }
-    std::fs::write(&svg_path, svg).with_context(|| format!("writing {}", svg_path.display()))?;
+    dvr_engine::files::write_atomic(
+        &svg_path,
+        svg.as_bytes(),
+        dvr_engine::files::Durability::Renamed,
+    )
+    .with_context(|| format!("writing {}", svg_path.display()))?;
 
     let png_path = stem.with_extension("png");
     let mut pixels = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];

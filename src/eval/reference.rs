@@ -1,11 +1,20 @@
-//! The reference cache: `DIR/<scene>/reference/NNNN.{exr,png}` plus `reference.json`,
-//! the settings they were rendered with. Frames are reused when the key matches, so an
-//! interrupted eval resumes where it stopped; a different key re-renders them all.
+//! The reference cache: `DIR/reference/NNNN.{exr,png}` plus `reference.json`, the key
+//! they were rendered under (`dvr eval` keeps one per scene folder, `dvr reference` one
+//! in its `--out`). Frames are reused only when the key matches and the frame reads
+//! back; a different key re-renders them all, an unreadable frame is re-rendered with a
+//! warning. The key holds a hash of the **content** of everything a reference depends
+//! on, not of names: the scene, the transfer functions it loads, the volume's voxels
+//! (whichever files they came from: NRRD data files, DICOM slices, sidecars, or a
+//! procedural generator), the environment map's texels, the path tracer's SPIR-V and
+//! the settings. Every file is written under a temporary name, flushed to disk and
+//! renamed, so an interrupted run never leaves a file that looks finished.
 
 use crate::setup::Setup;
 use anyhow::{Context, Result};
-use dvr_engine::image_io::{read_exr, to_rgb, write_exr, write_png};
+use dvr_engine::files::Durability;
+use dvr_engine::image_io::{encode_exr, encode_png, read_exr, to_rgb, write_file};
 use dvr_engine::metrics::Rgb32Image;
+use dvr_engine::renderer::scene_setup::{load_environment, load_volume};
 use dvr_engine::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -15,27 +24,34 @@ use std::path::{Path, PathBuf};
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ReferenceKey {
     pub scene: String,
-    /// FNV-1a of the scene as TOML (camera path, lights, TFs, render settings), so an
-    /// edited scene file invalidates its references.
+    /// Hash of the scene as TOML (camera path, lights, render settings, file names), so
+    /// an edited scene file invalidates its references.
     pub scene_hash: String,
+    /// Hash of what the scene's files hold: both transfer functions' control points,
+    /// the volume's dims, spacing, window and voxels, and the environment map's texels.
+    /// Editing a TF file or replacing a volume changes it though no name changes.
+    pub content_hash: String,
     pub width: u32,
     pub height: u32,
     pub frames: u32,
     pub ref_spp: u32,
     pub volume_size: u32,
-    /// FNV-1a of the SPIR-V that makes references (path tracing and accumulation), so a
+    /// Hash of the SPIR-V that makes references (path tracing and accumulation), so a
     /// change to the path tracer invalidates them.
     pub renderer_hash: String,
 }
 
 impl ReferenceKey {
+    /// The key of `scene`'s references; loads its volume and environment map to hash
+    /// their content.
     pub fn new(scene: &Scene, size: (u32, u32), ref_spp: u32, volume_size: u32) -> Result<Self> {
         let toml = scene
             .to_toml()
             .with_context(|| format!("describing scene {}", scene.name))?;
         Ok(Self {
             scene: scene.name.clone(),
-            scene_hash: format!("{:016x}", fnv1a(toml.as_bytes())),
+            scene_hash: ContentHash::of(toml.as_bytes()),
+            content_hash: content_hash(scene, volume_size)?,
             width: size.0,
             height: size.1,
             frames: scene.frames,
@@ -46,39 +62,112 @@ impl ReferenceKey {
     }
 }
 
-/// Hash of the shaders a reference depends on.
-fn renderer_hash() -> String {
-    let mut bytes = Vec::new();
-    for (name, spirv) in dvr_engine::shaders::SHADERS {
-        if matches!(*name, "path_trace" | "accumulate") {
-            bytes.extend_from_slice(name.as_bytes());
-            bytes.extend_from_slice(spirv);
-        }
+/// See [`ReferenceKey::content_hash`].
+fn content_hash(scene: &Scene, volume_size: u32) -> Result<String> {
+    let mut h = ContentHash::new();
+    h.write(scene.tf_a.to_toml().as_bytes());
+    if let Some(b) = &scene.tf_b {
+        h.write(b.to_toml().as_bytes());
     }
-    format!("{:016x}", fnv1a(&bytes))
+    let volume = load_volume(scene, volume_size)
+        .with_context(|| format!("loading the volume of {}", scene.name))?;
+    for d in volume.dims {
+        h.write(&d.to_le_bytes());
+    }
+    for x in volume.spacing.iter().chain(&volume.window) {
+        h.write(&x.to_le_bytes());
+    }
+    h.write(volume.data.as_bytes());
+    let environment = load_environment(&scene.lights)
+        .with_context(|| format!("loading the environment map of {}", scene.name))?;
+    if let Some(env) = environment {
+        h.write(&env.width.to_le_bytes());
+        h.write(&env.height.to_le_bytes());
+        let texels: Vec<u8> = env
+            .rgba
+            .iter()
+            .flatten()
+            .flat_map(|c| c.to_le_bytes())
+            .collect();
+        h.write(&texels);
+    }
+    Ok(h.finish())
 }
 
-fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
+/// Hash of the shaders a reference depends on.
+fn renderer_hash() -> String {
+    let mut h = ContentHash::new();
+    for (name, spirv) in dvr_engine::shaders::SHADERS {
+        if matches!(*name, "path_trace" | "accumulate") {
+            h.write(name.as_bytes());
+            h.write(spirv);
+        }
+    }
+    h.finish()
+}
+
+/// FNV-1a (64-bit) over 8-byte words, each chunk's length mixed in: a stable hash (the
+/// key files outlive compiler versions, unlike `std`'s hasher) that reads a gigabyte
+/// volume in well under a second. A cache key, not a signature.
+struct ContentHash(u64);
+
+impl ContentHash {
+    const PRIME: u64 = 0x0100_0000_01b3;
+
+    fn new() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+
+    fn of(bytes: &[u8]) -> String {
+        let mut h = Self::new();
+        h.write(bytes);
+        h.finish()
+    }
+
+    fn mix(&mut self, word: u64) {
+        self.0 = (self.0 ^ word).wrapping_mul(Self::PRIME);
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        self.mix(bytes.len() as u64);
+        let mut words = bytes.chunks_exact(8);
+        for w in &mut words {
+            self.mix(u64::from_le_bytes(w.try_into().unwrap_or([0; 8])));
+        }
+        for &b in words.remainder() {
+            self.mix(u64::from(b));
+        }
+    }
+
+    fn finish(&self) -> String {
+        format!("{:016x}", self.0)
+    }
 }
 
 pub fn frame_name(f: u32) -> String {
     format!("{f:04}")
 }
 
-/// One scene's reference folder.
+/// One reference folder.
 #[derive(Clone, Debug)]
 pub struct ReferenceCache {
     pub dir: PathBuf,
     key: ReferenceKey,
 }
 
+/// The cached frames that can be reused and what is wrong with the others.
+pub struct CacheState {
+    /// Frames to render: all when the key differs, else those absent or unreadable.
+    pub missing: Vec<u32>,
+    /// Frames on disk under the right key that did not read back, and why.
+    pub unreadable: Vec<(PathBuf, String)>,
+}
+
 impl ReferenceCache {
-    pub fn new(scene_dir: &Path, key: ReferenceKey) -> Self {
+    /// The cache in `parent/reference/`.
+    pub fn new(parent: &Path, key: ReferenceKey) -> Self {
         Self {
-            dir: scene_dir.join("reference"),
+            dir: parent.join("reference"),
             key,
         }
     }
@@ -89,8 +178,25 @@ impl ReferenceCache {
 
     /// What differs between the stored key and this one, for the log.
     fn change_note(&self, old: &ReferenceKey) -> String {
+        let edited = [
+            (old.scene_hash != self.key.scene_hash, "scene edited"),
+            (
+                old.content_hash != self.key.content_hash,
+                "volume, transfer function or environment map changed",
+            ),
+            (
+                old.renderer_hash != self.key.renderer_hash,
+                "path tracer changed",
+            ),
+        ];
+        let what: String = edited
+            .iter()
+            .filter(|(changed, _)| *changed)
+            .map(|(_, what)| format!(", {what}"))
+            .collect();
         format!(
-            "reference settings changed ({}x{}, {} frames, {} spp → {}x{}, {} frames, {} spp{}), re-rendering",
+            "reference settings changed ({}x{}, {} frames, {} spp → {}x{}, {} frames, {} spp{what}), \
+             re-rendering",
             old.width,
             old.height,
             old.frames,
@@ -99,14 +205,6 @@ impl ReferenceCache {
             self.key.height,
             self.key.frames,
             self.key.ref_spp,
-            match (
-                old.scene_hash != self.key.scene_hash,
-                old.renderer_hash != self.key.renderer_hash
-            ) {
-                (true, _) => ", scene edited",
-                (false, true) => ", path tracer changed",
-                _ => "",
-            }
         )
     }
 
@@ -119,7 +217,7 @@ impl ReferenceCache {
     }
 
     fn stored_key(&self) -> Option<ReferenceKey> {
-        let text = std::fs::read_to_string(self.key_path()).ok()?;
+        let text = dvr_engine::files::read_text(&self.key_path(), 1 << 16).ok()?;
         serde_json::from_str(&text).ok()
     }
 
@@ -128,12 +226,51 @@ impl ReferenceCache {
         self.stored_key().as_ref() == Some(&self.key)
     }
 
-    /// Frames still to render: all when the key differs, else those missing on disk.
+    /// Which frames are reusable: under the right key, both files present and reading
+    /// back at the key's size (a crash or a full disk can leave a cut file).
+    pub fn state(&self) -> CacheState {
+        if !self.key_matches() {
+            return CacheState {
+                missing: (0..self.key.frames).collect(),
+                unreadable: Vec::new(),
+            };
+        }
+        let mut state = CacheState {
+            missing: Vec::new(),
+            unreadable: Vec::new(),
+        };
+        for f in 0..self.key.frames {
+            let (exr, png) = (self.exr(f), self.png(f));
+            if !exr.exists() || !png.exists() {
+                state.missing.push(f);
+                continue;
+            }
+            let problem = match self.load(f) {
+                Err(e) => Some((exr, format!("{e:#}"))),
+                // Decoded whole: a cut PNG keeps a valid header.
+                Ok(_) => match image::open(&png).map(|i| (i.width(), i.height())) {
+                    Err(e) => Some((png, e.to_string())),
+                    Ok(size) if size != (self.key.width, self.key.height) => Some((
+                        png,
+                        format!(
+                            "is {}x{}, expected {}x{}",
+                            size.0, size.1, self.key.width, self.key.height
+                        ),
+                    )),
+                    Ok(_) => None,
+                },
+            };
+            if let Some(p) = problem {
+                state.missing.push(f);
+                state.unreadable.push(p);
+            }
+        }
+        state
+    }
+
+    /// Frames still to render (see [`ReferenceCache::state`]).
     pub fn missing(&self) -> Vec<u32> {
-        let matches = self.key_matches();
-        (0..self.key.frames)
-            .filter(|&f| !matches || !self.exr(f).is_file() || !self.png(f).is_file())
-            .collect()
+        self.state().missing
     }
 
     /// Makes the folder consistent with this key before rendering: a different (or
@@ -169,7 +306,7 @@ impl ReferenceCache {
             }
         }
         let json = serde_json::to_string_pretty(&self.key)?;
-        std::fs::write(self.key_path(), json)
+        dvr_engine::files::write_atomic(&self.key_path(), json.as_bytes(), Durability::Synced)
             .with_context(|| format!("writing {}", self.key_path().display()))?;
         Ok(note)
     }
@@ -187,15 +324,14 @@ impl ReferenceCache {
         Ok(to_rgb(setup.width(), setup.height(), &pixels))
     }
 
-    /// Stores rendered frame `f` (eval writes it on a worker thread while the next one
-    /// renders); the EXR is written under a temporary name and renamed, so an
-    /// interruption never leaves a truncated frame that looks finished.
+    /// Writes frame `f`'s files, each whole or not at all (temporary name, fsync,
+    /// rename): PNG, then the EXR that [`ReferenceCache::load`] reads. `dvr eval` calls
+    /// it on a worker thread while the next frame renders.
     pub fn store(&self, f: u32, img: &Rgb32Image) -> Result<()> {
-        write_png(&self.png(f), img)?;
-        let tmp = self.dir.join(format!("{}.partial.exr", frame_name(f)));
-        write_exr(&tmp, img)?;
-        std::fs::rename(&tmp, self.exr(f))
-            .with_context(|| format!("renaming {} to {}", tmp.display(), self.exr(f).display()))
+        let (png, exr) = (self.png(f), self.exr(f));
+        write_file(&png, &encode_png(&png, img)?, Durability::Synced)?;
+        write_file(&exr, &encode_exr(&exr, img)?, Durability::Synced)?;
+        Ok(())
     }
 
     pub fn load(&self, f: u32) -> Result<Rgb32Image> {
@@ -212,35 +348,136 @@ impl ReferenceCache {
         }
         Ok(img)
     }
+
+    /// Brings the cache up to date: reuses what is there, warns about and re-renders
+    /// unreadable frames, renders the rest with a renderer made by `setup` only when
+    /// some frame is missing.
+    pub fn fill(&self, setup: &Setup, report: &mut dyn FillReport) -> Result<()> {
+        let state = self.state();
+        let reused = self.key.frames as usize - state.missing.len();
+        for (path, why) in &state.unreadable {
+            report.note(None);
+            log::warn!(
+                "{}: cached reference does not read back ({why}); re-rendering it",
+                path.display()
+            );
+        }
+        if state.missing.is_empty() {
+            report.note(Some(&format!(
+                "reusing {reused} reference frame(s) in {}",
+                self.dir.display()
+            )));
+            return Ok(());
+        }
+        if let Some(changed) = self.prepare()? {
+            report.note(Some(&changed));
+        } else if reused > 0 {
+            report.note(Some(&format!(
+                "reusing {reused} reference frame(s), rendering {}",
+                state.missing.len()
+            )));
+        }
+        // The same renderer set-up for `dvr reference` and `dvr eval`, so their cached
+        // frames are identical.
+        let mut renderer = setup.renderer(&["none"])?;
+        report.rendered(0, state.missing.len());
+        for (i, &f) in state.missing.iter().enumerate() {
+            let img = self.render(setup, &mut renderer, f)?;
+            report.store(self, f, img)?;
+            report.rendered(i + 1, state.missing.len());
+        }
+        report.finished(&renderer)
+    }
+}
+
+/// How [`ReferenceCache::fill`] tells the user what it does, and how it writes frames.
+pub trait FillReport {
+    /// A line for the log (`None`: only end a progress line, a warning follows).
+    fn note(&mut self, text: Option<&str>);
+    /// `done` of `of` frames rendered.
+    fn rendered(&mut self, done: usize, of: usize);
+    /// Writes rendered frame `f` through [`ReferenceCache::store`]: here at once;
+    /// `dvr eval` hands it to a worker thread while the next frame renders.
+    fn store(&mut self, cache: &ReferenceCache, f: u32, img: Rgb32Image) -> Result<()> {
+        cache.store(f, &img)
+    }
+    /// Every missing frame has been rendered by `renderer` (and handed to
+    /// [`FillReport::store`]): wait for writes still running, count GPU time.
+    fn finished(&mut self, _renderer: &dvr_engine::renderer::Renderer) -> Result<()> {
+        Ok(())
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn key(spp: u32) -> ReferenceKey {
-        let scene = Scene::builtin("cloud/orbit")
+    fn scene() -> Scene {
+        Scene::builtin("cloud/orbit")
             .unwrap()
             .with_frames(3)
-            .unwrap();
-        ReferenceKey::new(&scene, (8, 8), spp, 16).unwrap()
+            .unwrap()
+    }
+
+    fn key(spp: u32) -> ReferenceKey {
+        ReferenceKey::new(&scene(), (8, 8), spp, 16).unwrap()
     }
 
     #[test]
     fn key_depends_on_settings_and_scene() {
         assert_eq!(key(16), key(16));
         assert_ne!(key(16), key(32));
-        let a = Scene::builtin("cloud/orbit")
-            .unwrap()
-            .with_frames(3)
-            .unwrap();
         let b = Scene::builtin("cloud/point-light")
             .unwrap()
             .with_frames(3)
             .unwrap();
-        let ka = ReferenceKey::new(&a, (8, 8), 16, 16).unwrap();
         let kb = ReferenceKey::new(&b, (8, 8), 16, 16).unwrap();
-        assert_ne!(ka.scene_hash, kb.scene_hash);
+        assert_ne!(key(16).scene_hash, kb.scene_hash);
+        // A different procedural volume: same scene text, other voxels.
+        let k32 = ReferenceKey::new(&scene(), (8, 8), 16, 32).unwrap();
+        assert_ne!(key(16).content_hash, k32.content_hash);
+    }
+
+    /// Defect: editing a TF file or replacing the volume file a scene names kept the
+    /// key (it hashed only the scene text), so stale references were reused.
+    #[test]
+    fn key_follows_the_content_of_tf_and_volume_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let tf = |opacity: f64| {
+            format!(
+                "[[point]]\ndensity = 0.0\nopacity = 0.0\ndiffuse = [1, 1, 1]\n\
+                 [[point]]\ndensity = 1.0\nopacity = {opacity}\ndiffuse = [1, 1, 1]\n"
+            )
+        };
+        std::fs::write(d.join("tf.toml"), tf(0.8)).unwrap();
+        std::fs::write(d.join("v.raw"), [10u8, 20, 30, 40, 50, 60, 70, 80]).unwrap();
+        std::fs::write(
+            d.join("s.toml"),
+            "[volume]\nfile = \"v.raw\"\ndims = [2, 2, 2]\nformat = \"u8\"\n[transfer]\n\
+             a = \"tf.toml\"\n[[light]]\nkind = \"point\"\nposition = [1, 1, 1]\nintensity = 1\n",
+        )
+        .unwrap();
+        let key = || {
+            let s = Scene::load(d.join("s.toml")).unwrap();
+            ReferenceKey::new(&s, (8, 8), 4, 16).unwrap()
+        };
+        let before = key();
+        assert_eq!(before, key());
+        std::fs::write(d.join("tf.toml"), tf(0.05)).unwrap();
+        let tf_edited = key();
+        assert_ne!(before, tf_edited, "TF edited");
+        std::fs::write(d.join("v.raw"), [80u8, 70, 60, 50, 40, 30, 20, 10]).unwrap();
+        let volume_replaced = key();
+        assert_ne!(tf_edited, volume_replaced, "volume replaced");
+        assert_eq!(before.scene_hash, volume_replaced.scene_hash);
+        let cache = ReferenceCache::new(d, before);
+        cache.prepare().unwrap();
+        let note = ReferenceCache::new(d, volume_replaced).prepare().unwrap();
+        assert!(
+            note.is_some_and(|n| n.contains("volume, transfer function")),
+            "a note saying why"
+        );
     }
 
     #[test]
@@ -251,8 +488,7 @@ mod tests {
         assert!(cache.prepare().unwrap().is_none());
         let img = Rgb32Image::filled(8, 8, [0.5; 3]);
         for f in 0..2 {
-            write_exr(&cache.exr(f), &img).unwrap();
-            write_png(&cache.png(f), &img).unwrap();
+            cache.store(f, &img).unwrap();
         }
         // Same key: frames 0 and 1 are reused, only 2 is missing.
         assert_eq!(cache.missing(), vec![2]);
@@ -276,5 +512,46 @@ mod tests {
         let note = other.prepare().unwrap().expect("a note");
         assert!(note.contains("unreadable"), "{note}");
         assert!(other.key_matches());
+    }
+
+    /// Defect: a cached EXR cut to 0 bytes (a crash without fsync) was "reused" and
+    /// then failed every later eval; now it is re-rendered with a warning.
+    #[test]
+    fn cut_or_wrong_sized_frames_are_missing_not_reused() {
+        let tmp = tempfile::tempdir().unwrap();
+        let cache = ReferenceCache::new(tmp.path(), key(16));
+        cache.prepare().unwrap();
+        for f in 0..3 {
+            cache.store(f, &Rgb32Image::filled(8, 8, [0.5; 3])).unwrap();
+        }
+        assert!(cache.missing().is_empty());
+        std::fs::write(cache.exr(0), b"").unwrap();
+        std::fs::write(cache.png(2), b"\x89PNG").unwrap();
+        let state = cache.state();
+        assert_eq!(state.missing, vec![0, 2]);
+        assert_eq!(state.unreadable.len(), 2);
+        assert!(state.unreadable[0].0.ends_with("0000.exr"));
+        // The other frames' files are whole: written to a temporary name and renamed.
+        let leftovers: Vec<_> = std::fs::read_dir(&cache.dir)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+            .collect();
+        assert!(leftovers.is_empty());
+    }
+
+    #[test]
+    fn content_hash_is_stable_and_length_aware() {
+        assert_eq!(ContentHash::of(b"abc"), ContentHash::of(b"abc"));
+        assert_ne!(ContentHash::of(b"abc"), ContentHash::of(b"abd"));
+        let mut a = ContentHash::new();
+        a.write(b"ab");
+        a.write(b"c");
+        let mut b = ContentHash::new();
+        b.write(b"a");
+        b.write(b"bc");
+        assert_ne!(a.finish(), b.finish(), "chunk boundaries count");
+        // Pinned: keys written by earlier runs must keep matching.
+        assert_eq!(ContentHash::of(b""), "af63bd4c8601b7df");
     }
 }

@@ -5,7 +5,7 @@
 use super::baseline::{self, BaselinePoint};
 use super::images::{write_display_png, write_flip_png};
 use super::overlap::Overlap;
-use super::reference::{frame_name, ReferenceCache, ReferenceKey};
+use super::reference::{frame_name, FillReport, ReferenceCache, ReferenceKey};
 use super::score::{self, score, FrameReference};
 use super::timing::Timing;
 use super::{scenes, EvalArgs, GPU_WARMUP_FRAMES};
@@ -287,51 +287,51 @@ fn scene_args(args: &EvalArgs, name: &str) -> SceneArgs {
     }
 }
 
-fn ensure_references(
-    scene: &PlannedScene,
-    setup: &Setup,
+/// The eval's view of filling a scene's reference cache: notes under the progress
+/// line, reference frames counted as progress, each frame written on the pool while the
+/// GPU renders the next, and the renderer's GPU time counted.
+struct ReferenceProgress<'a> {
+    progress: &'a mut Progress,
+    label: &'a str,
     ref_spp: u32,
-    progress: &mut Progress,
-    label: &str,
-    timing: &Arc<Timing>,
-) -> Result<()> {
-    let refs = &scene.references;
-    let missing = refs.missing();
-    let reused = scene.frames as usize - missing.len();
-    if missing.is_empty() {
-        progress.newline();
-        eprintln!(
-            "{label}: reusing {reused} reference frame(s) in {}",
-            refs.dir.display()
+    timing: &'a Arc<Timing>,
+    writes: Option<Overlap<()>>,
+}
+
+impl FillReport for ReferenceProgress<'_> {
+    fn note(&mut self, text: Option<&str>) {
+        self.progress.newline();
+        if let Some(text) = text {
+            eprintln!("{}: {text}", self.label);
+        }
+    }
+
+    fn rendered(&mut self, done: usize, of: usize) {
+        let status = format!(
+            "{} | reference {done}/{of} ({} spp)",
+            self.label, self.ref_spp
         );
-        return Ok(());
+        if done == 0 {
+            self.progress.show(&status);
+        } else {
+            self.progress.advance(f64::from(self.ref_spp), &status);
+        }
     }
-    if let Some(note) = refs.prepare()? {
-        progress.newline();
-        eprintln!("{label}: {note}");
-    } else if reused > 0 {
-        progress.newline();
-        eprintln!(
-            "{label}: reusing {reused} reference frame(s), rendering {}",
-            missing.len()
-        );
+
+    fn store(&mut self, cache: &ReferenceCache, f: u32, img: Rgb32Image) -> Result<()> {
+        let cache = cache.clone();
+        self.writes
+            .get_or_insert_with(|| Overlap::new(self.timing))
+            .spawn(move || cache.store(f, &img))
     }
-    // The same renderer set-up as `dvr reference`, so cached frames are identical to it.
-    let mut renderer = setup.renderer(&["none"])?;
-    let n = missing.len();
-    progress.show(&format!("{label} | reference 0/{n} ({ref_spp} spp)"));
-    // Each frame is written on the pool while the GPU renders the next.
-    let mut writes = Overlap::new(timing);
-    for (i, &f) in missing.iter().enumerate() {
-        let img = refs.render(setup, &mut renderer, f)?;
-        let cache = refs.clone();
-        writes.spawn(move || cache.store(f, &img))?;
-        let status = format!("{label} | reference {}/{n} ({ref_spp} spp)", i + 1);
-        progress.advance(f64::from(ref_spp), &status);
+
+    fn finished(&mut self, renderer: &dvr_engine::renderer::Renderer) -> Result<()> {
+        if let Some(writes) = self.writes.take() {
+            writes.finish()?;
+        }
+        self.timing.add_gpu_ms(renderer.gpu_ms());
+        Ok(())
     }
-    writes.finish()?;
-    timing.add_gpu_ms(renderer.gpu_ms());
-    Ok(())
 }
 
 pub fn evaluate_scene(
@@ -344,9 +344,18 @@ pub fn evaluate_scene(
 ) -> Result<SceneResult> {
     progress.show(&format!("{label} | loading"));
     let setup = Setup::new(&scene_args(args, &scene.spec))?;
-    timing
-        .references
-        .time(|| ensure_references(scene, &setup, args.ref_spp, progress, label, timing))?;
+    timing.references.time(|| {
+        scene.references.fill(
+            &setup,
+            &mut ReferenceProgress {
+                progress,
+                label,
+                ref_spp: args.ref_spp,
+                timing,
+                writes: None,
+            },
+        )
+    })?;
 
     let names: Vec<&str> = methods.iter().map(String::as_str).collect();
     let mut renderer = setup.renderer(&names)?;

@@ -274,12 +274,7 @@ pub(super) fn save_screenshot(path: &Path, s: &Screenshot) -> Result<()> {
         .chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])
         .collect();
-    image::save_buffer(
-        path,
-        &rgb,
-        s.width,
-        s.height,
-        image::ExtendedColorType::Rgb8,
-    )
-    .with_context(|| format!("writing {}", path.display()))
+    let png = dvr_engine::image_io::encode_srgb8_png(path, s.width, s.height, &rgb)?;
+    dvr_engine::image_io::write_file(path, &png, dvr_engine::files::Durability::Renamed)
+        .with_context(|| format!("writing {}", path.display()))
 }

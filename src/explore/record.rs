@@ -14,6 +14,7 @@
 //! environment colours keep their first-frame values; render settings are the last ones.
 
 use anyhow::{Context, Result};
+use dvr_engine::files::{write_atomic, Durability::Renamed};
 use dvr_engine::scene::{
     self, BuiltinVolume, CameraKey, CameraSpec, Interpolation, Light, LightKey, Scene, TfKey,
     TransferSpec, VolumeSource,
@@ -72,7 +73,7 @@ impl Recorder {
     ) -> Result<()> {
         if self.tfs.last() != Some(tf) {
             let path = self.dir.join(Self::tf_name(self.tfs.len()));
-            std::fs::write(&path, tf.to_toml())
+            write_atomic(&path, tf.to_toml().as_bytes(), Renamed)
                 .with_context(|| format!("writing {}", path.display()))?;
             self.tfs.push(tf.clone());
         }
@@ -126,7 +127,7 @@ impl Recorder {
         let note = "# Recorded by `dvr explore --record`: camera and light keyframes replay the \
                     session exactly;\n# TF edits are one blend from the first TF to the last \
                     (see src/explore/record.rs).\n";
-        std::fs::write(&path, format!("{note}{text}"))
+        write_atomic(&path, format!("{note}{text}").as_bytes(), Renamed)
             .with_context(|| format!("writing {}", path.display()))?;
         Ok(Some(path))
     }

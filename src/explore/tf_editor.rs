@@ -7,6 +7,7 @@
 //! The geometry (point ↔ pixel, picking, moving with neighbours' order kept) is plain
 //! functions with unit tests; [`show`] only wires them to egui.
 
+use dvr_engine::files::Durability::Renamed;
 use dvr_engine::transfer::{ControlPoint, TransferFunction};
 use egui::{Color32, Pos2, Rect, Sense, Stroke};
 
@@ -243,7 +244,8 @@ pub fn show(ui: &mut egui::Ui, ed: &mut TfEditor, tf: &mut TransferFunction, his
     ui.horizontal(|ui| {
         ui.add(egui::TextEdit::singleline(&mut ed.path).desired_width(150.0));
         if ui.button("save").clicked() {
-            ed.message = match std::fs::write(&ed.path, tf.to_toml()) {
+            let (path, text) = (std::path::Path::new(&ed.path), tf.to_toml());
+            ed.message = match dvr_engine::files::write_atomic(path, text.as_bytes(), Renamed) {
                 Ok(()) => format!("saved {}", ed.path),
                 Err(e) => format!("{}: {e}", ed.path),
             };

@@ -487,7 +487,7 @@ fn render_controls(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model) {
         0..=16,
         "roulette from bounce",
     ) {
-        r.set_russian_roulette_depth(rr);
+        refused = r.set_russian_roulette_depth(rr).err().or(refused);
     }
     if let Some(e) = refused {
         state.set_status(e.to_string());

@@ -206,7 +206,12 @@ pub fn chrome_trace<'a>(
 
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
     let text = serde_json::to_string_pretty(value)?;
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+    dvr_engine::files::write_atomic(
+        path,
+        text.as_bytes(),
+        dvr_engine::files::Durability::Renamed,
+    )
+    .with_context(|| format!("writing {}", path.display()))
 }
 
 #[cfg(test)]

@@ -11,11 +11,14 @@ DATA/<dataset>.npz (noisy, ref: (clips, frames, 3, H, W) float32) with a content
 The defaults (64x64 clips, 256-spp references) make the cheap pre-training set; the
 issue's setting (7-frame 128x128 clips with 1024-spp references, about 7 min per clip
 on lavapipe with two rendering at once on this 2-core machine) is
---size 128x128 --ref-spp 1024 (pipeline.sh runs both). Clips already rendered are
-reused, so a run can be resumed or extended.
+--size 128x128 --ref-spp 1024 (pipeline.sh runs both). Clips already rendered with the
+same settings (DATA/<dataset>/clipNNN/done.json) are reused, so a run can be resumed or
+extended.
 """
 import argparse
 import hashlib
+import io
+import json
 import math
 import os
 import subprocess
@@ -100,6 +103,29 @@ def read_exr(path):
     return np.moveaxis(px, -1, 0)  # (3,H,W)
 
 
+def marker_path(clip_dir):
+    return os.path.join(clip_dir, "done.json")
+
+
+def read_marker(clip_dir):
+    try:
+        with open(marker_path(clip_dir)) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def write_atomic(path, data):
+    """Writes under a temporary name, flushes to disk and renames: a crash leaves the
+    old file or none, never a cut one."""
+    tmp = f"{path}.{os.getpid()}.tmp"
+    with open(tmp, "wb") as f:
+        f.write(data)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
 def run(cmd):
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
@@ -131,10 +157,15 @@ def main():
         with open(scene, "w") as f:
             f.write(text)
         common = ["--scene", scene, "--frames", str(a.frames), "--size", a.size]
-        last = os.path.join(d, "reference", f"{a.frames - 1:04d}.exr")
-        if not os.path.exists(last):
+        # A clip is done when both commands finished for exactly these settings: the
+        # marker is written (atomically) after them, so a crash, a cut file or other
+        # settings re-render. `dvr reference` itself reuses frames rendered under the
+        # same content key.
+        done = dict(scene=text, frames=a.frames, size=a.size, spp=a.spp, ref_spp=a.ref_spp)
+        if read_marker(d) != done:
             run([a.dvr, "capture", *common, "--spp", str(a.spp), "--denoiser", "none", "--out", d])
             run([a.dvr, "reference", *common, "--ref-spp", str(a.ref_spp), "--out", d])
+            write_atomic(marker_path(d), json.dumps(done, indent=1).encode())
         noisy.append(np.stack([read_exr(os.path.join(d, "none", f"{t:04d}.exr")) for t in range(a.frames)]))
         refs.append(np.stack([read_exr(os.path.join(d, "reference", f"{t:04d}.exr")) for t in range(a.frames)]))
         meta.append(info)
@@ -144,10 +175,12 @@ def main():
     noisy = np.stack(noisy).astype(np.float32)
     refs = np.stack(refs).astype(np.float32)
     h = hashlib.sha256(noisy.tobytes() + refs.tobytes()).hexdigest()[:16]
-    np.savez(os.path.join(a.data, f"{a.dataset}.npz"), noisy=noisy, ref=refs, hash=h,
+    buf = io.BytesIO()
+    np.savez(buf, noisy=noisy, ref=refs, hash=h,
              meta=np.array([str(m) for m in meta]),
              settings=np.array(f"{a.clips} clips x {a.frames} frames, {a.size}, {a.spp} spp input, "
                                f"{a.ref_spp}-spp references, seed {a.seed}"))
+    write_atomic(os.path.join(a.data, f"{a.dataset}.npz"), buf.getvalue())
     print(f"wrote {a.data}/{a.dataset}.npz: {noisy.shape}, sha256[:16] {h}, {time.time() - t0:.0f}s")
 
 

@@ -29,7 +29,7 @@ use crate::passes::present::Present;
 use crate::passes::surface_features::SurfaceFeatures;
 use crate::passes::SceneBindings;
 use crate::scene::RenderSettings;
-use crate::shaders::frame::{FrameBlock, FrameParams, SampleStream};
+use crate::shaders::frame::{FrameBlock, FrameParams, SampleStream, MAX_LIGHTS};
 use ash::vk;
 use glam::Vec3;
 use gpu_allocator::MemoryLocation;
@@ -343,6 +343,7 @@ impl Renderer {
         request: &FrameRequest,
         present: Option<&PresentTarget<'_>>,
     ) -> Result<Option<FrameResult>> {
+        check_light_count(inputs)?;
         let slot = (self.frame_index % SLOTS as u64) as usize;
         let completed = self.wait_slot(slot)?;
         if present.is_some() && self.passes.present.is_none() {
@@ -589,6 +590,19 @@ fn check_spp(ctx: &GpuContext, spp: u32, size: Extent) -> Result<()> {
             ctx.info.name
         ),
     })
+}
+
+/// The frame block's light array holds [`MAX_LIGHTS`]: more is an error, never a
+/// silent drop (scenes are checked against the same limit when loaded).
+fn check_light_count(inputs: &FrameInputs) -> Result<()> {
+    if inputs.lights.len() > MAX_LIGHTS {
+        return Err(EngineError::InvalidSetting {
+            name: "lights",
+            value: inputs.lights.len().to_string(),
+            allowed: format!("the path tracer takes at most {MAX_LIGHTS}"),
+        });
+    }
+    Ok(())
 }
 
 /// Builds the denoisers called `names` for a renderer built for `config` whose path

@@ -1,8 +1,8 @@
 //! High-sample references: accumulated in as few path-tracing dispatches as the device
 //! takes, from a sample stream of their own.
 
-use super::{add_readbacks, read_pixels, FrameInputs, Renderer};
-use crate::error::Result;
+use super::{add_readbacks, check_light_count, read_pixels, FrameInputs, Renderer};
+use crate::error::{EngineError, Result};
 use crate::graph::Frame;
 use crate::shaders::frame::SampleStream;
 
@@ -46,6 +46,14 @@ impl Renderer {
         batch: u32,
     ) -> Result<Vec<[f32; 4]>> {
         self.flush()?;
+        check_light_count(inputs)?;
+        if spp == 0 {
+            return Err(EngineError::InvalidSetting {
+                name: "reference spp",
+                value: spp.to_string(),
+                allowed: "a reference needs at least 1 sample per pixel".into(),
+            });
+        }
         let batch = batch.clamp(1, spp.clamp(1, self.samples_per_dispatch()));
         self.graph.reset_history("reference.");
         let mut done = 0;

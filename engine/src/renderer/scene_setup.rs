@@ -215,6 +215,7 @@ pub fn load_environment(lights: &[Light]) -> Result<Option<EnvironmentUpload>, I
         if let Light::Environment(e) = l {
             if let EnvSource::Map { path } = &e.source {
                 let img = crate::image_io::read_exr(path)?;
+                check_radiance(path, &img)?;
                 return Ok(Some(EnvironmentUpload {
                     width: img.width,
                     height: img.height,
@@ -224,4 +225,58 @@ pub fn load_environment(lights: &[Light]) -> Result<Option<EnvironmentUpload>, I
         }
     }
     Ok(None)
+}
+
+/// An environment map holds radiance: finite and non-negative in every channel. One
+/// NaN or Inf texel would turn every path that samples it into NaN (a black or
+/// speckled image with no error), so it is refused, naming the first.
+fn check_radiance(
+    path: &std::path::Path,
+    img: &crate::metrics::Rgb32Image,
+) -> Result<(), ImageIoError> {
+    let bad = |c: &[f32; 3]| c.iter().any(|v| !v.is_finite() || *v < 0.0);
+    let count = img.data.iter().filter(|c| bad(c)).count();
+    match img.data.iter().position(bad) {
+        None => Ok(()),
+        Some(i) => {
+            let w = img.width.max(1) as usize;
+            Err(ImageIoError::Exr {
+                path: path.to_path_buf(),
+                message: format!(
+                    "{count} texel(s) are NaN, infinite or negative, the first at ({}, {}) = \
+                     {:?}; an environment map holds radiance (finite, >= 0)",
+                    i % w,
+                    i / w,
+                    img.data[i]
+                ),
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metrics::Rgb32Image;
+    use crate::scene::EnvironmentLight;
+
+    #[test]
+    fn environment_maps_with_nan_or_inf_are_refused_naming_the_texel() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("sky.exr");
+        let mut img = Rgb32Image::filled(4, 2, [0.5; 3]);
+        img.data[6] = [0.5, f32::INFINITY, 0.5];
+        img.data[7] = [f32::NAN, 0.5, 0.5];
+        crate::image_io::write_exr(&path, &img).expect("write exr");
+        let light = Light::Environment(EnvironmentLight {
+            source: EnvSource::Map { path: path.clone() },
+            intensity: 1.0,
+        });
+        // Used to load, and every path sampling the texel became NaN.
+        let msg = load_environment(&[light]).unwrap_err().to_string();
+        assert!(
+            msg.contains("sky.exr") && msg.contains("2 texel(s)") && msg.contains("(2, 1)"),
+            "{msg}"
+        );
+    }
 }

@@ -36,6 +36,32 @@ pub struct WrlsUpdatePush {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct WrlsConstantPush {
+    pub camera: Vec4,
+    pub width: u32,
+    pub height: u32,
+    pub history_valid: u32,
+    pub lambda: f32,
+    pub delta: f32,
+    pub tolerance: f32,
+    pub change_ratio: f32,
+    pub outlier_sigmas: f32,
+    pub gradient_valid: u32,
+    pub drift_valid: u32,
+    pub stratum: u32,
+    pub lambda_min: f32,
+    pub change_gain: f32,
+    pub shrink: f32,
+    pub drift_z: f32,
+    pub spp: f32,
+    pub lambda_moving: f32,
+    pub pad0: f32,
+    pub pad1: f32,
+    pub pad2: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct WrlsDriftPush {
     pub width: u32,
     pub height: u32,
@@ -126,6 +152,34 @@ pub fn mirrored_layouts() -> Vec<MirroredLayout> {
                 change_gain,
                 shrink,
                 drift_z,
+                pad0,
+                pad1,
+                pad2
+            }),
+        ),
+        (
+            "wrls_constant",
+            "push",
+            std::mem::size_of::<WrlsConstantPush>(),
+            field_offsets!(WrlsConstantPush {
+                camera,
+                width,
+                height,
+                history_valid,
+                lambda,
+                delta,
+                tolerance,
+                change_ratio,
+                outlier_sigmas,
+                gradient_valid,
+                drift_valid,
+                stratum,
+                lambda_min,
+                change_gain,
+                shrink,
+                drift_z,
+                spp,
+                lambda_moving,
                 pad0,
                 pad1,
                 pad2

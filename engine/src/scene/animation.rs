@@ -32,9 +32,9 @@
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use super::camera::{check_fov, CameraSpec};
+use super::camera::{check_fov, CameraSpec, MAX_CAMERA_DISTANCE};
 use super::error::{Ctx, SceneError};
-use super::light::Light;
+use super::light::{check_intensity, check_position, Light};
 
 /// Frames in a scene that does not say.
 pub const DEFAULT_FRAMES: u32 = 60;
@@ -240,6 +240,47 @@ impl Animation {
         a
     }
 
+    /// One keyframe per track and frame in a scene file: with two, which one holds
+    /// depends on their order in the file, which is a slip, not an intent. (A scene
+    /// resampled to fewer frames may bring keyframes together; there the later one
+    /// holds, see [`sample`].)
+    pub(crate) fn check_unique_frames(&self, ctx: &Ctx) -> Result<(), SceneError> {
+        let duplicate = |track: &str, i: usize, j: usize, frame: u32| {
+            Err(ctx.invalid(
+                format!("animation.{track}[{j}].frame"),
+                format!(
+                    "{frame} is also the frame of animation.{track}[{i}]; one keyframe per \
+                     frame (merge the two)"
+                ),
+            ))
+        };
+        for (j, k) in self.camera.iter().enumerate() {
+            if let Some(i) = self.camera[..j].iter().position(|o| o.frame == k.frame) {
+                return duplicate("camera", i, j, k.frame);
+            }
+        }
+        for (j, k) in self.light.iter().enumerate() {
+            let same = |o: &LightKey| o.frame == k.frame && o.index == k.index;
+            if let Some(i) = self.light[..j].iter().position(same) {
+                return duplicate("light", i, j, k.frame);
+            }
+        }
+        // Blend and shift are tracks of their own (a key may set either or both, each
+        // key with its own interpolation): two keys on one frame clash only when both
+        // set the same value.
+        for (j, k) in self.tf.iter().enumerate() {
+            let same = |o: &TfKey| {
+                o.frame == k.frame
+                    && ((o.blend.is_some() && k.blend.is_some())
+                        || (o.shift.is_some() && k.shift.is_some()))
+            };
+            if let Some(i) = self.tf[..j].iter().position(same) {
+                return duplicate("tf", i, j, k.frame);
+            }
+        }
+        Ok(())
+    }
+
     pub(crate) fn check(
         &self,
         ctx: &Ctx,
@@ -285,13 +326,45 @@ impl Animation {
             }
         }
         if let Some(o) = &self.orbit {
-            ctx.finite("animation.orbit.degrees_per_frame", o.degrees_per_frame)?;
-            ctx.finite("animation.orbit.start_degrees", o.start_degrees)?;
+            ctx.in_range(
+                "animation.orbit.degrees_per_frame",
+                o.degrees_per_frame,
+                -360.0,
+                360.0,
+                " degrees",
+            )?;
+            ctx.in_range(
+                "animation.orbit.start_degrees",
+                o.start_degrees,
+                -360.0,
+                360.0,
+                " degrees",
+            )?;
             if let Some(c) = o.center {
-                ctx.finite3("animation.orbit.center", c)?;
+                ctx.near_origin(
+                    "animation.orbit.center",
+                    c,
+                    MAX_CAMERA_DISTANCE,
+                    "the camera looks at it",
+                )?;
             }
             if let Some(h) = o.height {
-                ctx.finite("animation.orbit.height", h)?;
+                ctx.in_range(
+                    "animation.orbit.height",
+                    h,
+                    -MAX_CAMERA_DISTANCE,
+                    MAX_CAMERA_DISTANCE,
+                    " world units",
+                )?;
+            }
+            if let Some(r) = o.radius {
+                ctx.in_range(
+                    "animation.orbit.radius",
+                    r,
+                    0.0,
+                    MAX_CAMERA_DISTANCE,
+                    " world units",
+                )?;
             }
             let radius = o.radius.unwrap_or_else(|| o.frame_of(camera).3);
             if !(radius.is_finite() && radius > 1e-6) {
@@ -321,7 +394,7 @@ impl Animation {
                         format!("light {} has no position", k.index),
                     ));
                 }
-                ctx.finite3(&field("position"), p)?;
+                check_position(ctx, &field("position"), p)?;
             }
             if let Some(c) = k.colour {
                 if light.colour().is_none() {
@@ -336,7 +409,7 @@ impl Animation {
                 ctx.colour(&field("colour"), c)?;
             }
             if let Some(x) = k.intensity {
-                ctx.non_negative(&field("intensity"), x)?;
+                check_intensity(ctx, &field("intensity"), x)?;
             }
         }
         for (i, k) in self.tf.iter().enumerate() {

@@ -17,6 +17,10 @@ use super::error::{Ctx, SceneError};
 pub const CAMERA_NEAR: f32 = 0.01;
 /// Far plane in world units.
 pub const CAMERA_FAR: f32 = 100.0;
+/// Farthest the camera and its target may be from the volume's centre: half the far
+/// plane, so the volume is always inside the view frustum's depth range.
+pub const MAX_CAMERA_DISTANCE: f64 = (CAMERA_FAR as f64) / 2.0;
+
 /// Vertical field of view when a scene does not give one.
 pub const DEFAULT_FOV_Y_DEGREES: f64 = 40.0;
 
@@ -60,8 +64,19 @@ impl Default for CameraSpec {
 
 impl CameraSpec {
     pub(crate) fn check(&self, ctx: &Ctx, field: &str) -> Result<(), SceneError> {
-        ctx.finite3(&format!("{field}.position"), self.position)?;
-        ctx.finite3(&format!("{field}.target"), self.target)?;
+        let why = "the volume is 1 unit across and the far plane 100 units away";
+        ctx.near_origin(
+            &format!("{field}.position"),
+            self.position,
+            MAX_CAMERA_DISTANCE,
+            why,
+        )?;
+        ctx.near_origin(
+            &format!("{field}.target"),
+            self.target,
+            MAX_CAMERA_DISTANCE,
+            why,
+        )?;
         ctx.unit_vector(&format!("{field}.up"), self.up)?;
         check_fov(ctx, &format!("{field}.fov_y_degrees"), self.fov_y_degrees)?;
         let dir = self.target - self.position;

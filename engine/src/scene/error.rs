@@ -50,6 +50,10 @@ pub enum SceneError {
     },
 }
 
+/// Largest colour channel: colours scale radiance (with a light's intensity), and
+/// colour × intensity must stay far inside f32 through a path's products.
+pub const MAX_COLOUR: f64 = 1e6;
+
 /// Where a scene came from: names it in errors and anchors its relative paths.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Ctx<'a> {
@@ -74,14 +78,6 @@ impl Ctx<'_> {
         }
     }
 
-    pub fn finite(&self, field: &str, x: f64) -> Result<(), SceneError> {
-        if x.is_finite() {
-            Ok(())
-        } else {
-            Err(self.invalid(field, format!("{x} is not a finite number")))
-        }
-    }
-
     pub fn positive(&self, field: &str, x: f64) -> Result<(), SceneError> {
         if x.is_finite() && x > 0.0 {
             Ok(())
@@ -90,11 +86,64 @@ impl Ctx<'_> {
         }
     }
 
-    pub fn non_negative(&self, field: &str, x: f64) -> Result<(), SceneError> {
-        if x.is_finite() && x >= 0.0 {
+    /// `x` finite and in `[lo, hi]`; `why` (may be empty) says what the range means.
+    pub fn in_range(
+        &self,
+        field: &str,
+        x: f64,
+        lo: f64,
+        hi: f64,
+        why: &str,
+    ) -> Result<(), SceneError> {
+        if x.is_finite() && (lo..=hi).contains(&x) {
             Ok(())
         } else {
-            Err(self.invalid(field, format!("{x} must be finite and >= 0")))
+            Err(self.invalid(
+                field,
+                format!("{} is outside [{}, {}]{why}", num(x), num(lo), num(hi)),
+            ))
+        }
+    }
+
+    /// `x` finite and in `(0, hi]`; `why` (may be empty) says what the range means.
+    pub fn positive_up_to(
+        &self,
+        field: &str,
+        x: f64,
+        hi: f64,
+        why: &str,
+    ) -> Result<(), SceneError> {
+        if x.is_finite() && x > 0.0 && x <= hi {
+            Ok(())
+        } else {
+            Err(self.invalid(
+                field,
+                format!("{} is outside (0, {}]{why}", num(x), num(hi)),
+            ))
+        }
+    }
+
+    /// A point finite and at most `max` world units from the origin (the volume's
+    /// centre); `why` says what is lost past it.
+    pub fn near_origin(
+        &self,
+        field: &str,
+        v: DVec3,
+        max: f64,
+        why: &str,
+    ) -> Result<(), SceneError> {
+        self.finite3(field, v)?;
+        if v.length() <= max {
+            Ok(())
+        } else {
+            Err(self.invalid(
+                field,
+                format!(
+                    "{v} is {} world units from the volume's centre; at most {} ({why})",
+                    num(v.length()),
+                    num(max)
+                ),
+            ))
         }
     }
 
@@ -106,14 +155,14 @@ impl Ctx<'_> {
         }
     }
 
-    /// A colour: finite, every channel `>= 0`.
+    /// A colour: finite, every channel in `[0, MAX_COLOUR]`.
     pub fn colour(&self, field: &str, c: DVec3) -> Result<(), SceneError> {
-        if c.is_finite() && c.min_element() >= 0.0 {
+        if c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= MAX_COLOUR {
             Ok(())
         } else {
             Err(self.invalid(
                 field,
-                format!("colour {c} must be finite and >= 0 in every channel"),
+                format!("colour {c} must be finite and in [0, {MAX_COLOUR:e}] in every channel"),
             ))
         }
     }
@@ -125,5 +174,14 @@ impl Ctx<'_> {
         } else {
             Err(self.invalid(field, "must not be the zero vector"))
         }
+    }
+}
+
+/// A number as a person writes it: plain when moderate, `1e300` when huge or tiny.
+pub(crate) fn num(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
     }
 }

@@ -56,6 +56,7 @@ pub(crate) fn parse(text: &str, origin: &str, base: Option<&Path>) -> Result<Sce
         .map(|(i, l)| l.into_light(&ctx, i))
         .collect::<Result<Vec<Light>, _>>()?;
     let (frames, animation) = file.animation.split();
+    animation.check_unique_frames(&ctx)?;
     let scene = Scene {
         name: file.name.unwrap_or_else(|| default_name(origin)),
         volume,

@@ -25,6 +25,38 @@ use serde::{Deserialize, Serialize};
 
 use super::error::{Ctx, SceneError};
 
+/// Lights the path tracer takes (the size of the light array in
+/// `shaders/glsl/include/frame.glsl`, declared with its GLSL twin in
+/// [`crate::shaders::frame`]); a scene with more is an error, never truncated.
+pub use crate::shaders::frame::MAX_LIGHTS;
+
+/// Largest light intensity: lit surfaces of order 1 need 1–200; past this the
+/// radiance overflows f32 on its way through a path and the image turns black.
+pub const MAX_INTENSITY: f64 = 1e6;
+
+/// Farthest a light (or an area light's target) may be from the volume's centre, in
+/// world units (the volume is 1 unit across): a point light 1000 units away needs
+/// intensity 10⁶ to light it at all.
+pub const MAX_LIGHT_DISTANCE: f64 = 1e3;
+
+/// Largest side of an area light, in world units.
+pub const MAX_AREA_SIZE: f64 = 100.0;
+
+/// Checks a light intensity (at rest or in a keyframe).
+pub(crate) fn check_intensity(ctx: &Ctx, field: &str, x: f64) -> Result<(), SceneError> {
+    ctx.in_range(field, x, 0.0, MAX_INTENSITY, "")
+}
+
+/// Checks a light position (at rest or in a keyframe).
+pub(crate) fn check_position(ctx: &Ctx, field: &str, p: DVec3) -> Result<(), SceneError> {
+    ctx.near_origin(
+        field,
+        p,
+        MAX_LIGHT_DISTANCE,
+        "a light farther away contributes nothing at any sensible intensity",
+    )
+}
+
 /// The light types the path tracer implements.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -136,9 +168,9 @@ impl Light {
     /// the scene's list, for the message.
     pub(crate) fn check(&self, ctx: &Ctx, index: usize) -> Result<(), SceneError> {
         let field = |name: &str| format!("light[{index}].{name}");
-        ctx.non_negative(&field("intensity"), self.intensity())?;
+        check_intensity(ctx, &field("intensity"), self.intensity())?;
         if let Some(p) = self.position() {
-            ctx.finite3(&field("position"), p)?;
+            check_position(ctx, &field("position"), p)?;
         }
         if let Some(c) = self.colour() {
             ctx.colour(&field("colour"), c)?;
@@ -146,11 +178,13 @@ impl Light {
         match self {
             Self::Point(_) => {}
             Self::Area(a) => {
-                ctx.positive(&field("size"), a.size.x)?;
-                ctx.positive(&field("size"), a.size.y)?;
+                for side in [a.size.x, a.size.y] {
+                    ctx.positive(&field("size"), side)?;
+                    ctx.in_range(&field("size"), side, 0.0, MAX_AREA_SIZE, " world units")?;
+                }
                 match a.facing {
                     Facing::Target(t) => {
-                        ctx.finite3(&field("target"), t)?;
+                        check_position(ctx, &field("target"), t)?;
                         if (t - a.position).length_squared() < 1e-12 {
                             return Err(ctx.invalid(field("target"), "equals the light's position"));
                         }
@@ -160,13 +194,18 @@ impl Light {
             }
             Self::Environment(e) => match &e.source {
                 EnvSource::Constant { .. } => {}
-                EnvSource::Map { path } => {
-                    if !path.is_file() {
-                        return Err(
-                            ctx.invalid(field("map"), format!("{} does not exist", path.display()))
-                        );
+                EnvSource::Map { path } => match crate::files::not_a_regular_file(path) {
+                    Ok(None) => {}
+                    Ok(Some(what)) => {
+                        return Err(ctx.invalid(
+                            field("map"),
+                            format!("{} is {what}, not an EXR file", path.display()),
+                        ))
                     }
-                }
+                    Err(e) => {
+                        return Err(ctx.invalid(field("map"), format!("{}: {e}", path.display())))
+                    }
+                },
                 EnvSource::Gradient { top, bottom } => {
                     ctx.colour(&field("top"), *top)?;
                     ctx.colour(&field("bottom"), *bottom)?;

@@ -93,10 +93,13 @@ impl Scene {
     /// folder.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, SceneError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            crate::files::read_text(path, crate::files::MAX_TEXT_FILE_BYTES).map_err(|source| {
+                SceneError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
         file::parse(&text, &path.display().to_string(), path.parent())
     }
 
@@ -199,6 +202,16 @@ impl Scene {
                 "a scene needs at least one [[light]] (or render.emission = true)",
             ));
         }
+        if self.lights.len() > light::MAX_LIGHTS {
+            return Err(ctx.invalid(
+                "light",
+                format!(
+                    "{} lights; the path tracer takes at most {} (remove or merge some)",
+                    self.lights.len(),
+                    light::MAX_LIGHTS
+                ),
+            ));
+        }
         let mut environments = 0;
         for (i, light) in self.lights.iter().enumerate() {
             light.check(ctx, i)?;
@@ -220,13 +233,63 @@ impl Scene {
             &self.lights,
             self.tf_b.is_some(),
         )?;
-        // The camera must be well defined where keyframes put it (in between, linear
-        // motion between two valid poses could only fail by passing exactly through the
-        // target, which no sensible path does).
+        // The camera must be well defined where keyframes put it, and in between.
         for (i, k) in self.animation.camera.iter().enumerate() {
             self.camera_at(k.frame)
                 .check(ctx, &format!("animation.camera[{i}]"))?;
         }
+        for f in self.camera_closest_approaches() {
+            self.camera_at(f)
+                .check(ctx, &format!("animation.camera (frame {f})"))?;
+        }
         Ok(())
+    }
+
+    /// The frames where the camera comes closest to its target, or to looking along its
+    /// up vector, between keyframes. Between two consecutive keyframe frames a and b
+    /// every track is linear (or held), so the view direction is affine in the frame
+    /// on [a, b − 1], and the minimum of |direction| (or of |direction × up|) over
+    /// that range is at the integer frames around the continuous minimum. An orbit
+    /// keeps both constant, so it needs none.
+    fn camera_closest_approaches(&self) -> Vec<u32> {
+        if self.animation.orbit.is_some() || self.animation.camera.is_empty() {
+            return Vec::new();
+        }
+        let last = self.frames.saturating_sub(1);
+        let mut stops: Vec<u32> = self
+            .animation
+            .camera
+            .iter()
+            .map(|k| k.frame.min(last))
+            .chain([0, last])
+            .collect();
+        stops.sort_unstable();
+        stops.dedup();
+        let dir = |f: u32| {
+            let c = self.camera_at(f);
+            c.target - c.position
+        };
+        let up = self.camera.up.normalize_or(glam::DVec3::Z);
+        let mut out = Vec::new();
+        for w in stops.windows(2) {
+            let (a, b) = (w[0], w[1] - 1);
+            if b <= a {
+                continue;
+            }
+            let (d0, d1) = (dir(a), dir(b));
+            for (v0, v1) in [(d0, d1), (d0.cross(up), d1.cross(up))] {
+                let e = v1 - v0;
+                let s = if e.length_squared() > 0.0 {
+                    (-v0.dot(e) / e.length_squared()).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let f = f64::from(a) + s * f64::from(b - a);
+                out.extend([f.floor() as u32, f.ceil() as u32]);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
     }
 }

@@ -8,7 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::error::{Ctx, SceneError};
+use super::error::{num, Ctx, SceneError};
 use crate::error::{EngineError, Result};
 
 /// How free paths and transmittance are estimated.
@@ -91,6 +91,17 @@ pub struct RenderSettings {
 /// white-furnace tests take up to 1000), low enough to bound a frame's cost.
 pub const MAX_BOUNCES: u32 = 1024;
 
+/// Most samples per pixel per frame a scene (or `--spp`) may ask for: a real-time
+/// budget, far past the 1–2 the denoisers are made for; references take more through
+/// `--ref-spp`. A device may allow fewer: the renderer says so, naming it (lavapipe
+/// takes 4, see `renderer::MAX_SAMPLES_PER_DISPATCH`).
+pub const MAX_SPP: u32 = 64;
+
+/// Ray-march step range in voxels: below it a frame takes minutes, above it the march
+/// steps over the volume.
+pub const MIN_STEP_VOXELS: f64 = 0.05;
+pub const MAX_STEP_VOXELS: f64 = 10.0;
+
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
@@ -157,10 +168,18 @@ impl RenderSettings {
         self.feature_threshold
     }
 
-    /// Samples per pixel per frame: at least 1 (a device may take fewer in one frame:
-    /// the renderer says how many).
+    /// Samples per pixel per frame: 1 to [`MAX_SPP`] (a device may take fewer in one
+    /// frame: the renderer says how many).
     pub fn set_spp(&mut self, spp: u32) -> Result<()> {
-        allow("spp", spp, spp >= 1, "at least 1")?;
+        allow(
+            "spp",
+            spp,
+            (1..=MAX_SPP).contains(&spp),
+            &format!(
+                "1..={MAX_SPP} samples per pixel per frame (references take more through \
+                 `--ref-spp`)"
+            ),
+        )?;
         self.spp = spp;
         Ok(())
     }
@@ -177,23 +196,34 @@ impl RenderSettings {
     pub fn set_hg_g(&mut self, g: f64) -> Result<()> {
         allow(
             "hg_g",
-            g,
+            num(g),
             g.is_finite() && g > -1.0 && g < 1.0,
             "between -1 and 1, exclusive",
         )?;
         self.hg_g = g;
         Ok(())
     }
-    pub fn set_russian_roulette_depth(&mut self, bounce: u32) {
+    /// Bounce from which Russian roulette may end a path: 0 to [`MAX_BOUNCES`].
+    pub fn set_russian_roulette_depth(&mut self, bounce: u32) -> Result<()> {
+        allow(
+            "russian_roulette_depth",
+            bounce,
+            bounce <= MAX_BOUNCES,
+            &format!("0..={MAX_BOUNCES} (the bounce limit)"),
+        )?;
         self.russian_roulette_depth = bounce;
+        Ok(())
     }
-    /// Ray-marching step in voxels.
+    /// Ray-marching step in voxels: [`MIN_STEP_VOXELS`] to [`MAX_STEP_VOXELS`].
     pub fn set_step_size(&mut self, voxels: f64) -> Result<()> {
         allow(
             "step_size",
-            voxels,
-            voxels.is_finite() && voxels > 0.0,
-            "finite and > 0",
+            num(voxels),
+            voxels.is_finite() && (MIN_STEP_VOXELS..=MAX_STEP_VOXELS).contains(&voxels),
+            &format!(
+                "[{MIN_STEP_VOXELS}, {MAX_STEP_VOXELS}] voxels (ray-march step; 0.5 is the \
+                 default)"
+            ),
         )?;
         self.step_size = voxels;
         Ok(())
@@ -215,7 +245,7 @@ impl RenderSettings {
     pub fn set_filter_sigma(&mut self, pixels: f64) -> Result<()> {
         allow(
             "filter_sigma",
-            pixels,
+            num(pixels),
             pixels.is_finite() && pixels >= 0.0,
             "finite and >= 0",
         )?;
@@ -226,7 +256,7 @@ impl RenderSettings {
     pub fn set_feature_threshold(&mut self, opacity: f64) -> Result<()> {
         allow(
             "feature_threshold",
-            opacity,
+            num(opacity),
             opacity > 0.0 && opacity <= 1.0,
             "in (0, 1]",
         )?;
@@ -249,6 +279,7 @@ impl RenderSettings {
         let mut copy = *self;
         copy.set_spp(self.spp)
             .and_then(|_| copy.set_max_bounces(self.max_bounces))
+            .and_then(|_| copy.set_russian_roulette_depth(self.russian_roulette_depth))
             .and_then(|_| copy.set_hg_g(self.hg_g))
             .and_then(|_| copy.set_step_size(self.step_size))
             .and_then(|_| copy.set_filter_sigma(self.filter_sigma))
@@ -272,8 +303,12 @@ mod tests {
     fn setters_refuse_values_out_of_range_and_keep_the_old_one() {
         let mut s = RenderSettings::default();
         let e = s.set_spp(0).expect_err("0 spp").to_string();
-        assert!(e.contains("spp = 0") && e.contains("at least 1"), "{e}");
+        assert!(e.contains("spp = 0") && e.contains("1..=64"), "{e}");
+        assert!(s.set_spp(MAX_SPP + 1).is_err());
         assert_eq!(s.spp(), 2);
+        let e = s.set_step_size(1e-6).expect_err("tiny step").to_string();
+        assert!(e.contains("1e-6") && e.contains("[0.05, 10] voxels"), "{e}");
+        assert!(s.set_russian_roulette_depth(MAX_BOUNCES + 1).is_err());
         assert!(s.set_hg_g(1.0).is_err() && s.set_hg_g(f64::NAN).is_err());
         assert!(s.set_max_bounces(MAX_BOUNCES + 1).is_err());
         assert!(s.set_step_size(0.0).is_err() && s.set_filter_sigma(-1.0).is_err());

@@ -519,3 +519,134 @@ fn open_accepts_names_and_paths() {
         "{e:?}"
     );
 }
+
+/// Values that parse but render black, hang or depend on file order: each used to be
+/// accepted; each must now be an error naming the field and the allowed range.
+#[test]
+fn nonsense_values_are_refused_with_their_range() {
+    let with = |find: &str, replace: &str| {
+        assert!(MINIMAL.contains(find), "{find}");
+        MINIMAL.replacen(find, replace, 1)
+    };
+    for (text, needles) in [
+        (
+            with("intensity = 10", "intensity = 1e300"),
+            &["light[0].intensity", "1e300", "[0, 1e6]"][..],
+        ),
+        (
+            with("builtin = \"cloud\"", "builtin = \"cloud\"\ndensity_scale = 1e300"),
+            &["volume.density_scale", "(0, 1e6]"],
+        ),
+        (
+            with("spp = 2", "spp = 2\nstep_size = 1e-6"),
+            &["render.step_size", "1e-6", "[0.05, 10] voxels"],
+        ),
+        (
+            with("spp = 2", "spp = 2\nstep_size = 1e9"),
+            &["render.step_size", "1e9"],
+        ),
+        (
+            with("spp = 2", "spp = 512"),
+            &["render.spp", "1..=64", "--ref-spp"],
+        ),
+        (
+            with("position = [1.0, 1.0, 1.0]", "position = [1e7, 1.0, 1.0]"),
+            &["light[0].position", "at most 1000"],
+        ),
+        (
+            format!("{MINIMAL}[camera]\nposition = [1e6, 0, 0]\n"),
+            &["camera.position", "at most 50"],
+        ),
+        (
+            with("frames = 10", "frames = 10\n[[animation.camera]]\nframe = 4\nposition = [0.0, 0.0, 0.0]"),
+            &["animation.camera[0].target", "equals the camera position"],
+        ),
+        (
+            // Linear from the rest position (one side) to the other: passes through the
+            // target at frame 4.
+            format!(
+                "{}[camera]\nposition = [1.0, 0.0, 0.0]\n",
+                with("frames = 10", "frames = 10\n[[animation.camera]]\nframe = 8\nposition = [-1.0, 0.0, 0.0]")
+            ),
+            &["animation.camera (frame 4).target", "equals the camera position"],
+        ),
+        (
+            with(
+                "frames = 10",
+                "frames = 10\n[[animation.camera]]\nframe = 4\nfov_y_degrees = 30\n\
+                 [[animation.camera]]\nframe = 4\nfov_y_degrees = 50",
+            ),
+            &["animation.camera[1].frame", "also the frame of animation.camera[0]"],
+        ),
+        (
+            with(
+                "frames = 10",
+                "frames = 10\n[[animation.tf]]\nframe = 3\nblend = 0.5\n[[animation.tf]]\nframe = 3\nblend = 1.0",
+            ),
+            &["animation.tf[1].frame"],
+        ),
+        (
+            with(
+                "frames = 10",
+                "frames = 10\n[[animation.tf]]\nframe = 3\nshift = 0.1\n[[animation.tf]]\nframe = 3\nblend = 1.0\nshift = 0.2",
+            ),
+            &["animation.tf[1].frame", "also the frame of animation.tf[0]"],
+        ),
+    ] {
+        let msg = parse_err(&text);
+        assert!(msg.starts_with("bad.toml: "), "{msg}");
+        for n in needles {
+            assert!(msg.contains(n), "message should mention {n:?}: {msg}");
+        }
+    }
+}
+
+/// A blend keyframe and a shift keyframe on one frame set different tracks (each with
+/// its own interpolation), so both hold whatever their order in the file.
+#[test]
+fn tf_blend_and_shift_keys_may_share_a_frame() {
+    let text = MINIMAL.replacen(
+        "frames = 10",
+        "frames = 10\n[[animation.tf]]\nframe = 4\nblend = 1.0\ninterpolation = \"step\"\n\
+         [[animation.tf]]\nframe = 4\nshift = 0.25",
+        1,
+    );
+    let scene = Scene::from_toml_str(&text, "ok.toml").expect("blend and shift keys");
+    let s = scene.frame_state(4);
+    assert_eq!((s.tf_blend, s.tf_shift), (1.0, 0.25));
+}
+
+#[test]
+fn lights_past_the_limit_are_an_error_not_dropped() {
+    let light = "[[light]]\nkind = \"point\"\nposition = [1.0, 1.0, 1.0]\nintensity = 10\n";
+    let four = format!("{MINIMAL}{}", light.repeat(3));
+    Scene::from_toml_str(&four, "four.toml").expect("four lights are fine");
+    // Five lights used to render exactly four lights' worth.
+    let msg = parse_err(&format!("{MINIMAL}{}", light.repeat(4)));
+    assert!(
+        msg.contains("5 lights") && msg.contains("at most 4"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn empty_file_paths_and_folders_are_named_for_what_they_are() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // `file = ""` used to resolve to the scene's folder: "holds no DICOM files".
+    let text = MINIMAL.replace("builtin = \"cloud\"", "file = \"\"");
+    let msg = parse_err(&text);
+    assert!(
+        msg.contains("volume.file") && msg.contains("is empty"),
+        "{msg}"
+    );
+    // An environment map that is a folder used to "not exist".
+    let env = format!(
+        "{MINIMAL}[[light]]\nkind = \"environment\"\nmode = \"map\"\nmap = \"{}\"\nintensity = 1\n",
+        dir.path().display()
+    );
+    let msg = parse_err(&env);
+    assert!(
+        msg.contains("light[1].map") && msg.contains("is a folder"),
+        "{msg}"
+    );
+}

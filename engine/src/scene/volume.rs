@@ -20,6 +20,10 @@ use super::error::{Ctx, SceneError};
 /// Extinction per world unit at opacity 1 when a scene does not say.
 pub const DEFAULT_DENSITY_SCALE: f64 = 100.0;
 
+/// Largest `density_scale`: an opacity-1 mean free path of 10⁻⁶ of the volume, far
+/// denser than any tissue needs; past it f32 extinction sums overflow to a black image.
+pub const MAX_DENSITY_SCALE: f64 = 1e6;
+
 /// The procedural or bundled datasets every build has.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -83,7 +87,12 @@ pub struct VolumeSpec {
 
 impl VolumeSpec {
     pub(crate) fn check(&self, ctx: &Ctx) -> Result<(), SceneError> {
-        ctx.positive("volume.density_scale", self.density_scale)?;
+        ctx.positive_up_to(
+            "volume.density_scale",
+            self.density_scale,
+            MAX_DENSITY_SCALE,
+            " (extinction per world unit at opacity 1; the built-in scenes use 150)",
+        )?;
         match &self.source {
             VolumeSource::Builtin {
                 size: Some(size), ..
@@ -94,6 +103,13 @@ impl VolumeSpec {
             VolumeSource::File { path, .. } if !path.exists() => {
                 Err(ctx.invalid("volume.file", format!("{} does not exist", path.display())))
             }
+            VolumeSource::File { path, raw: Some(_) } if !path.is_file() => Err(ctx.invalid(
+                "volume.file",
+                format!(
+                    "{} is not a file (a raw volume is one file)",
+                    path.display()
+                ),
+            )),
             VolumeSource::File { raw: None, .. } => Ok(()),
             VolumeSource::File { raw: Some(r), .. } => {
                 if r.dims.contains(&0) {
@@ -102,7 +118,13 @@ impl VolumeSpec {
                     );
                 }
                 for s in r.spacing {
-                    ctx.positive("volume.spacing", s)?;
+                    ctx.in_range(
+                        "volume.spacing",
+                        s,
+                        crate::volume::MIN_SPACING_MM,
+                        crate::volume::MAX_SPACING_MM,
+                        " mm",
+                    )?;
                 }
                 Ok(())
             }
@@ -166,6 +188,13 @@ impl VolumeFile {
                     }
                 }
                 (None, Some(path)) => {
+                    if path.as_os_str().is_empty() {
+                        return Err(ctx.invalid(
+                            "volume.file",
+                            "is empty; name a volume file (.nrrd, .nhdr, .nii, .nii.gz, .dcm, raw) \
+                             or a DICOM folder",
+                        ));
+                    }
                     if self.size.is_some() {
                         return Err(ctx.invalid("volume.size", "only for `builtin` volumes"));
                     }

@@ -116,7 +116,7 @@ pub struct FrameParams<'a> {
     pub volume_dims: [u32; 3],
     /// Edge of a majorant-grid brick in voxels.
     pub brick: u32,
-    /// At most [`MAX_LIGHTS`]; more are ignored.
+    /// At most [`MAX_LIGHTS`] (scenes and the renderer refuse more).
     pub lights: &'a [GpuLight],
     pub stream: SampleStream,
     pub max_bounces: u32,

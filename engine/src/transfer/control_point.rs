@@ -71,16 +71,20 @@ impl ControlPoint {
             }
         }
         for (ch, x) in self.emissive.into_iter().enumerate() {
-            if !x.is_finite() || x < 0.0 {
+            if !(x.is_finite() && (0.0..=MAX_EMISSIVE).contains(&x)) {
                 return Err((
                     "emissive",
-                    format!("channel {ch} is {x}, must be finite and >= 0"),
+                    format!("channel {ch} is {x}, must be in [0, {MAX_EMISSIVE:e}]"),
                 ));
             }
         }
         unit("roughness", self.roughness)
     }
 }
+
+/// Largest emitted radiance per channel: far brighter than any light a scene needs,
+/// and far inside f32 when summed along a path.
+pub const MAX_EMISSIVE: f32 = 1e6;
 
 fn unit(field: &'static str, x: f32) -> Result<(), (&'static str, String)> {
     if (0.0..=1.0).contains(&x) {
@@ -121,6 +125,8 @@ mod tests {
         assert_eq!(p.check().map_err(|e| e.0), Err("diffuse"));
         p.diffuse[2] = 0.5;
         p.emissive[0] = f32::NAN;
+        assert_eq!(p.check().map_err(|e| e.0), Err("emissive"));
+        p.emissive[0] = 1e30;
         assert_eq!(p.check().map_err(|e| e.0), Err("emissive"));
         p.emissive[0] = 0.0;
         p.opacity = -0.1;

@@ -55,6 +55,10 @@ mod tag {
 }
 use tag::Tag;
 
+/// Largest slice file read: a 4096×4096 16-bit slice (32 MiB, the largest this engine
+/// uploads) plus generous room for its other attributes.
+const MAX_SLICE_FILE_BYTES: u64 = 96 << 20;
+
 /// One parsed slice.
 #[derive(Debug)]
 struct Slice {
@@ -124,14 +128,31 @@ fn has_preamble(p: &Path) -> bool {
 /// Loads the given slice files as one series; `series_path` names the series in errors
 /// and gives the volume its name.
 pub(crate) fn load_files(series_path: &Path, files: Vec<PathBuf>) -> Result<Volume, VolumeError> {
-    let mut slices = files
-        .iter()
-        .map(|f| parse_file(f))
-        .collect::<Result<Vec<_>, _>>()?;
     let inconsistent = |problem: String| VolumeError::InconsistentSeries {
         path: series_path.to_path_buf(),
         problem,
     };
+    // Bound what is read before reading it: the slice count is the volume's depth, and
+    // the first slice's size times that count is the whole volume.
+    if files.len() as u64 > u64::from(super::MAX_DIM) {
+        return Err(inconsistent(format!(
+            "{} slice files; at most {} slices are stacked (the largest 3D texture this \
+             engine uploads)",
+            files.len(),
+            super::MAX_DIM
+        )));
+    }
+    let mut slices = Vec::with_capacity(files.len());
+    for f in &files {
+        let s = parse_file(f)?;
+        if slices.is_empty() {
+            validate_dims(
+                series_path,
+                [i64::from(s.cols), i64::from(s.rows), files.len() as i64],
+            )?;
+        }
+        slices.push(s);
+    }
     let Some(first) = slices.first() else {
         return Err(inconsistent("no slices".into()));
     };
@@ -226,6 +247,11 @@ pub(crate) fn load_files(series_path: &Path, files: Vec<PathBuf>) -> Result<Volu
     Volume::from_stored(series_path, name, dims, spacing, stored)
 }
 
+/// A slice gap further than this fraction from the mean spacing is an error.
+const UNEVEN_SPACING_ERROR: f64 = 0.1;
+/// A slice gap further than this fraction from the mean spacing is worth a warning.
+const UNEVEN_SPACING_WARNING: f64 = 0.01;
+
 /// Sorts slices in place and returns the slice distance in mm.
 fn sort_slices(series_path: &Path, slices: &mut [Slice]) -> Result<f64, VolumeError> {
     let inconsistent = |problem: String| VolumeError::InconsistentSeries {
@@ -274,11 +300,35 @@ fn sort_slices(series_path: &Path, slices: &mut [Slice]) -> Result<f64, VolumeEr
         )));
     }
     let mean = (d[d.len() - 1] - d[0]) / gaps.len() as f64;
-    if let Some(g) = gaps.iter().find(|&&g| (g - mean).abs() > 0.1 * mean) {
-        log::warn!(
-            "{}: uneven slice spacing ({g:.3} mm vs mean {mean:.3} mm); using the mean",
-            series_path.display()
+    // Slices are stacked at one spacing: a gap far from it (a missing slice, two
+    // stacks) would put every slice after it at the wrong place, so it is an error; a
+    // small unevenness (rounding in the positions) is only worth a warning.
+    let worst = gaps
+        .iter()
+        .enumerate()
+        .max_by(|a, b| (a.1 - mean).abs().total_cmp(&(b.1 - mean).abs()));
+    if let Some((i, &g)) = worst {
+        let deviation = (g - mean).abs() / mean;
+        let between = format!(
+            "{} and {}",
+            slices[i].file.display(),
+            slices[i + 1].file.display()
         );
+        if deviation > UNEVEN_SPACING_ERROR {
+            return Err(inconsistent(format!(
+                "uneven slice spacing: {g:.3} mm between {between}, but {mean:.3} mm on \
+                 average (more than {:.0}% off); the slices are stacked at one spacing, so \
+                 the volume's geometry would be wrong (a missing slice? two stacks?)",
+                UNEVEN_SPACING_ERROR * 100.0
+            )));
+        }
+        if deviation > UNEVEN_SPACING_WARNING {
+            log::warn!(
+                "{}: uneven slice spacing ({g:.3} mm between {between} vs {mean:.3} mm on \
+                 average); slices are stacked at the mean",
+                series_path.display()
+            );
+        }
     }
     Ok(mean)
 }
@@ -432,6 +482,22 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// ImageOrientationPatient must hold two orthogonal unit vectors (the row and column
+/// directions): the slice normal, and so the slice order, comes from them.
+fn check_orientation(o: &[f64; 6]) -> Result<(), String> {
+    let (r, c) = ([o[0], o[1], o[2]], [o[3], o[4], o[5]]);
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let unit = |v: [f64; 3]| (dot(v, v).sqrt() - 1.0).abs() < 0.01;
+    if unit(r) && unit(c) && dot(r, c).abs() < 0.01 {
+        Ok(())
+    } else {
+        Err(format!(
+            "{o:?} is not two orthogonal unit vectors (row and column directions), so the \
+             slice order cannot be derived from it"
+        ))
+    }
+}
+
 fn text(v: &[u8]) -> String {
     String::from_utf8_lossy(v)
         .trim_matches(|c: char| c == '\0' || c.is_whitespace())
@@ -440,7 +506,7 @@ fn text(v: &[u8]) -> String {
 
 /// Parses one file down to its pixel data.
 fn parse_file(path: &Path) -> Result<Slice, VolumeError> {
-    let bytes = io::read_all(path)?;
+    let bytes = io::read_small(path, MAX_SLICE_FILE_BYTES, "a single-frame DICOM slice")?;
     let mut r = Reader {
         path,
         b: &bytes,
@@ -573,8 +639,11 @@ fn parse_file(path: &Path) -> Result<Slice, VolumeError> {
                 s.position = Some([p[0], p[1], p[2]]);
             }
             tag::ORIENTATION => {
-                let o = fixed("ImageOrientationPatient (0020,0037)", 6)?;
-                s.orientation = Some([o[0], o[1], o[2], o[3], o[4], o[5]]);
+                let field = "ImageOrientationPatient (0020,0037)";
+                let o = fixed(field, 6)?;
+                let o = [o[0], o[1], o[2], o[3], o[4], o[5]];
+                check_orientation(&o).map_err(|problem| r.malformed(field, problem))?;
+                s.orientation = Some(o);
             }
             tag::INSTANCE_NUMBER if len > 0 => {
                 s.instance = Some(fixed("InstanceNumber (0020,0013)", 1)?[0] as i64);

@@ -18,6 +18,10 @@ pub enum VolumeError {
         source: std::io::Error,
     },
 
+    /// The path is a folder, FIFO, socket or device where a file was expected.
+    #[error("{}: is {what}, not a file (volume data must be a regular file)", path.display())]
+    NotAFile { path: PathBuf, what: &'static str },
+
     /// The voxel data ends early.
     #[error("{}: truncated: expected {expected} bytes of voxel data, found {found}", path.display())]
     Truncated {

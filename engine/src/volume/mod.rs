@@ -361,21 +361,71 @@ pub(crate) fn validate_dims(path: &Path, dims: [i64; 3]) -> Result<[u32; 3], Vol
     Ok(dims.map(|d| d as u32))
 }
 
-/// Checks that voxel spacings are finite and positive; `field` names the header field.
+/// Smallest voxel spacing accepted, in mm (1 nm: past electron microscopy).
+pub const MIN_SPACING_MM: f64 = 1e-6;
+/// Largest voxel spacing accepted, in mm (1 km).
+pub const MAX_SPACING_MM: f64 = 1e6;
+/// Largest ratio between the largest and smallest spacing: anisotropic MRI is about
+/// 1:10; past 1:1000 the volume renders as a sheet (and usually a header is wrong).
+pub const MAX_ANISOTROPY: f64 = 1e3;
+
+/// Checks that voxel spacings are finite, in `[MIN_SPACING_MM, MAX_SPACING_MM]` and
+/// within [`MAX_ANISOTROPY`] of each other; `field` names the header field. Outside
+/// those the volume's world size overflows f32 or collapses to a sheet: a black image.
 pub(crate) fn validate_spacing(
     path: &Path,
     field: &str,
     spacing: [f64; 3],
 ) -> Result<[f32; 3], VolumeError> {
-    if spacing.iter().all(|s| s.is_finite() && *s > 0.0) {
-        Ok(spacing.map(|s| s as f32))
-    } else {
-        Err(VolumeError::MalformedHeader {
-            path: path.to_path_buf(),
-            field: field.to_string(),
-            problem: format!("voxel spacing {spacing:?} must be finite and positive"),
-        })
+    let bad = |problem: String| VolumeError::MalformedHeader {
+        path: path.to_path_buf(),
+        field: field.to_string(),
+        problem,
+    };
+    if !spacing
+        .iter()
+        .all(|s| s.is_finite() && (MIN_SPACING_MM..=MAX_SPACING_MM).contains(s))
+    {
+        return Err(bad(format!(
+            "voxel spacing {spacing:?} must be finite and in [{MIN_SPACING_MM:e}, \
+             {MAX_SPACING_MM:e}] mm"
+        )));
     }
+    let (lo, hi) = spacing
+        .iter()
+        .fold((f64::MAX, 0f64), |(lo, hi), &s| (lo.min(s), hi.max(s)));
+    if hi / lo > MAX_ANISOTROPY {
+        return Err(bad(format!(
+            "voxel spacing {spacing:?}: the largest is {:.0} times the smallest (at most \
+             {MAX_ANISOTROPY:.0}); the volume would render as a sheet",
+            hi / lo
+        )));
+    }
+    Ok(spacing.map(|s| s as f32))
+}
+
+/// [`Volume::load`] on another thread, failing if it does not return within `secs`
+/// seconds: what tests of endless or blocking inputs use, so a regression fails the test
+/// instead of hanging it (the stuck thread is left behind; the test process ends).
+#[cfg(test)]
+pub(crate) fn load_within_seconds(path: &Path, secs: u64) -> Result<Volume, VolumeError> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let p = path.to_path_buf();
+    std::thread::spawn(move || {
+        let _ = tx.send(Volume::load(&p, None));
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(secs))
+        .unwrap_or_else(|_| panic!("loading {} took over {secs} s", path.display()))
+}
+
+/// Makes a FIFO at `path` (with `mkfifo`); false where that is not possible, and the
+/// test that wants one skips that part.
+#[cfg(test)]
+pub(crate) fn make_fifo(path: &Path) -> bool {
+    std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .is_ok_and(|s| s.success())
 }
 
 /// The volume name for a file: its name without the (double) extension.

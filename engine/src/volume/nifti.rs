@@ -8,10 +8,8 @@
 //! normalisation. 4D files are read only when the extra dimensions have size 1. The
 //! orientation (qform/sform) is ignored: voxels keep the file's index order.
 
-use std::io::Read;
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
-
-use flate2::read::MultiGzDecoder;
 
 use super::error::VolumeError;
 use super::samples::{Affine, Rescale, SampleKind, Samples, Stored};
@@ -32,12 +30,22 @@ struct Header {
     rescale: Affine,
 }
 
-/// Loads a `.nii` or `.nii.gz` file.
+/// Loads a `.nii` or `.nii.gz` file. The header is read and checked first; the data
+/// after it is read only up to what the header's dims promise (one byte more, to tell a
+/// too-long file), so a huge or endless file costs no more memory than its volume.
 pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
-    let file = io::read_all(path)?;
-    let gz = file.starts_with(&[0x1f, 0x8b]);
+    let (file, len) = io::open_regular(path)?;
+    let io_err = |source| VolumeError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut reader = BufReader::new(file);
+    let gz = reader
+        .fill_buf()
+        .map_err(io_err)?
+        .starts_with(&[0x1f, 0x8b]);
     let (header, data) = if gz {
-        let mut dec = MultiGzDecoder::new(file.as_slice());
+        let mut dec = io::GzMembers::new(reader);
         let mut head = vec![0u8; HEADER_LEN];
         dec.read_exact(&mut head).map_err(|e| match e.kind() {
             std::io::ErrorKind::UnexpectedEof => short_header(path),
@@ -49,15 +57,29 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         let header = parse_header(path, &head)?;
         let expected = io::expected_bytes(header.dims, header.kind);
         let skip = header.vox_offset - HEADER_LEN as u64;
-        let data = io::read_bounded(path, dec, skip, expected)?;
+        let past_end = |got: u64| offset_past_end(path, header.vox_offset, HEADER_LEN as u64 + got);
+        let data = io::read_bounded(path, &mut dec, skip, expected, &past_end)?;
+        if data.len() as u64 == expected {
+            io::note_trailing_bytes(path, &dec);
+        }
         (header, data)
     } else {
-        let head = file.get(..HEADER_LEN).ok_or_else(|| short_header(path))?;
-        let header = parse_header(path, head)?;
-        let start = usize::try_from(header.vox_offset)
-            .unwrap_or(usize::MAX)
-            .min(file.len());
-        (header, file[start..].to_vec())
+        let mut head = Vec::with_capacity(HEADER_LEN);
+        (&mut reader)
+            .take(HEADER_LEN as u64)
+            .read_to_end(&mut head)
+            .map_err(io_err)?;
+        let header = parse_header(path, &head)?;
+        if header.vox_offset >= len {
+            return Err(offset_past_end(path, header.vox_offset, len));
+        }
+        // Check the size before reading, so a wrong header on a huge file fails fast.
+        io::check_len(path, header.dims, header.kind, len - header.vox_offset)?;
+        let expected = io::expected_bytes(header.dims, header.kind);
+        let skip = header.vox_offset - HEADER_LEN as u64;
+        let past_end = |got: u64| offset_past_end(path, header.vox_offset, HEADER_LEN as u64 + got);
+        let data = io::read_bounded(path, reader, skip, expected, &past_end)?;
+        (header, data)
     };
     io::check_len(path, header.dims, header.kind, data.len() as u64)?;
     let stored = Stored {
@@ -66,6 +88,17 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         rescale: Rescale::Uniform(header.rescale),
     };
     Volume::from_stored(path, name_of(path), header.dims, header.spacing, stored)
+}
+
+/// `vox_offset` at or past the end of the (decompressed) file of `len` bytes.
+fn offset_past_end(path: &Path, vox_offset: u64, len: u64) -> VolumeError {
+    VolumeError::MalformedHeader {
+        path: path.to_path_buf(),
+        field: "vox_offset".into(),
+        problem: format!(
+            "the voxel data would start at byte {vox_offset}, but the file ends at byte {len}"
+        ),
+    }
 }
 
 fn short_header(path: &Path) -> VolumeError {

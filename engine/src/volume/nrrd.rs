@@ -9,6 +9,7 @@
 //! encodings are rejected with a message saying so.
 
 use std::collections::HashMap;
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use super::error::VolumeError;
@@ -17,11 +18,14 @@ use super::{io, name_of, validate_dims, validate_spacing, Volume};
 
 const SUPPORTED_TYPES: &str = "uint8, uint16, int16, float";
 
+/// Longest header read before giving up: real headers are a few hundred bytes.
+const MAX_HEADER_BYTES: u64 = 1 << 20;
+
 /// A parsed header.
 struct Header {
     fields: HashMap<String, String>,
     /// Offset of the first byte after the header's blank line, if there is one.
-    data_offset: Option<usize>,
+    data_offset: Option<u64>,
 }
 
 impl Header {
@@ -40,8 +44,9 @@ impl Header {
 
 /// Loads a `.nrrd` or `.nhdr` file.
 pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
-    let file = io::read_all(path)?;
-    let header = parse_header(path, &file)?;
+    let (file, file_len) = io::open_regular(path)?;
+    let mut reader = BufReader::new(file);
+    let header = parse_header(path, &mut reader)?;
     let malformed = |field: &str, problem: String| VolumeError::MalformedHeader {
         path: path.to_path_buf(),
         field: field.to_string(),
@@ -101,12 +106,13 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         None => 0,
     };
 
-    // Where the (possibly compressed) data lives.
+    // Where the (possibly compressed) data lives: a detached file, or this file after
+    // the header's blank line. Nothing is read yet.
     let data_field = header
         .fields
         .get("data file")
         .or_else(|| header.fields.get("datafile"));
-    let (data_path, data_file, start) = match data_field {
+    let (data_path, mut data, data_len): (PathBuf, Box<dyn BufRead>, u64) = match data_field {
         Some(name) => {
             let name = name.trim();
             if name.starts_with("LIST") || name.contains(' ') || name.contains('%') {
@@ -115,42 +121,86 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
                     reason: format!("multi-file NRRD data (`data file: {name}`)"),
                 });
             }
+            if name.is_empty() {
+                return Err(malformed("data file", "is empty".into()));
+            }
             let p = resolve(path, name);
-            let bytes = io::read_all(&p)?;
-            (p, bytes, 0)
+            let (file, len) = io::open_regular(&p).map_err(|e| match e {
+                // Name the header too: it is what the user points at.
+                VolumeError::NotAFile { what, .. } => malformed(
+                    "data file",
+                    format!("{} is {what}, not a file of voxel data", p.display()),
+                ),
+                other => other,
+            })?;
+            (p, Box::new(BufReader::new(file)), len)
+        }
+        None if is_detached_header(path) => {
+            return Err(malformed(
+                "data file",
+                "missing: a detached header (.nhdr) names the file holding the voxel data \
+                 with `data file: NAME`"
+                    .into(),
+            ))
         }
         None => {
             let offset = header.data_offset.ok_or_else(|| {
                 malformed(
                     "data file",
-                    "no data after the header and no `data file` field".into(),
+                    "no blank line ends the header, so no data follows it, and there is no \
+                     `data file` field"
+                        .into(),
                 )
             })?;
-            (path.to_path_buf(), file, offset)
+            (
+                path.to_path_buf(),
+                Box::new(reader),
+                file_len.saturating_sub(offset),
+            )
         }
     };
-    let start = skip_lines(&data_file, start, line_skip).ok_or_else(|| {
-        malformed(
-            "line skip",
-            format!("the data has fewer than {line_skip} lines"),
-        )
-    })?;
-    let region = &data_file[start..];
+    let mut skipped_lines: u64 = 0;
+    for _ in 0..line_skip {
+        let mut line = Vec::new();
+        let n = (&mut data)
+            .take(MAX_HEADER_BYTES)
+            .read_until(b'\n', &mut line)
+            .map_err(|source| VolumeError::Io {
+                path: data_path.clone(),
+                source,
+            })?;
+        if n == 0 || line.last() != Some(&b'\n') {
+            return Err(malformed(
+                "line skip",
+                format!("the data has fewer than {line_skip} lines"),
+            ));
+        }
+        skipped_lines += n as u64;
+    }
+    let region_len = data_len.saturating_sub(skipped_lines);
     let expected = io::expected_bytes(dims, kind);
+    let skip_past_end = |got: u64| {
+        malformed(
+            "byte skip",
+            format!("skips {byte_skip} bytes, but the data has only {got}"),
+        )
+    };
 
     let encoding = field("encoding")?.trim().to_ascii_lowercase();
     let bytes = match encoding.as_str() {
         "raw" => {
             let skip = if byte_skip == -1 {
                 // -1: the data is the last `expected` bytes of the file.
-                (region.len() as u64).saturating_sub(expected)
+                region_len.saturating_sub(expected)
             } else {
                 byte_skip as u64
             };
-            let skip = usize::try_from(skip)
-                .unwrap_or(usize::MAX)
-                .min(region.len());
-            region[skip..].to_vec()
+            if skip > region_len {
+                return Err(skip_past_end(region_len));
+            }
+            // Check the size before reading, so wrong dims on a huge file fail fast.
+            io::check_len(&data_path, dims, kind, region_len - skip)?;
+            io::read_bounded(&data_path, data, skip, expected, &skip_past_end)?
         }
         "gzip" | "gz" => {
             if byte_skip < 0 {
@@ -159,7 +209,18 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
                     "-1 is only allowed with raw encoding".into(),
                 ));
             }
-            io::gunzip_bounded(&data_path, region, byte_skip as u64, expected)?
+            let mut gz = io::GzMembers::new(data);
+            let bytes = io::read_bounded(
+                &data_path,
+                &mut gz,
+                byte_skip as u64,
+                expected,
+                &skip_past_end,
+            )?;
+            if bytes.len() as u64 == expected {
+                io::note_trailing_bytes(&data_path, &gz);
+            }
+            bytes
         }
         other => {
             return Err(VolumeError::Unsupported {
@@ -173,62 +234,84 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
     Volume::from_stored(path, name_of(path), dims, spacing, stored)
 }
 
-/// Splits the header into fields; `data_offset` is set when a blank line ends it.
-fn parse_header(path: &Path, file: &[u8]) -> Result<Header, VolumeError> {
+/// True for a `.nhdr` file, which by definition keeps its data in another file.
+fn is_detached_header(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("nhdr"))
+}
+
+/// Reads the header's lines into fields, leaving `reader` at the first byte after the
+/// blank line that ends it (`data_offset`), or at the end of a file without one. Reads
+/// at most [`MAX_HEADER_BYTES`].
+fn parse_header(path: &Path, reader: &mut impl BufRead) -> Result<Header, VolumeError> {
+    let malformed = |field: &str, problem: String| VolumeError::MalformedHeader {
+        path: path.to_path_buf(),
+        field: field.to_string(),
+        problem,
+    };
     let mut fields = HashMap::new();
-    let mut pos = 0;
+    let mut pos: u64 = 0;
     let mut first = true;
     let mut data_offset = None;
-    while pos < file.len() {
-        let end = file[pos..]
-            .iter()
-            .position(|&b| b == b'\n')
-            .map_or(file.len(), |i| pos + i);
-        let raw = &file[pos..end];
-        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
-        pos = (end + 1).min(file.len());
-        let line = std::str::from_utf8(raw).map_err(|_| VolumeError::MalformedHeader {
-            path: path.to_path_buf(),
-            field: "header".into(),
-            problem: "header line is not text (missing blank line before the data?)".into(),
+    let mut raw = Vec::new();
+    loop {
+        raw.clear();
+        let room = MAX_HEADER_BYTES.saturating_sub(pos);
+        let n = reader
+            .take(room)
+            .read_until(b'\n', &mut raw)
+            .map_err(|source| VolumeError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        if n == 0 {
+            if pos >= MAX_HEADER_BYTES {
+                return Err(malformed(
+                    "header",
+                    format!(
+                        "no blank line ends the header within its first {MAX_HEADER_BYTES} bytes"
+                    ),
+                ));
+            }
+            break;
+        }
+        pos += n as u64;
+        let line = raw.strip_suffix(b"\n").unwrap_or(&raw);
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        let line = std::str::from_utf8(line).map_err(|_| {
+            malformed(
+                "header",
+                "header line is not text (missing blank line before the data?)".into(),
+            )
         })?;
         if first {
             if !line.starts_with("NRRD000") {
-                return Err(VolumeError::MalformedHeader {
-                    path: path.to_path_buf(),
-                    field: "magic".into(),
-                    problem: format!("file does not start with NRRD000x (found {line:.16?})"),
-                });
+                return Err(malformed(
+                    "magic",
+                    format!("file does not start with NRRD000x (found {line:.16?})"),
+                ));
             }
             first = false;
             continue;
         }
         if line.is_empty() {
-            data_offset = Some(end + 1);
+            data_offset = Some(pos);
             break;
         }
         if line.starts_with('#') || line.contains(":=") {
             continue; // comment or key/value pair
         }
         let Some((key, value)) = line.split_once(':') else {
-            return Err(VolumeError::MalformedHeader {
-                path: path.to_path_buf(),
-                field: line.to_string(),
-                problem: "expected `field: value`".into(),
-            });
+            return Err(malformed(line, "expected `field: value`".into()));
         };
         fields.insert(key.trim().to_ascii_lowercase(), value.trim().to_string());
     }
     if first {
-        return Err(VolumeError::MalformedHeader {
-            path: path.to_path_buf(),
-            field: "magic".into(),
-            problem: "empty file".into(),
-        });
+        return Err(malformed("magic", "empty file".into()));
     }
     Ok(Header {
         fields,
-        data_offset: data_offset.filter(|&o| o <= file.len()),
+        data_offset,
     })
 }
 
@@ -254,7 +337,7 @@ fn parse_type(path: &Path, t: &str) -> Result<SampleKind, VolumeError> {
 /// when an axis of size 1 is dropped.
 fn spatial_axes(path: &Path, sizes: &[i64]) -> Result<Vec<usize>, VolumeError> {
     match sizes.len() {
-        1..=3 => Ok((0..sizes.len()).collect()),
+        2 | 3 => Ok((0..sizes.len()).collect()),
         4 => match sizes.iter().position(|&s| s == 1) {
             Some(drop) => Ok((0..4).filter(|&a| a != drop).collect()),
             None => Err(VolumeError::Unsupported {
@@ -264,7 +347,9 @@ fn spatial_axes(path: &Path, sizes: &[i64]) -> Result<Vec<usize>, VolumeError> {
         },
         n => Err(VolumeError::Unsupported {
             path: path.to_path_buf(),
-            reason: format!("NRRD dimension {n}; 2, 3 or 4 (with a size-1 axis) are read"),
+            reason: format!(
+                "NRRD dimension {n}: a volume needs 2 (one slice), 3, or 4 (with a size-1 axis)"
+            ),
         }),
     }
 }
@@ -346,15 +431,6 @@ fn parse_directions(s: &str) -> Option<Vec<Option<f64>>> {
         rest = r[close + 1..].trim_start();
     }
     Some(out)
-}
-
-/// Offset after skipping `lines` newline-terminated lines from `start`.
-fn skip_lines(data: &[u8], mut start: usize, lines: usize) -> Option<usize> {
-    for _ in 0..lines {
-        let nl = data.get(start..)?.iter().position(|&b| b == b'\n')?;
-        start += nl + 1;
-    }
-    Some(start)
 }
 
 /// A detached data file name, relative to the header's folder unless absolute.

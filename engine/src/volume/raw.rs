@@ -62,6 +62,9 @@ fn unit_spacing() -> [f32; 3] {
     [1.0; 3]
 }
 
+/// Largest sidecar read: a few lines of TOML or JSON.
+const MAX_SIDECAR_BYTES: u64 = 64 << 10;
+
 /// The sidecar paths tried for `path`, in order.
 fn sidecar_paths(path: &Path) -> [PathBuf; 2] {
     ["json", "toml"].map(|ext| {
@@ -78,7 +81,7 @@ pub(crate) fn read_sidecar(path: &Path) -> Result<Option<RawParams>, VolumeError
         if !side.is_file() {
             continue;
         }
-        let bytes = io::read_all(&side)?;
+        let bytes = io::read_small(&side, MAX_SIDECAR_BYTES, "a sidecar")?;
         let text = String::from_utf8_lossy(&bytes);
         let parsed = if side.extension().is_some_and(|e| e == "json") {
             serde_json::from_str::<RawParams>(&text).map_err(|e| e.to_string())
@@ -102,14 +105,14 @@ pub(crate) fn load(path: &Path, params: &RawParams) -> Result<Volume, VolumeErro
     let spacing = validate_spacing(path, "spacing", params.spacing.map(f64::from))?;
     let kind = params.format.kind();
     // Check the size before reading, so wrong dims on a huge file fail fast.
-    let len = std::fs::metadata(path)
-        .map_err(|source| VolumeError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?
-        .len();
+    let (file, len) = io::open_regular(path)?;
     io::check_len(path, dims, kind, len)?;
-    let bytes = io::read_all(path)?;
+    let expected = io::expected_bytes(dims, kind);
+    let bytes = io::read_bounded(path, file, 0, expected, &|found| VolumeError::Truncated {
+        path: path.to_path_buf(),
+        expected,
+        found,
+    })?;
     io::check_len(path, dims, kind, bytes.len() as u64)?;
     let stored = Stored::plain(Samples::decode(kind, bytes, false));
     Volume::from_stored(path, name_of(path), dims, spacing, stored)

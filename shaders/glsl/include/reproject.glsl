@@ -20,6 +20,7 @@ layout(constant_id = 8) const int MOTION_SOURCE = 0;
 
 struct Reprojection {
     vec2 uv;        // last frame's texture coordinate of this pixel's surface
+    vec2 motion;    // this pixel's motion to last frame, in pixels
     bool valid;     // on screen, same surface, history exists
     ivec2 tap;      // the first (lower-left) texel of the bilinear footprint at uv
     vec4 weights;   // bilinear weights of taps (0,0) (1,0) (0,1) (1,1), zero for a tap
@@ -67,6 +68,7 @@ Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, flo
     vec2 delta = MOTION_SOURCE == 0 ? m.xy : m.zw;
     vec2 q = vec2(p) + 0.5 + delta;
     r.uv = q / vec2(size);
+    r.motion = delta;
     r.valid = history_valid && all(greaterThanEqual(q, vec2(0.0))) && all(lessThan(q, vec2(size)));
     r.tap = ivec2(floor(q - 0.5));
     r.weights = vec4(0.0);

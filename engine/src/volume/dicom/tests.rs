@@ -56,6 +56,37 @@ fn three_slice_series_sorts_by_position_and_rescales() {
 }
 
 #[test]
+fn zeroed_orientation_and_uneven_spacing_are_named() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let zeroed = dir.path().join("zeroed");
+    std::fs::create_dir(&zeroed).expect("mkdir");
+    for z in 0..3 {
+        let mut s = slice(z, vec![0; 12]);
+        s.orientation = Some([0.0; 6]);
+        write::dicom(&zeroed.join(format!("s{z}.dcm")), &s);
+    }
+    // Used to say the slices "lie at the same position".
+    let msg = Volume::load(&zeroed, None).unwrap_err().to_string();
+    assert!(
+        msg.contains("ImageOrientationPatient") && msg.contains("orthogonal unit vectors"),
+        "{msg}"
+    );
+
+    // A missing slice (gaps 2.5, 5.0) used to be stacked at the mean with a warning
+    // nobody saw: the geometry was wrong.
+    let gap = dir.path().join("gap");
+    std::fs::create_dir(&gap).expect("mkdir");
+    for (i, z) in [0, 1, 3].into_iter().enumerate() {
+        write::dicom(&gap.join(format!("s{i}.dcm")), &slice(z, vec![0; 12]));
+    }
+    let msg = Volume::load(&gap, None).unwrap_err().to_string();
+    assert!(
+        msg.contains("uneven slice spacing") && msg.contains("5.000 mm"),
+        "{msg}"
+    );
+}
+
+#[test]
 fn instance_number_fallback_and_8_bit() {
     let dir = tempfile::tempdir().expect("tempdir");
     for (file, inst) in [("x1.dcm", 3), ("x2.dcm", 1), ("x3.dcm", 2)] {

@@ -138,6 +138,90 @@ fn bad_files_are_rejected_by_name() {
 }
 
 #[test]
+fn header_is_checked_before_the_data_is_read() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("t4.nii");
+    write::nifti(
+        &path,
+        [5, 4, 3],
+        [1.0; 3],
+        &NiftiData::U8(vec![7; 60]),
+        None,
+    );
+    let mut b = std::fs::read(&path).expect("read");
+    b[40..42].copy_from_slice(&4i16.to_le_bytes());
+    b[48..50].copy_from_slice(&20i16.to_le_bytes());
+    write::bytes(&path, &b);
+    // An 8 GiB (sparse) 4-D file: the loader used to read all of it first.
+    let f = std::fs::OpenOptions::new()
+        .write(true)
+        .open(&path)
+        .expect("open");
+    f.set_len(8 << 30).expect("sparse file");
+    let err = crate::volume::load_within_seconds(&path, 5).unwrap_err();
+    assert!(matches!(err, VolumeError::Unsupported { .. }), "{err}");
+    assert!(err.to_string().contains("4D NIfTI"), "{err}");
+}
+
+#[test]
+fn clear_messages_for_vox_offset_pixdim_and_trailing_gzip_bytes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for name in ["off.nii", "off.nii.gz"] {
+        let path = dir.path().join(name);
+        let plain = dir.path().join("plain.nii");
+        write::nifti(
+            &plain,
+            [5, 4, 3],
+            [1.0; 3],
+            &NiftiData::U8(vec![7; 60]),
+            None,
+        );
+        let mut b = std::fs::read(&plain).expect("read");
+        b[108..112].copy_from_slice(&1000f32.to_le_bytes());
+        if name.ends_with(".gz") {
+            let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+            std::io::Write::write_all(&mut e, &b).expect("gzip");
+            b = e.finish().expect("gzip");
+        }
+        write::bytes(&path, &b);
+        // Used to say "truncated: expected 60 bytes of voxel data, found 0".
+        let err = Volume::load(&path, None).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            msg.contains(name) && msg.contains("vox_offset") && msg.contains("1000"),
+            "{msg}"
+        );
+    }
+
+    // pixdim 3e38 used to load (and render black).
+    let path = dir.path().join("px.nii");
+    write::nifti(
+        &path,
+        [5, 4, 3],
+        [1.0, 3e38, 1.0],
+        &NiftiData::U8(vec![7; 60]),
+        None,
+    );
+    let msg = Volume::load(&path, None).unwrap_err().to_string();
+    assert!(msg.contains("pixdim") && msg.contains("1e6"), "{msg}");
+
+    // Valid gzip followed by other bytes used to fail with "invalid gzip header".
+    let path = dir.path().join("tail.nii.gz");
+    write::nifti(
+        &path,
+        [5, 4, 3],
+        [1.0; 3],
+        &NiftiData::U8(vec![7; 60]),
+        None,
+    );
+    let mut b = std::fs::read(&path).expect("read");
+    b.extend_from_slice(&[0; 100]);
+    write::bytes(&path, &b);
+    let v = Volume::load(&path, None).expect("complete data with trailing zeros");
+    assert_eq!(v.data, VolumeData::U8(vec![7; 60]));
+}
+
+#[test]
 fn nan_in_float_nifti_is_rejected() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("nan.nii.gz");

@@ -215,6 +215,81 @@ fn bad_files_are_rejected_by_name() {
 }
 
 #[test]
+fn detached_data_that_is_a_device_fifo_or_missing_is_refused_at_once() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let header = |name: &str, data_file: Option<&str>| {
+        let p = dir.path().join(name);
+        let mut h =
+            "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 64 64 64\nencoding: raw\n".to_string();
+        if let Some(f) = data_file {
+            h += &format!("data file: {f}\n");
+        }
+        write::text(&p, &h);
+        p
+    };
+    // Used to read /dev/zero until memory ran out (3 GB in 2.5 s).
+    let p = header("zero.nhdr", Some("/dev/zero"));
+    let err = crate::volume::load_within_seconds(&p, 5).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains("zero.nhdr") && msg.contains("/dev/zero is a character device"),
+        "{msg}"
+    );
+    // Used to block forever opening the FIFO.
+    let fifo = dir.path().join("pipe.raw");
+    if crate::volume::make_fifo(&fifo) {
+        let p = header("fifo.nhdr", Some("pipe.raw"));
+        let err = crate::volume::load_within_seconds(&p, 5).unwrap_err();
+        assert!(err.to_string().contains("FIFO"), "{err}");
+    }
+    // Used to say "truncated: ... found 0".
+    let p = header("nodata.nhdr", None);
+    let err = Volume::load(&p, None).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains("nodata.nhdr") && msg.contains("data file") && msg.contains("detached"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn one_dimensional_nrrd_is_refused_with_the_dimensions_it_takes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = dir.path().join("line.nrrd");
+    let mut f = b"NRRD0004\ntype: uint8\ndimension: 1\nsizes: 4\nencoding: raw\n\n".to_vec();
+    f.extend_from_slice(&[0, 1, 2, 3]);
+    write::bytes(&p, &f);
+    let err = Volume::load(&p, None).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains("line.nrrd") && msg.contains("dimension 1") && msg.contains("2 (one slice)"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn gzip_data_followed_by_other_bytes_loads_with_a_clear_note() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("t.nrrd");
+    let values: Vec<u8> = (0..24).map(|i| i * 10).collect();
+    write::nrrd(
+        &path,
+        [2, 3, 4],
+        [1.0; 3],
+        &NrrdData::U8(values.clone()),
+        true,
+        false,
+        false,
+    );
+    let mut bytes = std::fs::read(&path).expect("read");
+    bytes.extend_from_slice(b"\ntrailing text");
+    write::bytes(&path, &bytes);
+    // Used to fail with "invalid gzip header".
+    let v = Volume::load(&path, None).expect("complete data with trailing bytes");
+    assert_eq!(v.data, VolumeData::U8(values));
+}
+
+#[test]
 fn directions_parse() {
     let v = parse_directions("none (1,0,0) (0, 2 ,0) (0,0,-3)").expect("parse");
     assert_eq!(v, vec![None, Some(1.0), Some(2.0), Some(3.0)]);

@@ -1,0 +1,369 @@
+//! `ours` and the paper's weighted-RLS family (TVCG §5–6), from the same passes through
+//! specialisation constants and variant switches.
+//!
+//! Passes of a frame, in order (each in its own file here):
+//! - `<name>.gradient` ([`gradient`], `wrls_gradient.comp`): temporal gradients, when the
+//!   scene changed: last frame's samples re-traced in this frame's scene;
+//! - `<name>.update` ([`update`]): the per-pixel models reprojected, adjusted for the
+//!   measured change and updated by weighted RLS: `wrls_constant.comp` for ours' constant
+//!   model p = [1] (two state images), `wrls_update.comp` for the paper's p = [1, z]
+//!   (nine state images);
+//! - `<name>.drift` ([`spatial`], `wrls_drift.comp`): the pooled lag test;
+//! - `<name>.atrous0..k` ([`spatial`], `wrls_atrous.comp`): ours' à-trous spatial filter
+//!   on the models' standard errors, or `<name>.spatial` (`wrls_spatial.comp`): the
+//!   paper's 5×5 model blending.
+//!
+//! Variants: `ours` and its ablations (one part each: `ours-feature`,
+//! `ours-no-gradient`, `ours-no-atrous`, `ours-no-drift`, `ours-fixed-lambda`), the paper's
+//! exact form `wrls-paper` and its Fig. 8 ablations `rls`, `wrls-nf`, `rls-nf`.
+
+mod gradient;
+mod spatial;
+mod update;
+
+use super::{DenoiseInputs, Denoiser, MotionSource};
+use crate::error::Result;
+use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
+use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::passes::path_trace::{self, PathTraceFeatures};
+use ash::vk;
+
+/// The paper's parameters (λ, α, h, δ, the 5×5 blending) and ours'.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WrlsParams {
+    pub lambda: f32,
+    /// Ours' forgetting factor for a pixel whose surface moved on screen (camera motion).
+    pub lambda_moving: f32,
+    pub alpha: f32,
+    /// Bandwidth of the paper's relative-distance weights (`wrls-paper` only).
+    pub h: f32,
+    /// Initial P = delta · I for a new model.
+    pub delta: f32,
+    /// Disocclusion tolerance in pixels (see [`super::REPROJECTION_TOLERANCE_PX`]).
+    pub tolerance: f32,
+    pub sigma_spatial: f32,
+    pub sigma_range: f32,
+    /// Standard errors by which a neighbour's prediction may differ from the pixel's own
+    /// and still be blended (ours' spatial weights, 5×5 and à-trous alike).
+    pub kappa: f32,
+    /// Squared a-priori residual over its running noise level that counts as a change.
+    pub change_ratio: f32,
+    /// Residual weights (not the paper's): a sample's weight falls off with its a-priori
+    /// residual in units of the model's running noise level, exp(−r²/(k²·noise)); this
+    /// is k. Only samples many standard deviations out (spikes) lose weight.
+    pub outlier_sigmas: f32,
+    /// Edge of the temporal-gradient strata in pixels: one pixel in S×S is re-traced.
+    pub stratum: u32,
+    /// Smallest forgetting factor the temporal gradients may set (a sudden change).
+    pub lambda_min: f32,
+    /// How fast the forgetting factor falls towards λ_min with the change the gradients
+    /// measure: ours by gain × relative change × luminance / noise σ (the change per
+    /// frame against the pixel's noise, as a steady-state Kalman gain); the paper's
+    /// models (`ours-feature`) by gain × relative change.
+    pub change_gain: f32,
+    /// Shrinkage of the gradient ratio towards 1: a ratio `k` standard errors from 1
+    /// keeps k²/(k² + shrink) of its departure.
+    pub shrink: f32,
+    /// Pooled residual, in standard errors of its mean, from which the pooled lag test
+    /// starts to correct the models (fully at twice this).
+    pub drift_z: f32,
+    /// Radius of the pooled lag test's square neighbourhood, in pixels.
+    pub drift_radius: u32,
+
+    /// À-trous iterations of the spatial filter (steps 1, 2, 4, …).
+    pub atrous_iterations: u32,
+}
+
+impl Default for WrlsParams {
+    fn default() -> Self {
+        Self {
+            lambda: 0.998,
+            lambda_moving: 0.9,
+            alpha: 0.75,
+            h: 0.75,
+            delta: 100.0,
+            tolerance: super::REPROJECTION_TOLERANCE_PX,
+            sigma_spatial: 2.0,
+            sigma_range: 0.5,
+            kappa: 2.0,
+            change_ratio: 12.0,
+            outlier_sigmas: 10.0,
+            stratum: 4,
+            lambda_min: 0.1,
+            change_gain: 4.0,
+            shrink: 4.0,
+            drift_z: 3.0,
+            drift_radius: 2,
+            atrous_iterations: 3,
+        }
+    }
+}
+
+impl WrlsParams {
+    /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
+    /// `DVR_WRLS="change_gain=2,kappa=3"`: for parameter studies with `dvr eval`.
+    pub fn with_overrides(mut self, spec: Option<&str>) -> Result<Self> {
+        let Some(spec) = spec else { return Ok(self) };
+        for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let bad = |problem: String| crate::error::EngineError::Pass {
+                pass: "wrls".into(),
+                problem: format!("DVR_WRLS: {item:?}: {problem}"),
+            };
+            let (name, value) = item
+                .split_once('=')
+                .ok_or_else(|| bad("expected name=value".into()))?;
+            let v: f32 = value
+                .trim()
+                .parse()
+                .map_err(|e| bad(format!("not a number ({e})")))?;
+            let field = match name.trim() {
+                "lambda" => &mut self.lambda,
+                "lambda_moving" => &mut self.lambda_moving,
+                "alpha" => &mut self.alpha,
+                "kappa" => &mut self.kappa,
+                "change_ratio" => &mut self.change_ratio,
+                "outlier_sigmas" => &mut self.outlier_sigmas,
+                "lambda_min" => &mut self.lambda_min,
+                "change_gain" => &mut self.change_gain,
+                "shrink" => &mut self.shrink,
+                "drift_z" => &mut self.drift_z,
+                "drift_radius" => {
+                    self.drift_radius = v as u32;
+                    continue;
+                }
+                "stratum" => {
+                    self.stratum = v as u32;
+                    continue;
+                }
+                "atrous_iterations" => {
+                    self.atrous_iterations = v as u32;
+                    continue;
+                }
+                other => return Err(bad(format!("unknown parameter {other:?}"))),
+            };
+            *field = v;
+        }
+        Ok(self)
+    }
+}
+
+/// Which variant: the paper's ablation switches (weighting, temporal feature) and our
+/// changes to it (predictor from the reprojected history, residual-scaled weights,
+/// automatic forgetting, constant/feature model selection).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WrlsVariant {
+    pub weighted: bool,
+    pub feature: bool,
+    /// The paper's exact predictor p = [1, z(t)] (z contains this frame's noisy colour).
+    pub paper_predictor: bool,
+    /// Automatic forgetting: a model whose residual is far above its noise level twice in
+    /// a row starts over (a light/TF change); without it λ stays 0.998.
+    pub restart_on_change: bool,
+    /// Also keep the constant model p = [1] and use the temporal feature only where it
+    /// predicts measurably better (see include/wrls.glsl).
+    pub model_selection: bool,
+    /// Temporal gradients (wrls_gradient.comp): last frame's samples re-traced in this
+    /// frame's scene measure how much each region changed; the models are scaled by it
+    /// and forget in proportion.
+    pub gradients: bool,
+    /// The spatial filter: an à-trous wavelet over the per-pixel predictions
+    /// (wrls_atrous.comp) instead of the paper's 5×5 model blending (wrls_spatial.comp).
+    pub atrous: bool,
+    /// The pooled lag test (wrls_drift.comp): a residual that the models of a
+    /// neighbourhood share, clearly above its noise, is added to them.
+    pub drift: bool,
+}
+
+impl WrlsVariant {
+    pub fn from_name(name: &str) -> Option<Self> {
+        // Ours: weighted RLS on the constant model p = [1] (the temporal feature buys
+        // nothing once the gradients follow change: see README, "What each part buys"),
+        // temporal gradients, à-trous spatial filter, restarts on confirmed jumps.
+        let ours = Self {
+            weighted: true,
+            feature: false,
+            paper_predictor: false,
+            restart_on_change: true,
+            model_selection: false,
+            gradients: true,
+            atrous: true,
+            drift: true,
+        };
+        // The paper's single model p = [1, z] with its 5×5 model blending.
+        let paper = Self {
+            feature: true,
+            gradients: false,
+            atrous: false,
+            drift: false,
+            ..ours
+        };
+        Some(match name {
+            "ours" => ours,
+            // Ablations of ours: one part each.
+            "ours-feature" => Self {
+                feature: true,
+                model_selection: true,
+                ..ours
+            },
+            "ours-no-gradient" => Self {
+                gradients: false,
+                ..ours
+            },
+            "ours-no-atrous" => Self {
+                atrous: false,
+                ..ours
+            },
+            "ours-no-drift" => Self {
+                drift: false,
+                ..ours
+            },
+            "ours-fixed-lambda" => Self {
+                restart_on_change: false,
+                gradients: false,
+                drift: false,
+                ..ours
+            },
+            "wrls-paper" => Self {
+                paper_predictor: true,
+                restart_on_change: false,
+                ..paper
+            },
+            // The paper's ablations (Fig. 8).
+            "rls" => Self {
+                weighted: false,
+                ..paper
+            },
+            "wrls-nf" => Self {
+                feature: false,
+                ..paper
+            },
+            "rls-nf" => Self {
+                weighted: false,
+                feature: false,
+                ..paper
+            },
+            _ => return None,
+        })
+    }
+}
+
+/// The pipelines of one variant.
+pub struct Wrls {
+    name: String,
+    variant: WrlsVariant,
+    pub params: WrlsParams,
+    /// What the temporal denoisers reproject with.
+    pub motion: MotionSource,
+    gradients: Option<ComputePipeline>,
+    /// `wrls_constant` (ours' constant model) or `wrls_update` (the paper's models).
+    update: ComputePipeline,
+    drift: Option<ComputePipeline>,
+    /// `wrls_atrous`, or the paper's 5×5 blending `wrls_spatial`.
+    spatial: ComputePipeline,
+}
+
+impl Wrls {
+    pub fn new(
+        ctx: &GpuContext,
+        name: &str,
+        variant: WrlsVariant,
+        motion: MotionSource,
+        features: PathTraceFeatures,
+    ) -> Result<Self> {
+        let spec = [
+            ("WEIGHTED", SpecValue::Bool(variant.weighted)),
+            ("USE_FEATURE", SpecValue::Bool(variant.feature)),
+            ("MOTION_SOURCE", SpecValue::I32(motion.spec())),
+            ("PAPER_PREDICTOR", SpecValue::Bool(variant.paper_predictor)),
+            (
+                "RESTART_ON_CHANGE",
+                SpecValue::Bool(variant.restart_on_change),
+            ),
+            ("MODEL_SELECTION", SpecValue::Bool(variant.model_selection)),
+        ];
+        let optional = |on: bool, shader: &str, spec: &[(&str, SpecValue)]| {
+            on.then(|| ComputePipeline::new(ctx, shader, spec))
+                .transpose()
+        };
+        let update = if variant.feature {
+            ComputePipeline::new(ctx, "wrls_update", &spec)?
+        } else {
+            ComputePipeline::new(ctx, "wrls_constant", &[spec[0], spec[2], spec[4]])?
+        };
+        // The paper's 5×5 blending applies the neighbours' feature models; the constant
+        // model's predictions are filtered by the à-trous pass (one level without it).
+        let spatial = if variant.atrous || !variant.feature {
+            ComputePipeline::new(ctx, "wrls_atrous", &[])?
+        } else {
+            ComputePipeline::new(ctx, "wrls_spatial", &[spec[1], spec[3], spec[5]])?
+        };
+        Ok(Self {
+            name: name.to_string(),
+            variant,
+            params: WrlsParams::default()
+                .with_overrides(std::env::var("DVR_WRLS").ok().as_deref())?,
+            motion,
+            // The gradient pass traces paths: it is specialised like the path tracer.
+            gradients: optional(
+                variant.gradients,
+                "wrls_gradient",
+                &path_trace::specialization(features),
+            )?,
+            update,
+            drift: optional(variant.drift, "wrls_drift", &[])?,
+            spatial,
+        })
+    }
+}
+
+impl Denoiser for Wrls {
+    fn uses_surface_features(&self) -> bool {
+        self.motion == MotionSource::Features
+    }
+
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn add<'f>(
+        &'f self,
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        frame: &mut Frame<'f>,
+        input: &DenoiseInputs,
+    ) -> Result<ImageHandle> {
+        let desc = ImageDesc::d2(
+            input.size.width,
+            input.size.height,
+            vk::Format::R32G32B32A32_SFLOAT,
+        );
+        let n = &self.name;
+        let out = graph.image(ctx, &format!("{n}.out"), desc)?;
+        let lag = spatial::LagImages {
+            prediction: graph.image(ctx, &format!("{n}.prediction"), desc)?,
+            residual: graph.image(ctx, &format!("{n}.residual"), desc)?,
+            drift: graph.history(ctx, &format!("{n}.drift"), desc)?,
+        };
+        let gradients = self.add_gradients(ctx, graph, frame, input)?;
+        let models = if self.variant.feature {
+            Some(self.add_feature_update(ctx, graph, frame, input, &gradients, &lag)?)
+        } else {
+            self.add_constant_update(ctx, graph, frame, input, &gradients, &lag)?;
+            None
+        };
+        self.add_drift(frame, input.size, &lag);
+        match models {
+            Some(m) if !self.variant.atrous => self.add_paper_spatial(frame, input, &m, out),
+            _ => self.add_atrous(ctx, graph, frame, input.size, lag.prediction, out)?,
+        }
+        Ok(out)
+    }
+
+    fn destroy(&mut self, ctx: &GpuContext) {
+        for p in [&mut self.gradients, &mut self.drift].into_iter().flatten() {
+            p.destroy(ctx);
+        }
+        self.update.destroy(ctx);
+        self.spatial.destroy(ctx);
+    }
+}
