@@ -176,7 +176,6 @@ impl Harness {
 impl Drop for Harness {
     fn drop(&mut self) {
         let _ = self.ctx.wait_idle();
-        self.denoiser.destroy(&self.ctx);
         self.graph.destroy(&self.ctx);
     }
 }

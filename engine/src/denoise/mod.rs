@@ -20,9 +20,7 @@ pub use wrls::{Wrls, WrlsVariant};
 
 use crate::error::{EngineError, Result};
 use crate::gpu::GpuContext;
-use crate::graph::{
-    Bind, Bindings, BufferHandle, Extent, Frame, History, ImageHandle, PassBuilder, RenderGraph,
-};
+use crate::graph::{Bindings, BufferHandle, Extent, Frame, History, ImageHandle, RenderGraph};
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::SceneBindings;
 
@@ -180,24 +178,6 @@ impl Reprojection {
             .read("position_cur", self.position_cur)
             .sampled_nearest("position_prev", self.position_prev);
     }
-
-    /// Transitional (wrls.rs; others use [`Reprojection::bind`]).
-    pub fn declare(&self, b: &mut PassBuilder) {
-        b.uniform(self.uniforms)
-            .read(self.motion)
-            .read(self.position_cur)
-            .sampled(self.position_prev);
-    }
-
-    /// Transitional (wrls.rs): what [`Reprojection::declare`] binds to.
-    pub fn binds(&self) -> Vec<(&'static str, Bind)> {
-        vec![
-            ("frame", Bind::Buffer(self.uniforms)),
-            ("motion", Bind::Image(self.motion)),
-            ("position_cur", Bind::Image(self.position_cur)),
-            ("position_prev", Bind::ImageNearest(self.position_prev)),
-        ]
-    }
 }
 
 pub trait Denoiser {
@@ -211,12 +191,4 @@ pub trait Denoiser {
         frame: &mut Frame<'f>,
         input: &DenoiseInputs,
     ) -> Result<ImageHandle>;
-    /// Transitional: pipelines live in the context's cache, so there is nothing to
-    /// release; wrls.rs still overrides this until it moves to the cache.
-    fn destroy(&mut self, _ctx: &GpuContext) {}
-    /// Transitional (wrls.rs overrides it): whether the frame renders the surface
-    /// features is the registry's [`DenoiserInfo::features`]; nothing calls this.
-    fn uses_surface_features(&self) -> bool {
-        false
-    }
 }

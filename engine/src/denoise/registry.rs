@@ -40,8 +40,8 @@ enum Kind {
     Accum,
     Taa,
     Svgf,
-    /// A member of the wRLS family: `WrlsVariant::from_name` knows its switches.
-    Wrls,
+    /// A member of the wRLS family, with its switches.
+    Wrls(WrlsVariant),
     /// The recurrent autoencoder: the shipped network `net` (None: the one trained on
     /// the scene's dataset, see [`super::rae::network_for`]) at `precision`.
     Rae {
@@ -101,9 +101,18 @@ const fn rae(
     )
 }
 
-const fn wrls(name: &'static str, description: &'static str) -> DenoiserInfo {
-    entry(name, description, FeatureUse::ForMotion, Kind::Wrls)
+const fn wrls(name: &'static str, description: &'static str, variant: WrlsVariant) -> DenoiserInfo {
+    entry(
+        name,
+        description,
+        FeatureUse::ForMotion,
+        Kind::Wrls(variant),
+    )
 }
+
+/// Ours, and the paper's model (see [`WrlsVariant`]).
+const OURS: WrlsVariant = WrlsVariant::OURS;
+const PAPER: WrlsVariant = WrlsVariant::PAPER;
 
 use FeatureUse::{Always, ForMotion, Never};
 
@@ -131,16 +140,55 @@ pub const DENOISERS: &[DenoiserInfo] = &[
     wrls(
         "ours",
         "weighted RLS on the constant model with temporal gradients, a pooled lag test and an à-trous filter",
+        OURS,
     ),
-    wrls("ours-feature", "ours with the temporal feature and model selection"),
-    wrls("ours-no-gradient", "ours without temporal gradients"),
-    wrls("ours-no-atrous", "ours with the paper's 5×5 model blending instead of the à-trous filter"),
-    wrls("ours-no-drift", "ours without the pooled lag test"),
-    wrls("ours-fixed-lambda", "ours with a fixed forgetting factor (no restarts, gradients or lag test)"),
-    wrls("wrls-paper", "the paper's weighted RLS denoiser (TVCG §5–6) as published"),
-    wrls("rls", "the paper's RLS-F ablation: unweighted RLS"),
-    wrls("wrls-nf", "the paper's ablation without the temporal feature"),
-    wrls("rls-nf", "unweighted RLS without the temporal feature"),
+    // Ablations of ours: one part each.
+    wrls(
+        "ours-feature",
+        "ours with the temporal feature and model selection",
+        WrlsVariant { feature: true, model_selection: true, ..OURS },
+    ),
+    wrls(
+        "ours-no-gradient",
+        "ours without temporal gradients",
+        WrlsVariant { gradients: false, ..OURS },
+    ),
+    wrls(
+        "ours-no-atrous",
+        "ours with the paper's 5×5 model blending instead of the à-trous filter",
+        WrlsVariant { atrous: false, ..OURS },
+    ),
+    wrls(
+        "ours-no-drift",
+        "ours without the pooled lag test",
+        WrlsVariant { drift: false, ..OURS },
+    ),
+    wrls(
+        "ours-fixed-lambda",
+        "ours with a fixed forgetting factor (no restarts, gradients or lag test)",
+        WrlsVariant { restart_on_change: false, gradients: false, drift: false, ..OURS },
+    ),
+    wrls(
+        "wrls-paper",
+        "the paper's weighted RLS denoiser (TVCG §5–6) as published",
+        WrlsVariant { paper_predictor: true, restart_on_change: false, ..PAPER },
+    ),
+    // The paper's ablations (Fig. 8).
+    wrls(
+        "rls",
+        "the paper's RLS-F ablation: unweighted RLS",
+        WrlsVariant { weighted: false, ..PAPER },
+    ),
+    wrls(
+        "wrls-nf",
+        "the paper's ablation without the temporal feature",
+        WrlsVariant { feature: false, ..PAPER },
+    ),
+    wrls(
+        "rls-nf",
+        "unweighted RLS without the temporal feature",
+        WrlsVariant { weighted: false, feature: false, ..PAPER },
+    ),
     rae(
         "rae",
         "recurrent denoising autoencoder (Chaitanya et al. 2017), the network trained on the scene's dataset",
@@ -173,9 +221,7 @@ impl DenoiserInfo {
             Kind::Accum => Box::new(Accum::new(ctx, self.name)?),
             Kind::Taa => Box::new(Taa::new(ctx, self.name, motion)?),
             Kind::Svgf => Box::new(Svgf::new(ctx, self.name, motion)?),
-            Kind::Wrls => {
-                let variant =
-                    WrlsVariant::from_name(self.name).ok_or_else(|| unknown(self.name))?;
+            Kind::Wrls(variant) => {
                 Box::new(Wrls::new(ctx, self.name, variant, motion, config.features)?)
             }
             Kind::Rae { .. } => {
@@ -223,17 +269,21 @@ mod tests {
     use super::*;
 
     #[test]
-    fn names_are_unique_and_every_wrls_name_has_a_variant() {
+    fn names_are_unique_and_described() {
         let all: Vec<&str> = names().collect();
         for (i, n) in all.iter().enumerate() {
             assert!(!all[..i].contains(n), "{n} is listed twice");
         }
-        for d in DENOISERS.iter().filter(|d| d.kind == Kind::Wrls) {
-            assert!(
-                WrlsVariant::from_name(d.name).is_some(),
-                "{}: no wRLS variant",
-                d.name
-            );
+        // Each wRLS row is a different variant (a copied row would rename one).
+        let variants: Vec<_> = DENOISERS
+            .iter()
+            .filter_map(|d| match d.kind {
+                Kind::Wrls(v) => Some(v),
+                _ => None,
+            })
+            .collect();
+        for (i, v) in variants.iter().enumerate() {
+            assert!(!variants[..i].contains(v), "{v:?} is listed twice");
         }
         assert!(DENOISERS.iter().all(|d| !d.description.is_empty()));
     }

@@ -9,29 +9,6 @@ use crate::gpu::{ComputePipeline, GpuContext, Pipeline};
 use crate::shaders::GpuBlock;
 use ash::vk;
 
-/// A resource bound to a shader variable, for [`PassContext::dispatch`] (the transitional
-/// API wrls.rs uses; other passes declare bindings with [`super::Bindings`]).
-#[derive(Clone, Copy, Debug)]
-pub enum Bind {
-    /// Storage image, or sampled with the linear clamp sampler.
-    Image(ImageHandle),
-    /// Sampled with the nearest clamp sampler.
-    ImageNearest(ImageHandle),
-    Buffer(BufferHandle),
-}
-
-impl From<ImageHandle> for Bind {
-    fn from(h: ImageHandle) -> Self {
-        Bind::Image(h)
-    }
-}
-
-impl From<BufferHandle> for Bind {
-    fn from(h: BufferHandle) -> Self {
-        Bind::Buffer(h)
-    }
-}
-
 pub struct PassContext<'a> {
     pub ctx: &'a GpuContext,
     pub cmd: vk::CommandBuffer,
@@ -120,27 +97,6 @@ impl<'a> PassContext<'a> {
             .bound
             .iter()
             .map(|b| (b.var, b.res, b.nearest))
-            .collect();
-        self.bind_and_dispatch(pipeline, &bound, bytemuck::bytes_of(push), groups)
-    }
-
-    /// Binds `bindings` to the shader variables of the same names, pushes `push` and
-    /// dispatches. Transitional: wrls.rs binds this way; every other pass declares its
-    /// bindings once with [`super::Bindings`].
-    pub fn dispatch<P: bytemuck::Pod>(
-        &mut self,
-        pipeline: &ComputePipeline,
-        bindings: &[(&str, Bind)],
-        push: &P,
-        groups: [u32; 3],
-    ) -> Result<()> {
-        let bound: Vec<_> = bindings
-            .iter()
-            .map(|&(var, bind)| match bind {
-                Bind::Image(h) => (var, Res::Image(h), false),
-                Bind::ImageNearest(h) => (var, Res::Image(h), true),
-                Bind::Buffer(h) => (var, Res::Buffer(h), false),
-            })
             .collect();
         self.bind_and_dispatch(pipeline, &bound, bytemuck::bytes_of(push), groups)
     }

@@ -38,9 +38,8 @@ pub(crate) struct Pass<'f> {
     pub record: Option<RecordFn<'f>>,
 }
 
-/// Declares the accesses of a pass that binds no shader variables by declaration: transfers,
-/// a graphics pass's attachments, and (until `denoise/wrls.rs` moves to [`Bindings`]) the
-/// storage and sampled accesses of passes that bind through [`PassContext::dispatch`].
+/// Declares the accesses of a pass that binds no shader variables: transfers and a
+/// graphics pass's attachments (compute passes declare [`Bindings`]).
 pub struct PassBuilder {
     accesses: Vec<(Res, Access)>,
 }
@@ -57,26 +56,6 @@ impl PassBuilder {
     /// Drawn to by a graphics pipeline (the pass begins and ends its own rendering).
     pub fn color_attachment(&mut self, h: ImageHandle) -> &mut Self {
         self.accesses.push((Res::Image(h), Access::ColorAttachment));
-        self
-    }
-    /// Transitional (wrls.rs): a sampled image bound by name in the record closure.
-    pub fn sampled(&mut self, h: ImageHandle) -> &mut Self {
-        self.accesses.push((Res::Image(h), Access::Sampled));
-        self
-    }
-    /// Transitional (wrls.rs): a storage read bound by name in the record closure.
-    pub fn read(&mut self, h: impl Into<Res>) -> &mut Self {
-        self.accesses.push((h.into(), Access::StorageRead));
-        self
-    }
-    /// Transitional (wrls.rs): a storage write bound by name in the record closure.
-    pub fn write(&mut self, h: impl Into<Res>) -> &mut Self {
-        self.accesses.push((h.into(), Access::StorageWrite));
-        self
-    }
-    /// Transitional (wrls.rs): a uniform buffer bound by name in the record closure.
-    pub fn uniform(&mut self, h: BufferHandle) -> &mut Self {
-        self.accesses.push((Res::Buffer(h), Access::Uniform));
         self
     }
 }

@@ -12,7 +12,7 @@ mod frame;
 mod resources;
 
 pub use access::{Access, Barrier, ResourceState};
-pub use context::{Bind, PassContext};
+pub use context::PassContext;
 pub use frame::{Bindings, Frame, PassBuilder};
 pub use resources::{BufferHandle, Extent, History, ImageHandle, Res};
 

@@ -10,7 +10,7 @@ pub mod path_trace;
 pub mod present;
 pub mod surface_features;
 
-use crate::graph::{Bind, Bindings, BufferHandle, ImageHandle, PassBuilder};
+use crate::graph::{Bindings, BufferHandle, ImageHandle};
 
 /// The scene's GPU resources that volume passes bind (declared in include/volume.glsl,
 /// include/lights.glsl and include/frame.glsl).
@@ -35,31 +35,5 @@ impl SceneBindings {
             .sampled("tf_specular_roughness", self.tf_specular_roughness)
             .sampled("tf_emissive", self.tf_emissive)
             .sampled_nearest("majorant_grid", self.majorant);
-    }
-
-    /// Transitional (wrls.rs; others use [`SceneBindings::bind_volume`]): declares the
-    /// volume, LUTs, majorant grid and uniforms as read.
-    pub fn declare_volume(&self, b: &mut PassBuilder) {
-        b.uniform(self.uniforms)
-            .sampled(self.volume)
-            .sampled(self.tf_diffuse_opacity)
-            .sampled(self.tf_specular_roughness)
-            .sampled(self.tf_emissive)
-            .sampled(self.majorant);
-    }
-
-    /// Transitional (wrls.rs): the names [`SceneBindings::declare_volume`] binds to.
-    pub fn volume_binds(&self) -> Vec<(&'static str, Bind)> {
-        vec![
-            ("frame", Bind::Buffer(self.uniforms)),
-            ("volume_density", Bind::Image(self.volume)),
-            ("tf_diffuse_opacity", Bind::Image(self.tf_diffuse_opacity)),
-            (
-                "tf_specular_roughness",
-                Bind::Image(self.tf_specular_roughness),
-            ),
-            ("tf_emissive", Bind::Image(self.tf_emissive)),
-            ("majorant_grid", Bind::ImageNearest(self.majorant)),
-        ]
     }
 }

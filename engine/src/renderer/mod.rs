@@ -9,7 +9,6 @@ mod reference;
 pub mod scene_gpu;
 pub mod scene_setup;
 mod submit;
-pub mod uniforms;
 
 pub use inputs::{CameraMatrices, FrameInputs, FrameRequest, FrameResult};
 pub use reference::{samples_per_dispatch, MAX_SAMPLES_PER_DISPATCH, PIXEL_SAMPLES_PER_DISPATCH};
@@ -278,9 +277,6 @@ impl Renderer {
     pub fn set_denoisers(&mut self, names: &[&str]) -> Result<Vec<FrameResult>> {
         let done = self.flush()?;
         let new = create_methods(&self.ctx, &self.config, self.features, names)?;
-        for m in &mut self.denoisers {
-            m.denoiser.destroy(&self.ctx);
-        }
         self.denoisers = new;
         self.graph.reset_history("");
         Ok(done)
@@ -639,9 +635,6 @@ impl Drop for Renderer {
             unsafe { ctx.device.destroy_fence(s.fence, None) };
         }
         unsafe { ctx.device.destroy_command_pool(self.pool, None) };
-        for m in &mut self.denoisers {
-            m.denoiser.destroy(ctx);
-        }
         self.graph.destroy(ctx);
     }
 }

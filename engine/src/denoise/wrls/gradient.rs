@@ -7,9 +7,26 @@ use super::Wrls;
 use crate::denoise::DenoiseInputs;
 use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc};
-use crate::graph::{Bind, Frame, ImageHandle, RenderGraph};
-use crate::renderer::uniforms::WrlsGradientPush;
+use crate::gpu_block;
+use crate::graph::{Frame, ImageHandle, RenderGraph};
 use ash::vk;
+use glam::{Mat4, Vec4};
+
+gpu_block! {
+    /// `WrlsGradientPush` in wrls_gradient.comp.
+    pub struct WrlsGradientPush {
+        pub prev_inv_view_proj: Mat4,
+        pub prev_camera: Vec4,
+        pub width: u32,
+        pub height: u32,
+        pub spp: u32,
+        pub prev_frame: u32,
+        pub stratum: u32,
+        pub pad0: u32,
+        pub pad1: u32,
+        pub pad2: u32,
+    }
+}
 
 /// Ours' temporal gradients of a frame, at stratum resolution in last frame's image.
 #[derive(Clone, Copy, Debug)]
@@ -61,27 +78,15 @@ impl Wrls {
             pad2: 0,
         };
         let scene = retrace.scene;
-        frame.add_pass(
-            format!("{n}.gradient"),
-            |b| {
-                scene.declare_volume(b);
-                b.sampled(scene.environment)
-                    .read(retrace.radiance_prev)
-                    .write(g.new)
-                    .write(g.old);
-            },
-            move |pc| {
-                let mut binds = scene.volume_binds();
-                binds.extend([
-                    ("environment_map", Bind::Image(scene.environment)),
-                    ("noisy_prev", Bind::Image(retrace.radiance_prev)),
-                    ("gradient_new", Bind::Image(g.new)),
-                    ("gradient_old", Bind::Image(g.old)),
-                ]);
-                let groups = pipeline.groups_2d(desc.extent[0], desc.extent[1]);
-                pc.dispatch(pipeline, &binds, &push, groups)
-            },
-        );
+        // One invocation per stratum.
+        let grid = [desc.extent[0], desc.extent[1], 1];
+        frame.add_compute(format!("{n}.gradient"), pipeline, push, grid, |b| {
+            scene.bind_volume(b);
+            b.sampled("environment_map", scene.environment)
+                .read("noisy_prev", retrace.radiance_prev)
+                .write("gradient_new", g.new)
+                .write("gradient_old", g.old);
+        });
         Ok(Gradients { valid: true, ..g })
     }
 }

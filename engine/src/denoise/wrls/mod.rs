@@ -22,11 +22,14 @@ mod spatial;
 mod update;
 
 use super::{DenoiseInputs, Denoiser, MotionSource};
-use crate::error::Result;
-use crate::gpu::{ComputePipeline, GpuContext, ImageDesc, SpecValue};
+use crate::error::{EngineError, Result};
+use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::path_trace::{self, PathTraceFeatures};
 use ash::vk;
+use gradient::WrlsGradientPush;
+use spatial::{WrlsAtrousPush, WrlsDriftPush, WrlsSpatialPush};
+use update::{WrlsConstantPush, WrlsUpdatePush};
 
 /// The paper's parameters (λ, α, h, δ, the 5×5 blending) and ours'.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,49 +102,50 @@ impl Default for WrlsParams {
     }
 }
 
+/// The parameters `DVR_WRLS` may set, and where each goes.
+#[allow(clippy::type_complexity)]
+const OVERRIDABLE: &[(&str, fn(&mut WrlsParams, f32))] = &[
+    ("lambda", |p, v| p.lambda = v),
+    ("lambda_moving", |p, v| p.lambda_moving = v),
+    ("alpha", |p, v| p.alpha = v),
+    ("kappa", |p, v| p.kappa = v),
+    ("change_ratio", |p, v| p.change_ratio = v),
+    ("outlier_sigmas", |p, v| p.outlier_sigmas = v),
+    ("lambda_min", |p, v| p.lambda_min = v),
+    ("change_gain", |p, v| p.change_gain = v),
+    ("shrink", |p, v| p.shrink = v),
+    ("drift_z", |p, v| p.drift_z = v),
+    ("drift_radius", |p, v| p.drift_radius = v as u32),
+    ("stratum", |p, v| p.stratum = v as u32),
+    ("atrous_iterations", |p, v| p.atrous_iterations = v as u32),
+];
+
 impl WrlsParams {
     /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
     /// `DVR_WRLS="change_gain=2,kappa=3"`: for parameter studies with `dvr eval`.
     pub fn with_overrides(mut self, spec: Option<&str>) -> Result<Self> {
         let Some(spec) = spec else { return Ok(self) };
         for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let bad = |problem: String| crate::error::EngineError::Pass {
-                pass: "wrls".into(),
-                problem: format!("DVR_WRLS: {item:?}: {problem}"),
+            let bad = |problem: String| EngineError::InvalidSetting {
+                name: "DVR_WRLS",
+                value: format!("{item:?}"),
+                allowed: problem,
             };
             let (name, value) = item
                 .split_once('=')
-                .ok_or_else(|| bad("expected name=value".into()))?;
+                .ok_or_else(|| bad("expected name=value pairs, comma-separated".into()))?;
             let v: f32 = value
                 .trim()
                 .parse()
-                .map_err(|e| bad(format!("not a number ({e})")))?;
-            let field = match name.trim() {
-                "lambda" => &mut self.lambda,
-                "lambda_moving" => &mut self.lambda_moving,
-                "alpha" => &mut self.alpha,
-                "kappa" => &mut self.kappa,
-                "change_ratio" => &mut self.change_ratio,
-                "outlier_sigmas" => &mut self.outlier_sigmas,
-                "lambda_min" => &mut self.lambda_min,
-                "change_gain" => &mut self.change_gain,
-                "shrink" => &mut self.shrink,
-                "drift_z" => &mut self.drift_z,
-                "drift_radius" => {
-                    self.drift_radius = v as u32;
-                    continue;
-                }
-                "stratum" => {
-                    self.stratum = v as u32;
-                    continue;
-                }
-                "atrous_iterations" => {
-                    self.atrous_iterations = v as u32;
-                    continue;
-                }
-                other => return Err(bad(format!("unknown parameter {other:?}"))),
-            };
-            *field = v;
+                .map_err(|e| bad(format!("the value must be a number ({e})")))?;
+            let (_, set) = OVERRIDABLE
+                .iter()
+                .find(|(n, _)| *n == name.trim())
+                .ok_or_else(|| {
+                    let known: Vec<&str> = OVERRIDABLE.iter().map(|(n, _)| *n).collect();
+                    bad(format!("parameters: {}", known.join(", ")))
+                })?;
+            set(&mut self, v);
         }
         Ok(self)
     }
@@ -175,76 +179,36 @@ pub struct WrlsVariant {
 }
 
 impl WrlsVariant {
-    pub fn from_name(name: &str) -> Option<Self> {
-        // Ours: weighted RLS on the constant model p = [1] (the temporal feature buys
-        // nothing once the gradients follow change: see README, "What each part buys"),
-        // temporal gradients, à-trous spatial filter, restarts on confirmed jumps.
-        let ours = Self {
-            weighted: true,
-            feature: false,
-            paper_predictor: false,
-            restart_on_change: true,
-            model_selection: false,
-            gradients: true,
-            atrous: true,
-            drift: true,
-        };
-        // The paper's single model p = [1, z] with its 5×5 model blending.
-        let paper = Self {
-            feature: true,
-            gradients: false,
-            atrous: false,
-            drift: false,
-            ..ours
-        };
-        Some(match name {
-            "ours" => ours,
-            // Ablations of ours: one part each.
-            "ours-feature" => Self {
-                feature: true,
-                model_selection: true,
-                ..ours
-            },
-            "ours-no-gradient" => Self {
-                gradients: false,
-                ..ours
-            },
-            "ours-no-atrous" => Self {
-                atrous: false,
-                ..ours
-            },
-            "ours-no-drift" => Self {
-                drift: false,
-                ..ours
-            },
-            "ours-fixed-lambda" => Self {
-                restart_on_change: false,
-                gradients: false,
-                drift: false,
-                ..ours
-            },
-            "wrls-paper" => Self {
-                paper_predictor: true,
-                restart_on_change: false,
-                ..paper
-            },
-            // The paper's ablations (Fig. 8).
-            "rls" => Self {
-                weighted: false,
-                ..paper
-            },
-            "wrls-nf" => Self {
-                feature: false,
-                ..paper
-            },
-            "rls-nf" => Self {
-                weighted: false,
-                feature: false,
-                ..paper
-            },
-            _ => return None,
-        })
-    }
+    /// Ours: weighted RLS on the constant model p = [1] (the temporal feature buys
+    /// nothing once the gradients follow change: see README, "What each part buys"),
+    /// temporal gradients, the pooled lag test, an à-trous spatial filter, restarts on
+    /// confirmed jumps. Its ablations (the registry's `ours-*` rows) switch one part off.
+    pub const OURS: Self = Self {
+        weighted: true,
+        feature: false,
+        paper_predictor: false,
+        restart_on_change: true,
+        model_selection: false,
+        gradients: true,
+        atrous: true,
+        drift: true,
+    };
+
+    /// The paper's single model p = [1, z] with its 5×5 model blending (the Fig. 8
+    /// ablations in the registry switch weighting or the feature off).
+    pub const PAPER: Self = Self {
+        feature: true,
+        gradients: false,
+        atrous: false,
+        drift: false,
+        ..Self::OURS
+    };
+}
+
+/// The model update's pipeline: ours' constant model or the paper's feature models.
+enum Update {
+    Constant(Pipeline<WrlsConstantPush>),
+    Feature(Pipeline<WrlsUpdatePush>),
 }
 
 /// The pipelines of one variant.
@@ -254,12 +218,13 @@ pub struct Wrls {
     pub params: WrlsParams,
     /// What the temporal denoisers reproject with.
     pub motion: MotionSource,
-    gradients: Option<ComputePipeline>,
-    /// `wrls_constant` (ours' constant model) or `wrls_update` (the paper's models).
-    update: ComputePipeline,
-    drift: Option<ComputePipeline>,
-    /// `wrls_atrous`, or the paper's 5×5 blending `wrls_spatial`.
-    spatial: ComputePipeline,
+    gradients: Option<Pipeline<WrlsGradientPush>>,
+    update: Update,
+    drift: Option<Pipeline<WrlsDriftPush>>,
+    /// The à-trous filter over the predictions (one level for variants without it).
+    atrous: Pipeline<WrlsAtrousPush>,
+    /// The paper's 5×5 model blending, for feature models without the à-trous filter.
+    paper_spatial: Option<Pipeline<WrlsSpatialPush>>,
 }
 
 impl Wrls {
@@ -270,33 +235,35 @@ impl Wrls {
         motion: MotionSource,
         features: PathTraceFeatures,
     ) -> Result<Self> {
-        let spec = [
-            ("WEIGHTED", SpecValue::Bool(variant.weighted)),
-            ("USE_FEATURE", SpecValue::Bool(variant.feature)),
-            ("MOTION_SOURCE", SpecValue::I32(motion.spec())),
-            ("PAPER_PREDICTOR", SpecValue::Bool(variant.paper_predictor)),
-            (
-                "RESTART_ON_CHANGE",
-                SpecValue::Bool(variant.restart_on_change),
-            ),
-            ("MODEL_SELECTION", SpecValue::Bool(variant.model_selection)),
-        ];
-        let optional = |on: bool, shader: &str, spec: &[(&str, SpecValue)]| {
-            on.then(|| ComputePipeline::new(ctx, shader, spec))
-                .transpose()
-        };
+        let weighted = ("WEIGHTED", SpecValue::Bool(variant.weighted));
+        let use_feature = ("USE_FEATURE", SpecValue::Bool(variant.feature));
+        let motion_source = ("MOTION_SOURCE", SpecValue::I32(motion.spec()));
+        let paper_predictor = ("PAPER_PREDICTOR", SpecValue::Bool(variant.paper_predictor));
+        let restart = (
+            "RESTART_ON_CHANGE",
+            SpecValue::Bool(variant.restart_on_change),
+        );
+        let selection = ("MODEL_SELECTION", SpecValue::Bool(variant.model_selection));
         let update = if variant.feature {
-            ComputePipeline::new(ctx, "wrls_update", &spec)?
+            Update::Feature(ctx.pipeline(
+                "wrls_update",
+                &[
+                    weighted,
+                    use_feature,
+                    motion_source,
+                    paper_predictor,
+                    restart,
+                    selection,
+                ],
+            )?)
         } else {
-            ComputePipeline::new(ctx, "wrls_constant", &[spec[0], spec[2], spec[4]])?
+            Update::Constant(ctx.pipeline("wrls_constant", &[weighted, motion_source, restart])?)
         };
         // The paper's 5×5 blending applies the neighbours' feature models; the constant
         // model's predictions are filtered by the à-trous pass (one level without it).
-        let spatial = if variant.atrous || !variant.feature {
-            ComputePipeline::new(ctx, "wrls_atrous", &[])?
-        } else {
-            ComputePipeline::new(ctx, "wrls_spatial", &[spec[1], spec[3], spec[5]])?
-        };
+        let paper_spatial = (variant.feature && !variant.atrous)
+            .then(|| ctx.pipeline("wrls_spatial", &[use_feature, paper_predictor, selection]))
+            .transpose()?;
         Ok(Self {
             name: name.to_string(),
             variant,
@@ -304,23 +271,22 @@ impl Wrls {
                 .with_overrides(std::env::var("DVR_WRLS").ok().as_deref())?,
             motion,
             // The gradient pass traces paths: it is specialised like the path tracer.
-            gradients: optional(
-                variant.gradients,
-                "wrls_gradient",
-                &path_trace::specialization(features),
-            )?,
+            gradients: variant
+                .gradients
+                .then(|| ctx.pipeline("wrls_gradient", &path_trace::specialization(features)))
+                .transpose()?,
             update,
-            drift: optional(variant.drift, "wrls_drift", &[])?,
-            spatial,
+            drift: variant
+                .drift
+                .then(|| ctx.pipeline("wrls_drift", &[]))
+                .transpose()?,
+            atrous: ctx.pipeline("wrls_atrous", &[])?,
+            paper_spatial,
         })
     }
 }
 
 impl Denoiser for Wrls {
-    fn uses_surface_features(&self) -> bool {
-        self.motion == MotionSource::Features
-    }
-
     fn name(&self) -> &str {
         &self.name
     }
@@ -345,25 +311,20 @@ impl Denoiser for Wrls {
             drift: graph.history(ctx, &format!("{n}.drift"), desc)?,
         };
         let gradients = self.add_gradients(ctx, graph, frame, input)?;
-        let models = if self.variant.feature {
-            Some(self.add_feature_update(ctx, graph, frame, input, &gradients, &lag)?)
-        } else {
-            self.add_constant_update(ctx, graph, frame, input, &gradients, &lag)?;
-            None
+        let models = match &self.update {
+            Update::Feature(pipeline) => {
+                Some(self.add_feature_update(pipeline, ctx, graph, frame, input, &gradients, &lag)?)
+            }
+            Update::Constant(pipeline) => {
+                self.add_constant_update(pipeline, ctx, graph, frame, input, &gradients, &lag)?;
+                None
+            }
         };
         self.add_drift(frame, input.size, &lag);
-        match models {
-            Some(m) if !self.variant.atrous => self.add_paper_spatial(frame, input, &m, out),
+        match (&self.paper_spatial, models) {
+            (Some(pipeline), Some(m)) => self.add_paper_spatial(pipeline, frame, input, &m, out),
             _ => self.add_atrous(ctx, graph, frame, input.size, lag.prediction, out)?,
         }
         Ok(out)
-    }
-
-    fn destroy(&mut self, ctx: &GpuContext) {
-        for p in [&mut self.gradients, &mut self.drift].into_iter().flatten() {
-            p.destroy(ctx);
-        }
-        self.update.destroy(ctx);
-        self.spatial.destroy(ctx);
     }
 }

@@ -7,10 +7,47 @@ use super::update::FeatureModels;
 use super::Wrls;
 use crate::denoise::DenoiseInputs;
 use crate::error::Result;
-use crate::gpu::GpuContext;
-use crate::graph::Extent;
-use crate::graph::{Bind, Frame, History, ImageHandle, RenderGraph};
-use crate::renderer::uniforms::{WrlsAtrousPush, WrlsDriftPush, WrlsSpatialPush};
+use crate::gpu::{GpuContext, Pipeline};
+use crate::gpu_block;
+use crate::graph::{Extent, Frame, History, ImageHandle, RenderGraph};
+
+gpu_block! {
+    /// `WrlsDriftPush` in wrls_drift.comp.
+    pub struct WrlsDriftPush {
+        pub width: u32,
+        pub height: u32,
+        pub radius: i32,
+        pub pad0: u32,
+    }
+}
+
+gpu_block! {
+    /// `WrlsAtrousPush` in wrls_atrous.comp.
+    pub struct WrlsAtrousPush {
+        pub width: u32,
+        pub height: u32,
+        pub step: i32,
+        pub kappa: f32,
+        pub last: u32,
+        pub pad0: u32,
+        pub pad1: u32,
+        pub pad2: u32,
+    }
+}
+
+gpu_block! {
+    /// `WrlsSpatialPush` in wrls_spatial.comp.
+    pub struct WrlsSpatialPush {
+        pub width: u32,
+        pub height: u32,
+        pub sigma_spatial: f32,
+        pub sigma_range: f32,
+        pub kappa: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+        pub pad2: f32,
+    }
+}
 
 /// What the update writes for the spatial filter and the pooled lag test, and the lag
 /// estimate that next frame's update reads.
@@ -36,21 +73,11 @@ impl Wrls {
             radius: self.params.drift_radius as i32,
             pad0: 0,
         };
-        let lag = *lag;
-        frame.add_pass(
-            format!("{}.drift", self.name),
-            |b| {
-                b.read(lag.residual).write(lag.drift.cur);
-            },
-            move |pc| {
-                let binds = [
-                    ("residual", Bind::Image(lag.residual)),
-                    ("drift", Bind::Image(lag.drift.cur)),
-                ];
-                let groups = pipeline.groups_2d(size.width, size.height);
-                pc.dispatch(pipeline, &binds, &push, groups)
-            },
-        );
+        let name = format!("{}.drift", self.name);
+        frame.add_compute(name, pipeline, push, size, |b| {
+            b.read("residual", lag.residual)
+                .write("drift", lag.drift.cur);
+        });
     }
 
     /// Ours' à-trous filter from `prediction` into `out`: steps 1, 2, 4, … ping-ponging
@@ -75,7 +102,7 @@ impl Wrls {
         } else {
             1
         };
-        let pipeline = &self.spatial;
+        let pipeline = &self.atrous;
         let mut src = prediction;
         for i in 0..iterations {
             let last = i + 1 == iterations;
@@ -94,20 +121,10 @@ impl Wrls {
                 pad1: 0,
                 pad2: 0,
             };
-            frame.add_pass(
-                format!("{}.atrous{i}", self.name),
-                |b| {
-                    b.read(src).write(dst);
-                },
-                move |pc| {
-                    let binds = [
-                        ("color_in", Bind::Image(src)),
-                        ("color_out", Bind::Image(dst)),
-                    ];
-                    let groups = pipeline.groups_2d(size.width, size.height);
-                    pc.dispatch(pipeline, &binds, &push, groups)
-                },
-            );
+            let name = format!("{}.atrous{i}", self.name);
+            frame.add_compute(name, pipeline, push, size, |b| {
+                b.read("color_in", src).write("color_out", dst);
+            });
             src = dst;
         }
         Ok(())
@@ -117,6 +134,7 @@ impl Wrls {
     /// its 5×5 window applied to its own predictor.
     pub(super) fn add_paper_spatial<'f>(
         &'f self,
+        pipeline: &Pipeline<WrlsSpatialPush>,
         frame: &mut Frame<'f>,
         input: &DenoiseInputs,
         m: &FeatureModels,
@@ -134,37 +152,18 @@ impl Wrls {
             pad1: 0.0,
             pad2: 0.0,
         };
-        let (noisy, m) = (input.noisy, *m);
-        frame.add_pass(
-            format!("{}.spatial", self.name),
-            |b| {
-                b.read(m.z.cur)
-                    .read(noisy)
-                    .read(m.p[0].cur)
-                    .read(m.p[2].cur)
-                    .read(m.constant.cur)
-                    .read(m.errors.cur)
-                    .write(out);
-                for h in &m.beta {
-                    b.read(h.cur);
-                }
-            },
-            move |pc| {
-                let binds = [
-                    ("z", Bind::Image(m.z.cur)),
-                    ("beta_r", Bind::Image(m.beta[0].cur)),
-                    ("beta_g", Bind::Image(m.beta[1].cur)),
-                    ("beta_b", Bind::Image(m.beta[2].cur)),
-                    ("noisy", Bind::Image(noisy)),
-                    ("denoised", Bind::Image(out)),
-                    ("p0", Bind::Image(m.p[0].cur)),
-                    ("p2", Bind::Image(m.p[2].cur)),
-                    ("constant", Bind::Image(m.constant.cur)),
-                    ("errors", Bind::Image(m.errors.cur)),
-                ];
-                let groups = self.spatial.groups_2d(size.width, size.height);
-                pc.dispatch(&self.spatial, &binds, &push, groups)
-            },
-        );
+        let name = format!("{}.spatial", self.name);
+        frame.add_compute(name, pipeline, push, size, |b| {
+            b.read("z", m.z.cur)
+                .read("beta_r", m.beta[0].cur)
+                .read("beta_g", m.beta[1].cur)
+                .read("beta_b", m.beta[2].cur)
+                .read("noisy", input.noisy)
+                .read("p0", m.p[0].cur)
+                .read("p2", m.p[2].cur)
+                .read("constant", m.constant.cur)
+                .read("errors", m.errors.cur)
+                .write("denoised", out);
+        });
     }
 }

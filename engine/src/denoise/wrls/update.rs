@@ -9,10 +9,65 @@ use super::spatial::LagImages;
 use super::Wrls;
 use crate::denoise::DenoiseInputs;
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc};
-use crate::graph::{Bind, Frame, History, RenderGraph};
-use crate::renderer::uniforms::{WrlsConstantPush, WrlsUpdatePush};
+use crate::gpu::{GpuContext, ImageDesc, Pipeline};
+use crate::gpu_block;
+use crate::graph::{Frame, History, RenderGraph};
 use ash::vk;
+use glam::Vec4;
+
+gpu_block! {
+    /// `WrlsConstantPush` in wrls_constant.comp.
+    pub struct WrlsConstantPush {
+        pub camera: Vec4,
+        pub width: u32,
+        pub height: u32,
+        pub history_valid: u32,
+        pub lambda: f32,
+        pub delta: f32,
+        pub tolerance: f32,
+        pub change_ratio: f32,
+        pub outlier_sigmas: f32,
+        pub gradient_valid: u32,
+        pub drift_valid: u32,
+        pub stratum: u32,
+        pub lambda_min: f32,
+        pub change_gain: f32,
+        pub shrink: f32,
+        pub drift_z: f32,
+        pub spp: f32,
+        pub lambda_moving: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+        pub pad2: f32,
+    }
+}
+
+gpu_block! {
+    /// `WrlsUpdatePush` in wrls_update.comp.
+    pub struct WrlsUpdatePush {
+        pub camera: Vec4,
+        pub width: u32,
+        pub height: u32,
+        pub history_valid: u32,
+        pub lambda: f32,
+        pub alpha: f32,
+        pub h: f32,
+        pub delta: f32,
+        pub tolerance: f32,
+        pub change_ratio: f32,
+        pub outlier_sigmas: f32,
+        pub gradient_valid: u32,
+        pub drift_valid: u32,
+        pub stratum: u32,
+        pub lambda_min: f32,
+        pub change_gain: f32,
+        pub shrink: f32,
+        pub drift_z: f32,
+        pub pad0: f32,
+        pub pad1: f32,
+        pub pad2: f32,
+    }
+}
 
 /// The paper's model state after this frame's update (what its 5×5 blending reads).
 #[derive(Clone, Copy, Debug)]
@@ -35,8 +90,10 @@ impl Wrls {
 
     /// Ours' constant model: `model` (rgb β, a P) and `stats` (running noise level,
     /// frames in a row with a far residual).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn add_constant_update<'f>(
         &'f self,
+        pipeline: &Pipeline<WrlsConstantPush>,
         ctx: &GpuContext,
         graph: &mut RenderGraph,
         frame: &mut Frame<'f>,
@@ -75,47 +132,29 @@ impl Wrls {
             pad2: 0.0,
         };
         let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
-        frame.add_pass(
-            format!("{n}.update"),
-            |b| {
-                reproj.declare(b);
-                b.read(noisy)
-                    .read(moments)
-                    .read(g.new)
-                    .read(g.old)
-                    .sampled(lag.drift.prev)
-                    .write(lag.prediction)
-                    .write(lag.residual);
-                for h in [model, stats] {
-                    b.sampled(h.prev).write(h.cur);
-                }
-            },
-            move |pc| {
-                let mut binds = reproj.binds();
-                binds.extend([
-                    ("noisy", Bind::Image(noisy)),
-                    ("moments", Bind::Image(moments)),
-                    ("model_prev", Bind::Image(model.prev)),
-                    ("stats_prev", Bind::Image(stats.prev)),
-                    ("model_cur", Bind::Image(model.cur)),
-                    ("stats_cur", Bind::Image(stats.cur)),
-                    ("prediction", Bind::Image(lag.prediction)),
-                    ("residual", Bind::Image(lag.residual)),
-                    ("drift_prev", Bind::Image(lag.drift.prev)),
-                    ("gradient_new", Bind::Image(g.new)),
-                    ("gradient_old", Bind::Image(g.old)),
-                ]);
-                let groups = self.update.groups_2d(size.width, size.height);
-                pc.dispatch(&self.update, &binds, &push, groups)
-            },
-        );
+        frame.add_compute(format!("{n}.update"), pipeline, push, size, |b| {
+            reproj.bind(b);
+            b.read("noisy", noisy)
+                .read("moments", moments)
+                .read("gradient_new", g.new)
+                .read("gradient_old", g.old)
+                .sampled("drift_prev", lag.drift.prev)
+                .write("prediction", lag.prediction)
+                .write("residual", lag.residual)
+                .sampled("model_prev", model.prev)
+                .write("model_cur", model.cur)
+                .sampled("stats_prev", stats.prev)
+                .write("stats_cur", stats.cur);
+        });
         Ok(())
     }
 
     /// The paper's models (and ours-feature): the temporal feature z, β per channel, the
     /// shared P, and for model selection the constant model and both models' errors.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn add_feature_update<'f>(
         &'f self,
+        pipeline: &Pipeline<WrlsUpdatePush>,
         ctx: &GpuContext,
         graph: &mut RenderGraph,
         frame: &mut Frame<'f>,
@@ -169,56 +208,29 @@ impl Wrls {
             pad2: 0.0,
         };
         let (noisy, g, lag) = (input.noisy, *gradients, *lag);
-        frame.add_pass(
-            format!("{n}.update"),
-            |b| {
-                reproj.declare(b);
-                b.read(noisy)
-                    .read(g.new)
-                    .read(g.old)
-                    .sampled(lag.drift.prev)
-                    .write(lag.prediction)
-                    .write(lag.residual);
-                for h in [m.z, m.constant, m.errors]
-                    .iter()
-                    .chain(&m.beta)
-                    .chain(&m.p)
-                {
-                    b.sampled(h.prev).write(h.cur);
-                }
-            },
-            move |pc| {
-                let mut binds = reproj.binds();
-                binds.extend([
-                    ("noisy", Bind::Image(noisy)),
-                    ("z_prev", Bind::Image(m.z.prev)),
-                    ("beta_r_prev", Bind::Image(m.beta[0].prev)),
-                    ("beta_g_prev", Bind::Image(m.beta[1].prev)),
-                    ("beta_b_prev", Bind::Image(m.beta[2].prev)),
-                    ("p0_prev", Bind::Image(m.p[0].prev)),
-                    ("p1_prev", Bind::Image(m.p[1].prev)),
-                    ("p2_prev", Bind::Image(m.p[2].prev)),
-                    ("z_cur", Bind::Image(m.z.cur)),
-                    ("beta_r_cur", Bind::Image(m.beta[0].cur)),
-                    ("beta_g_cur", Bind::Image(m.beta[1].cur)),
-                    ("beta_b_cur", Bind::Image(m.beta[2].cur)),
-                    ("p0_cur", Bind::Image(m.p[0].cur)),
-                    ("p1_cur", Bind::Image(m.p[1].cur)),
-                    ("p2_cur", Bind::Image(m.p[2].cur)),
-                    ("constant_prev", Bind::Image(m.constant.prev)),
-                    ("errors_prev", Bind::Image(m.errors.prev)),
-                    ("constant_cur", Bind::Image(m.constant.cur)),
-                    ("errors_cur", Bind::Image(m.errors.cur)),
-                    ("gradient_new", Bind::Image(g.new)),
-                    ("gradient_old", Bind::Image(g.old)),
-                    ("prediction", Bind::Image(lag.prediction)),
-                    ("residual", Bind::Image(lag.residual)),
-                    ("drift_prev", Bind::Image(lag.drift.prev)),
-                ]);
-                let groups = self.update.groups_2d(size.width, size.height);
-                pc.dispatch(&self.update, &binds, &push, groups)
-            },
-        );
+        frame.add_compute(format!("{n}.update"), pipeline, push, size, |b| {
+            reproj.bind(b);
+            b.read("noisy", noisy)
+                .read("gradient_new", g.new)
+                .read("gradient_old", g.old)
+                .sampled("drift_prev", lag.drift.prev)
+                .write("prediction", lag.prediction)
+                .write("residual", lag.residual);
+            let state: [(&'static str, &'static str, History); 9] = [
+                ("z_prev", "z_cur", m.z),
+                ("constant_prev", "constant_cur", m.constant),
+                ("errors_prev", "errors_cur", m.errors),
+                ("beta_r_prev", "beta_r_cur", m.beta[0]),
+                ("beta_g_prev", "beta_g_cur", m.beta[1]),
+                ("beta_b_prev", "beta_b_cur", m.beta[2]),
+                ("p0_prev", "p0_cur", m.p[0]),
+                ("p1_prev", "p1_cur", m.p[1]),
+                ("p2_prev", "p2_cur", m.p[2]),
+            ];
+            for (prev, cur, h) in state {
+                b.sampled(prev, h.prev).write(cur, h.cur);
+            }
+        });
         Ok(m)
     }
 }
