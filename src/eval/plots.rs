@@ -66,36 +66,42 @@ pub fn init_font() -> Result<()> {
     }
 }
 
-/// A method's colour, the same in every chart and on the page.
+/// Colours of the registry's rows, in its order (`dvr_engine::denoise::DENOISERS`):
+/// grey for the noisy input, red for ours, the rest a categorical palette.
+const PALETTE: [RGBColor; 18] = [
+    RGBColor(127, 127, 127),
+    RGBColor(31, 119, 180),
+    RGBColor(227, 119, 194),
+    RGBColor(140, 86, 75),
+    RGBColor(214, 39, 40),
+    RGBColor(174, 199, 232),
+    RGBColor(152, 223, 138),
+    RGBColor(197, 176, 213),
+    RGBColor(196, 156, 148),
+    RGBColor(255, 152, 150),
+    RGBColor(23, 190, 207),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(188, 189, 34),
+    RGBColor(219, 219, 141),
+    RGBColor(158, 218, 229),
+    RGBColor(247, 182, 210),
+];
+
+/// A method's colour, the same in every chart and on the page: by its row in the
+/// registry, so no name is listed here.
 pub fn method_colour(method: &str) -> RGBColor {
-    match method {
-        "none" => RGBColor(127, 127, 127),
-        "accum" => RGBColor(31, 119, 180),
-        "ours" => RGBColor(214, 39, 40),
-        "rls" => RGBColor(255, 127, 14),
-        "wrls-nf" => RGBColor(44, 160, 44),
-        "rls-nf" => RGBColor(148, 103, 189),
-        "svgf" => RGBColor(140, 86, 75),
-        "taa" => RGBColor(227, 119, 194),
-        "rae" => RGBColor(188, 189, 34),
-        "wrls-paper" => RGBColor(23, 190, 207),
-        "ours-fixed-lambda" => RGBColor(255, 152, 150),
-        other => {
-            // Any other method: a stable pick from a second palette, by name.
-            const MORE: [RGBColor; 6] = [
-                RGBColor(174, 199, 232),
-                RGBColor(152, 223, 138),
-                RGBColor(197, 176, 213),
-                RGBColor(196, 156, 148),
-                RGBColor(219, 219, 141),
-                RGBColor(158, 218, 229),
-            ];
-            let h = other
+    let row = dvr_engine::denoise::DENOISERS
+        .iter()
+        .position(|d| d.name == method)
+        .unwrap_or_else(|| {
+            // Not a registry name (a label from outside): a stable pick by name.
+            method
                 .bytes()
-                .fold(0usize, |h, b| h.wrapping_mul(31).wrapping_add(b.into()));
-            MORE[h % MORE.len()]
-        }
-    }
+                .fold(0usize, |h, b| h.wrapping_mul(31).wrapping_add(b.into()))
+        });
+    PALETTE[row % PALETTE.len()]
 }
 
 pub fn colour_hex(c: RGBColor) -> String {
@@ -433,6 +439,21 @@ pub fn overall_plot(out: &Path, results: &[SceneResult], overall: &[Overall]) ->
 mod tests {
     use super::super::csv::{overall_summary, tests::result};
     use super::*;
+
+    #[test]
+    fn every_denoiser_has_its_own_colour() {
+        let rows = dvr_engine::denoise::DENOISERS;
+        assert!(rows.len() <= PALETTE.len(), "add colours for the new rows");
+        for (i, d) in rows.iter().enumerate() {
+            let c = method_colour(d.name);
+            assert!(
+                rows[..i].iter().all(|e| method_colour(e.name) != c),
+                "{} shares a colour",
+                d.name
+            );
+        }
+        assert_eq!(method_colour("ours"), RGBColor(214, 39, 40), "ours is red");
+    }
 
     #[test]
     fn plots_are_written_as_svg_and_png() {
