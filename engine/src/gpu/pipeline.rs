@@ -71,7 +71,7 @@ pub struct ComputePipeline {
 impl ComputePipeline {
     /// Builds a pipeline the caller owns and must [`destroy`](Self::destroy); passes use
     /// [`GpuContext::pipeline`] instead.
-    pub fn new(ctx: &GpuContext, shader: &str, spec: &[(&str, SpecValue)]) -> Result<Self> {
+    pub(crate) fn new(ctx: &GpuContext, shader: &str, spec: &[(&str, SpecValue)]) -> Result<Self> {
         let words = shader_words(shader)?;
         let reflection = reflect::reflect(&words).map_err(|problem| EngineError::Reflection {
             shader: shader.into(),
@@ -181,19 +181,10 @@ impl ComputePipeline {
         })
     }
 
-    /// Workgroups needed to cover `w × h` invocations.
-    pub fn groups_2d(&self, w: u32, h: u32) -> [u32; 3] {
-        self.groups([w, h, 1])
-    }
-
     /// Workgroups needed to cover `grid` invocations.
     pub fn groups(&self, grid: [u32; 3]) -> [u32; 3] {
         let local = self.reflection.local_size;
         [0, 1, 2].map(|i| grid[i].div_ceil(local[i].max(1)))
-    }
-
-    pub fn destroy(&mut self, ctx: &GpuContext) {
-        self.release(ctx);
     }
 
     fn release(&self, ctx: &GpuContext) {
