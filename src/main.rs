@@ -11,6 +11,7 @@ mod demo;
 mod eval;
 mod explore;
 mod logger;
+mod output;
 mod profile;
 mod progress;
 mod setup;

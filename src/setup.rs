@@ -5,7 +5,6 @@ use crate::profile::PassStats;
 use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
 use dvr_engine::denoise::registry;
-use dvr_engine::files::Durability;
 use dvr_engine::gpu::GpuContext;
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
@@ -233,8 +232,7 @@ pub fn write_capture_page(
     );
     html.push_str("function show(){const i=String(f.value).padStart(4,'0');n.textContent=f.value;for(const im of document.querySelectorAll('img.seq'))im.src=im.dataset.m+'/'+i+'.png';}f.oninput=show;show();</script>");
     let path = out.join("index.html");
-    dvr_engine::files::write_atomic(&path, html.as_bytes(), Durability::Renamed)
-        .with_context(|| format!("writing {}", path.display()))
+    crate::output::write_text(&path, &html)
 }
 
 /// Text as HTML that shows exactly it: a scene's `name` is anyone's string, and a name

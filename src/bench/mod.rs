@@ -19,12 +19,13 @@ mod plots;
 use crate::capture::run_profile;
 use crate::eval::run::{method_gpu_ms, owned_by};
 use crate::eval::EvalArgs;
+use crate::output::{opt, write_text as write};
 use crate::profile::{self, Profile};
 use crate::SceneArgs;
 use anyhow::{Context, Result};
 use dvr_engine::gpu::timestamps::{gb_per_s, PassTiming};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(clap::Args, Clone, Debug)]
@@ -211,19 +212,6 @@ fn run_eval<'a>(args: &'a BenchArgs, denoisers: &[String]) -> Result<EvalRecord<
     })
 }
 
-fn write(path: &Path, text: &str) -> Result<()> {
-    dvr_engine::files::write_atomic(
-        path,
-        text.as_bytes(),
-        dvr_engine::files::Durability::Renamed,
-    )
-    .with_context(|| format!("writing {}", path.display()))
-}
-
-fn opt(v: Option<f64>) -> String {
-    v.map(|v| format!("{v:.2}")).unwrap_or_default()
-}
-
 /// Every pass of every size, the total last.
 fn profile_csv(profiles: &[Profile]) -> String {
     let mut s = String::from("size,pass,mean_ms,median_ms,p95_ms,mb,gb_per_s,percent_of_peak\n");
@@ -240,7 +228,7 @@ fn profile_csv(profiles: &[Profile]) -> String {
                 r.p95_ms,
                 r.bytes / 1e6,
                 r.gb_per_s,
-                opt(r.percent_of_peak)
+                opt(r.percent_of_peak, 2)
             );
         }
     }
@@ -309,7 +297,7 @@ fn methods_csv(profiles: &[Profile]) -> String {
                 r.method,
                 r.own_ms,
                 r.own_bytes / 1e6,
-                opt(r.own_percent_of_peak),
+                opt(r.own_percent_of_peak, 2),
                 r.frame_ms
             );
         }

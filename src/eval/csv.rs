@@ -5,7 +5,8 @@
 
 use super::run::{MetricRow, SceneResult};
 use super::{GPU_WARMUP_FRAMES, RECOVERY_TOLERANCE_DB};
-use anyhow::{Context, Result};
+use crate::output::{opt, write_text as write};
+use anyhow::Result;
 use dvr_engine::metrics::frames_to_recover;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -145,20 +146,6 @@ fn field(s: &str) -> String {
     } else {
         s.to_string()
     }
-}
-
-fn opt(v: Option<f64>, digits: usize) -> String {
-    v.map(|v| format!("{v:.digits$}")).unwrap_or_default()
-}
-
-fn write(path: &Path, text: &str) -> Result<()> {
-    // Write then rename: a reader (or an interruption) never sees half a table.
-    dvr_engine::files::write_atomic(
-        path,
-        text.as_bytes(),
-        dvr_engine::files::Durability::Renamed,
-    )
-    .with_context(|| format!("writing {}", path.display()))
 }
 
 pub fn metrics_csv(results: &[SceneResult]) -> String {

@@ -13,7 +13,7 @@ use super::csv::{overall_recovery_text, scene_summary, Overall, Recovery};
 use super::plots::{colour_hex, method_colour, scene_plot_stems, METRIC_PLOTS, OVERALL_PLOT_STEM};
 use super::run::SceneResult;
 use super::{EvalArgs, EXPOSURE, GPU_WARMUP_FRAMES, RECOVERY_TOLERANCE_DB};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -152,13 +152,7 @@ pub fn write_page(
     results: &[SceneResult],
     overall: &[Overall],
 ) -> Result<()> {
-    let html = page(info, results, overall);
-    dvr_engine::files::write_atomic(
-        path,
-        html.as_bytes(),
-        dvr_engine::files::Durability::Renamed,
-    )
-    .with_context(|| format!("writing {}", path.display()))
+    crate::output::write_text(path, &page(info, results, overall))
 }
 
 #[cfg(test)]

@@ -130,12 +130,7 @@ pub(crate) fn save(chart: &impl Chart, stem: &Path) -> Result<()> {
             .and_then(|_| root.present())
             .map_err(|e| anyhow!("drawing {}: {e}", svg_path.display()))?;
     }
-    dvr_engine::files::write_atomic(
-        &svg_path,
-        svg.as_bytes(),
-        dvr_engine::files::Durability::Renamed,
-    )
-    .with_context(|| format!("writing {}", svg_path.display()))?;
+    crate::output::write_text(&svg_path, &svg)?;
 
     let png_path = stem.with_extension("png");
     let mut pixels = vec![0u8; SIZE.0 as usize * SIZE.1 as usize * 3];

@@ -8,7 +8,7 @@
 
 pub mod stats;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::passes::bandwidth::PeakBandwidth;
 use serde::Serialize;
@@ -205,13 +205,7 @@ pub fn chrome_trace<'a>(
 }
 
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
-    let text = serde_json::to_string_pretty(value)?;
-    dvr_engine::files::write_atomic(
-        path,
-        text.as_bytes(),
-        dvr_engine::files::Durability::Renamed,
-    )
-    .with_context(|| format!("writing {}", path.display()))
+    crate::output::write_text(path, &serde_json::to_string_pretty(value)?)
 }
 
 #[cfg(test)]
