@@ -25,6 +25,21 @@ fn every_shader_passes_spirv_val() {
     }
 }
 
+/// The SPIR-V names its sources relative to the shader folder, never by the checkout's
+/// path: the same source must compile to the same bytes wherever the repository lies
+/// (`dvr eval` keys its reference cache on the path tracer's bytes).
+#[test]
+fn spirv_does_not_depend_on_the_checkout_path() {
+    let checkout = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let needle = format!("{}/", checkout.display());
+    for (name, bytes) in SHADERS {
+        assert!(
+            !bytes.windows(needle.len()).any(|w| w == needle.as_bytes()),
+            "{name}'s SPIR-V holds the checkout path {needle}"
+        );
+    }
+}
+
 #[test]
 fn every_shader_reflects_named_bindings_in_set_zero() {
     for (name, _) in SHADERS {

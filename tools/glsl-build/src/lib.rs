@@ -30,6 +30,9 @@ pub fn compile_dir(src_dir: &Path, out_dir: &Path) -> Result<Vec<Compiled>, Stri
     options.set_generate_debug_info(); // keeps OpName, which pipeline reflection binds by
     options.set_warnings_as_errors();
     let inc = include_dir.clone();
+    // Shaders and includes are named relative to the shader folder: the SPIR-V's debug
+    // strings hold these names, and an absolute path would make the same source compile
+    // to different bytes in each checkout (eval's reference cache keys on the bytes).
     options.set_include_callback(move |requested, _ty, requester, _depth| {
         let path = inc.join(requested);
         let content = fs::read_to_string(&path).map_err(|e| {
@@ -39,7 +42,7 @@ pub fn compile_dir(src_dir: &Path, out_dir: &Path) -> Result<Vec<Compiled>, Stri
             )
         })?;
         Ok(shaderc::ResolvedInclude {
-            resolved_name: path.display().to_string(),
+            resolved_name: format!("include/{requested}"),
             content,
         })
     });
@@ -59,11 +62,12 @@ pub fn compile_dir(src_dir: &Path, out_dir: &Path) -> Result<Vec<Compiled>, Stri
             .ok_or_else(|| format!("{}: shader name is not UTF-8", path.display()))?
             .to_string();
         let source = fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let file_name = format!("{name}.comp");
         let artifact = compiler
             .compile_into_spirv(
                 &source,
                 shaderc::ShaderKind::Compute,
-                &path.display().to_string(),
+                &file_name,
                 "main",
                 Some(&options),
             )
