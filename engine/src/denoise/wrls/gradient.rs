@@ -31,17 +31,23 @@ gpu_block! {
 /// Ours' temporal gradients of a frame, at stratum resolution in last frame's image.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Gradients {
+    /// Strata across and down.
+    pub strata: [u32; 2],
     /// Re-traced radiance (this frame's scene) and last frame's, per stratum.
     pub new: ImageHandle,
     pub old: ImageHandle,
+    /// Pooled over 3×3 strata ([`super::gradient_pool`]): rgb the colour of the change, a
+    /// the log luminance ratio; x its variance, y 1 where measured.
+    pub ratio: ImageHandle,
+    pub spread: ImageHandle,
     /// Measured this frame (false: the scene did not change, or nothing to compare).
     pub valid: bool,
 }
 
 impl Wrls {
-    /// Adds the temporal-gradient pass when the scene changed since last frame; the
-    /// images exist either way (the update pass binds them, and reads them only when
-    /// `valid`).
+    /// Adds the temporal-gradient pass and its pooling when the scene changed since last
+    /// frame; the images exist either way (the update pass binds them, and reads them
+    /// only when `valid`).
     pub(super) fn add_gradients<'f>(
         &'f self,
         ctx: &GpuContext,
@@ -58,8 +64,11 @@ impl Wrls {
         );
         let n = &self.name;
         let g = Gradients {
+            strata: [desc.extent[0], desc.extent[1]],
             new: graph.image(ctx, &format!("{n}.gradient_new"), desc)?,
             old: graph.image(ctx, &format!("{n}.gradient_old"), desc)?,
+            ratio: graph.image(ctx, &format!("{n}.gradient_ratio"), desc)?,
+            spread: graph.image(ctx, &format!("{n}.gradient_spread"), desc)?,
             valid: false,
         };
         let (Some(pipeline), Some(retrace)) = (&self.gradients, input.retrace) else {
@@ -87,6 +96,8 @@ impl Wrls {
                 .write("gradient_new", g.new)
                 .write("gradient_old", g.old);
         });
-        Ok(Gradients { valid: true, ..g })
+        let g = Gradients { valid: true, ..g };
+        self.add_gradient_pool(frame, &g);
+        Ok(g)
     }
 }

@@ -4,6 +4,8 @@
 //! Passes of a frame, in order (each in its own file here):
 //! - `<name>.gradient` ([`gradient`], `wrls_gradient.comp`): temporal gradients, when the
 //!   scene changed: last frame's samples re-traced in this frame's scene;
+//! - `<name>.gradient_pool` ([`gradient_pool`], `wrls_gradient_pool.comp`): the gradients
+//!   pooled over 3×3 strata, once per stratum;
 //! - `<name>.update` ([`update`]): the per-pixel models reprojected, adjusted for the
 //!   measured change and updated by weighted RLS: `wrls_constant.comp` for ours' constant
 //!   model p = [1] (two state images), `wrls_update.comp` for the paper's p = [1, z]
@@ -18,6 +20,7 @@
 //! exact form `wrls-paper` and its Fig. 8 ablations `rls`, `wrls-nf`, `rls-nf`.
 
 mod gradient;
+mod gradient_pool;
 mod spatial;
 mod update;
 
@@ -28,6 +31,7 @@ use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::path_trace::{self, PathTraceFeatures};
 use ash::vk;
 use gradient::WrlsGradientPush;
+use gradient_pool::WrlsGradientPoolPush;
 use spatial::{WrlsAtrousPush, WrlsDriftPush, WrlsSpatialPush};
 use update::{WrlsConstantPush, WrlsUpdatePush};
 
@@ -224,6 +228,7 @@ pub struct Wrls {
     /// What the temporal denoisers reproject with.
     pub motion: MotionSource,
     gradients: Option<Pipeline<WrlsGradientPush>>,
+    gradient_pool: Option<Pipeline<WrlsGradientPoolPush>>,
     update: Update,
     drift: Option<Pipeline<WrlsDriftPush>>,
     /// The à-trous filter over the predictions (one level for variants without it).
@@ -279,6 +284,10 @@ impl Wrls {
             gradients: variant
                 .gradients
                 .then(|| ctx.pipeline("wrls_gradient", &path_trace::specialization(features)))
+                .transpose()?,
+            gradient_pool: variant
+                .gradients
+                .then(|| ctx.pipeline("wrls_gradient_pool", &[]))
                 .transpose()?,
             update,
             drift: variant

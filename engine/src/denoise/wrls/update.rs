@@ -136,8 +136,8 @@ impl Wrls {
             reproj.bind(b);
             b.read("noisy", noisy)
                 .read("moments", moments)
-                .read("gradient_new", g.new)
-                .read("gradient_old", g.old)
+                .read("gradient_ratio", g.ratio)
+                .read("gradient_spread", g.spread)
                 .sampled("drift_prev", lag.drift.prev)
                 .write("prediction", lag.prediction)
                 .write("residual", lag.residual)
@@ -211,8 +211,8 @@ impl Wrls {
         frame.add_compute(format!("{n}.update"), pipeline, push, size, |b| {
             reproj.bind(b);
             b.read("noisy", noisy)
-                .read("gradient_new", g.new)
-                .read("gradient_old", g.old)
+                .read("gradient_ratio", g.ratio)
+                .read("gradient_spread", g.spread)
                 .sampled("drift_prev", lag.drift.prev)
                 .write("prediction", lag.prediction)
                 .write("residual", lag.residual);

@@ -1,0 +1,49 @@
+//! `<name>.gradient_pool` (wrls_gradient_pool.comp): ours' temporal gradients pooled over
+//! 3×3 strata, once per stratum, into the log luminance ratio, its variance and the
+//! colour of the change that the update passes read (one texel per pixel).
+
+use super::gradient::Gradients;
+use super::Wrls;
+use crate::gpu_block;
+use crate::graph::Frame;
+
+gpu_block! {
+    /// `WrlsGradientPoolPush` in wrls_gradient_pool.comp.
+    pub struct WrlsGradientPoolPush {
+        pub width: u32,
+        pub height: u32,
+        pub pad0: u32,
+        pub pad1: u32,
+    }
+}
+
+impl Wrls {
+    /// Pools this frame's temporal gradients (only when they were measured).
+    pub(super) fn add_gradient_pool<'f>(&'f self, frame: &mut Frame<'f>, g: &Gradients) {
+        let Some(pipeline) = &self.gradient_pool else {
+            return;
+        };
+        if !g.valid {
+            return;
+        }
+        let push = WrlsGradientPoolPush {
+            width: g.strata[0],
+            height: g.strata[1],
+            pad0: 0,
+            pad1: 0,
+        };
+        let grid = [g.strata[0], g.strata[1], 1];
+        frame.add_compute(
+            format!("{}.gradient_pool", self.name),
+            pipeline,
+            push,
+            grid,
+            |b| {
+                b.read("gradient_new", g.new)
+                    .read("gradient_old", g.old)
+                    .write("gradient_ratio", g.ratio)
+                    .write("gradient_spread", g.spread);
+            },
+        );
+    }
+}
