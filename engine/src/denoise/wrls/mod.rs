@@ -102,7 +102,7 @@ impl Default for WrlsParams {
             lambda_min: 0.1,
             change_gain: 4.0,
             shrink: 4.0,
-            trend: 1.0,
+            trend: 0.5,
             drift_z: 3.0,
             drift_radius: 2,
             atrous_iterations: 3,
