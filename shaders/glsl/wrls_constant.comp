@@ -48,7 +48,7 @@ layout(push_constant) uniform WrlsConstantPush {
     float drift_z;        // pooled residual, in standard errors, that starts to count
     float spp;            // samples per pixel of the noisy frame
     float lambda_moving;  // forgetting factor of a pixel whose surface moved on screen
-    float trend;          // share of last frame's gradient ratio (a log) expected again
+    float pad0;
     float pad1;
     float pad2;
 } pc;
@@ -73,16 +73,13 @@ void main() {
     float P = pc.delta;
     float noise_level = -1.0;  // none yet
     float streak = 0.0;
-    float log_ratio = 0.0;
     if (r.valid) {
         vec4 m = history_fetch(model_prev, r);
         vec4 st = history_fetch(stats_prev, r);
         // The scene changed: scale the model by the ratio the gradients measured, so it
         // follows the change instead of lagging, and forget in proportion to what the
         // scaling may have missed (below).
-        SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink,
-                                       pc.trend * st.z);
-        log_ratio = sc.log_ratio;
+        SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink);
         float mean_ratio = dot(sc.ratio, vec3(1.0 / 3.0));
         beta = m.rgb * sc.ratio;
         P = m.a;
@@ -153,7 +150,7 @@ void main() {
     }
     float noise = max(noise_level, 0.0) / 3.0;  // per channel
     imageStore(model_cur, p, vec4(beta, P));
-    imageStore(stats_cur, p, vec4(noise_level, streak, log_ratio, 0.0));
+    imageStore(stats_cur, p, vec4(noise_level, streak, 0.0, 0.0));
     imageStore(prediction, p, vec4(max(beta, vec3(0.0)), noise * P));
     // What this frame's update left unexplained, for the pooled lag test; a fresh model
     // has no history to lag.

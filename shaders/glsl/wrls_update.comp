@@ -97,7 +97,7 @@ void main() {
     float streak = 0.0;        // consecutive frames far above the noise level
     vec4 constant = vec4(0.0, 0.0, 0.0, pc.delta);
     vec3 errors = vec3(-1.0, -1.0, 0.0);  // a-priori errors (const, feature), const streak
-    SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink, 0.0);
+    SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink);
     // Forgetting in proportion to the measured change: a still scene keeps λ, a sudden
     // change falls to λ_min (what the scaling below did not explain is learned anew).
     float lambda = mix(pc.lambda_min, pc.lambda, 1.0 - min(1.0, pc.change_gain * sc.change));

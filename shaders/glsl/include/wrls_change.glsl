@@ -16,44 +16,30 @@ layout(binding = 24, rgba32f) uniform readonly image2D gradient_spread;  // x it
 // What the temporal gradients say about the scene around last frame's texture coordinate
 // `uv`: per channel, the ratio of this frame's radiance to last frame's (the same paths
 // traced in both scenes), and the relative change of luminance. No measurement
-// (`measured` false): ratio 1, change 0. `shrink`: squared standard errors of the ratio
-// that halve its departure from the prior. `prior`: the log luminance ratio expected
-// (last frame's, reprojected: under a moving light the change goes on, and a dark, noisy
-// region's measurement alone is shrunk so far towards 1 that the model lags; measured on
-// the suite's mri/area-light, worst frame −0.52 → +0.4 dB).
+// (`measured` false): ratio 1, change 0. `shrink`: squared standard errors of the log
+// ratio that halve its departure from 1.
 struct SceneChange {
     vec3 ratio;
     float change;
-    float log_ratio;  // the luminance ratio applied, as a log: next frame's prior
 };
 
-SceneChange scene_change(vec2 uv, ivec2 size, bool measured, uint stratum, float shrink,
-                         float prior) {
+SceneChange scene_change(vec2 uv, ivec2 size, bool measured, uint stratum, float shrink) {
     SceneChange sc;
     sc.ratio = vec3(1.0);
     sc.change = 0.0;
-    sc.log_ratio = 0.0;
     if (!measured) return sc;
     ivec2 k = clamp(ivec2(floor(uv * vec2(size) / float(stratum))), ivec2(0),
                     imageSize(gradient_ratio) - 1);
     vec4 pooled = imageLoad(gradient_ratio, k);
     vec2 spread = imageLoad(gradient_spread, k).xy;
     if (spread.y <= 0.0) return sc;
+    // A ratio within its noise of 1 is shrunk towards 1, so noise is not mistaken for
+    // change and the history is kept.
     float L = pooled.a, var_l = spread.x;
-    // Shrunk towards the prior: a ratio within its noise of it is taken as it, so noise
-    // is not mistaken for change and the history is kept. The prior only where this
-    // frame's measurement goes the same way, and never beyond it: the trend lends the
-    // measured change confidence, it does not extrapolate.
-    prior = L * prior > 0.0 ? sign(L) * min(abs(prior), abs(L)) : 0.0;
-    float d = L - prior;
-    float keep = d * d / (d * d + shrink * var_l + 1e-12);
-    sc.log_ratio = prior + keep * d;
-    float Ra = exp(sc.log_ratio);
+    float keep = L * L / (L * L + shrink * var_l + 1e-12);
+    float Ra = exp(keep * L);
     sc.change = abs(Ra - 1.0) / max(Ra, 1.0);
-    // The colour of the change is shrunk towards grey by the measurement alone: the
-    // prior knows only the luminance.
-    float keep0 = L * L / (L * L + shrink * var_l + 1e-12);
-    sc.ratio = mix(vec3(1.0), pooled.rgb, keep0) * Ra;
+    sc.ratio = mix(vec3(1.0), pooled.rgb, keep) * Ra;
     return sc;
 }
 

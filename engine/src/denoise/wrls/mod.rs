@@ -71,9 +71,6 @@ pub struct WrlsParams {
     /// Shrinkage of the gradient ratio towards 1: a ratio `k` standard errors from 1
     /// keeps k²/(k² + shrink) of its departure.
     pub shrink: f32,
-    /// Share of last frame's gradient ratio (as a log) that this frame's is shrunk
-    /// towards instead of 1: a change under way is expected to go on.
-    pub trend: f32,
     /// Pooled residual, in standard errors of its mean, from which the pooled lag test
     /// starts to correct the models (fully at twice this).
     pub drift_z: f32,
@@ -102,7 +99,6 @@ impl Default for WrlsParams {
             lambda_min: 0.1,
             change_gain: 4.0,
             shrink: 4.0,
-            trend: 0.5,
             drift_z: 3.0,
             drift_radius: 2,
             atrous_iterations: 3,
@@ -122,7 +118,6 @@ const OVERRIDABLE: &[(&str, fn(&mut WrlsParams, f32))] = &[
     ("lambda_min", |p, v| p.lambda_min = v),
     ("change_gain", |p, v| p.change_gain = v),
     ("shrink", |p, v| p.shrink = v),
-    ("trend", |p, v| p.trend = v),
     ("drift_z", |p, v| p.drift_z = v),
     ("drift_radius", |p, v| p.drift_radius = v as u32),
     ("stratum", |p, v| p.stratum = v as u32),

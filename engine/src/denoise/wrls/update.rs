@@ -36,7 +36,7 @@ gpu_block! {
         pub drift_z: f32,
         pub spp: f32,
         pub lambda_moving: f32,
-        pub trend: f32,
+        pub pad0: f32,
         pub pad1: f32,
         pub pad2: f32,
     }
@@ -127,7 +127,7 @@ impl Wrls {
             drift_z: p.drift_z,
             spp: input.spp as f32,
             lambda_moving: p.lambda_moving,
-            trend: p.trend,
+            pad0: 0.0,
             pad1: 0.0,
             pad2: 0.0,
         };
