@@ -43,9 +43,13 @@ vec2 to_pixel(mat4 view_proj, vec3 world, ivec2 size) {
 // Where last frame's ray missed but this one hit, only a still pixel keeps its history
 // (a semi-transparent pixel whose first collision comes and goes), anything moving is a
 // disocclusion.
-bool same_surface(ivec2 tap, vec2 delta, bool hit_now, float tolerance, ivec2 size) {
+// `camera_still`: the two frames' cameras are the same, so every point's own motion is
+// zero (the round trip below, exactly) and the test needs no projections.
+bool same_surface(ivec2 tap, vec2 delta, bool hit_now, float tolerance, ivec2 size,
+                  bool camera_still) {
     vec4 prev = texelFetch(position_prev, tap, 0);
     if (prev.w > 0.0) {
+        if (camera_still) return length(delta) <= tolerance;
         // Compare displacements, not places: that point's own motion must carry it from
         // where it was last frame to where it is now as this pixel's motion does. The
         // first real collision comes from a jittered sample (the pixel filter reaches
@@ -76,16 +80,21 @@ Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, flo
     bool hit_now = imageLoad(position_cur, p).w > 0.0;
     vec2 f = q - 0.5 - vec2(r.tap);
     vec4 bilinear = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    bool camera_still = frame.view_proj == frame.prev_view_proj;
     const ivec2 offsets[4] = ivec2[](ivec2(0, 0), ivec2(1, 0), ivec2(0, 1), ivec2(1, 1));
+    bool same[4] = bool[](false, false, false, false);
     for (int i = 0; i < 4; ++i) {
         ivec2 t = r.tap + offsets[i];
         bool inside = all(greaterThanEqual(t, ivec2(0))) && all(lessThan(t, size));
-        if (inside && same_surface(t, delta, hit_now, tolerance, size)) r.weights[i] = bilinear[i];
+        same[i] = inside && same_surface(t, delta, hit_now, tolerance, size, camera_still);
+        if (same[i]) r.weights[i] = bilinear[i];
     }
     float total = dot(r.weights, vec4(1.0));
-    // The nearest texel decides whether there is a history at all (as a nearest-texel
-    // test would); the weights then use whichever taps agree.
-    r.valid = total > 0.0 && same_surface(ivec2(q), delta, hit_now, tolerance, size);
+    // The nearest texel (one of the four taps, always on screen) decides whether there is
+    // a history at all (as a nearest-texel test would); the weights then use whichever
+    // taps agree.
+    ivec2 nearest = ivec2(q) - r.tap;
+    r.valid = total > 0.0 && same[nearest.x + 2 * nearest.y];
     r.weights = r.valid ? r.weights / total : vec4(0.0);
     return r;
 }
