@@ -60,7 +60,11 @@ if [[ -z "${DVR_ASSETS:-}" && -d "$here/assets" ]]; then
 fi
 
 has_loader() {
-    if { ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q 'libvulkan\.so\.1'; then
+    # ldconfig's list is read whole before it is searched: `ldconfig -p | grep -q` under
+    # pipefail fails at random (grep exits at the first match and ldconfig dies of SIGPIPE).
+    local cache
+    cache="$({ ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null || true)"
+    if grep -q 'libvulkan\.so\.1' <<< "$cache"; then
         return 0
     fi
     local dirs d
