@@ -36,7 +36,7 @@ pub(super) struct Gradients {
     /// Re-traced radiance (this frame's scene) and last frame's, per stratum.
     pub new: ImageHandle,
     pub old: ImageHandle,
-    /// Pooled over 3×3 strata ([`super::gradient_pool`]): rgb the colour of the change, a
+    /// Pooled over 3×3 or 5×5 strata ([`super::gradient_pool`]): rgb the colour of the change, a
     /// the log luminance ratio; x its variance, y 1 where measured.
     pub ratio: ImageHandle,
     pub spread: ImageHandle,

@@ -1,6 +1,7 @@
 //! `<name>.gradient_pool` (wrls_gradient_pool.comp): ours' temporal gradients pooled over
-//! 3×3 strata, once per stratum, into the log luminance ratio, its variance and the
-//! colour of the change that the update passes read (one texel per pixel).
+//! 3×3 or 5×5 strata (whichever shows the change more clearly), once per stratum, into
+//! the log luminance ratio, its variance and the colour of the change that the update
+//! passes read (one texel per pixel).
 
 use super::gradient::Gradients;
 use super::Wrls;
@@ -18,14 +19,11 @@ gpu_block! {
 }
 
 impl Wrls {
-    /// Pools this frame's temporal gradients (only when they were measured).
+    /// Pools this frame's temporal gradients (called once they are measured).
     pub(super) fn add_gradient_pool<'f>(&'f self, frame: &mut Frame<'f>, g: &Gradients) {
         let Some(pipeline) = &self.gradient_pool else {
             return;
         };
-        if !g.valid {
-            return;
-        }
         let push = WrlsGradientPoolPush {
             width: g.strata[0],
             height: g.strata[1],

@@ -5,7 +5,7 @@
 //! - `<name>.gradient` ([`gradient`], `wrls_gradient.comp`): temporal gradients, when the
 //!   scene changed: last frame's samples re-traced in this frame's scene;
 //! - `<name>.gradient_pool` ([`gradient_pool`], `wrls_gradient_pool.comp`): the gradients
-//!   pooled over 3×3 strata, once per stratum;
+//!   pooled over 3×3 or 5×5 strata, once per stratum;
 //! - `<name>.update` ([`update`]): the per-pixel models reprojected, adjusted for the
 //!   measured change and updated by weighted RLS: `wrls_constant.comp` for ours' constant
 //!   model p = [1] (two state images), `wrls_update.comp` for the paper's p = [1, z]
