@@ -229,6 +229,7 @@ pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, p
         height: setup.height(),
         spp: setup.settings.spp(),
         denoisers: renderer.denoiser_names(),
+        shared_tiles: renderer.ctx().shared_tiles,
     };
     Ok((Profile::new(run, &stats, &window, Some(peak)), window))
 }

@@ -6,8 +6,9 @@
 // step 1, 2, 4, 8, 16; the last iteration multiplies the albedo back in (`modulate`).
 #include "common.glsl"
 #include "svgf.glsl"
+#include "atrous_tile.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = TILE, local_size_y = TILE) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D color_in;    // demodulated rgb, a variance
 layout(binding = 1, rgba32f) uniform readonly image2D geometry;
@@ -29,15 +30,27 @@ layout(push_constant) uniform SvgfAtrousPush {
     float pad2;
 } pc;
 
+shared vec4 color_tile[TILE_TEXELS];
+shared vec4 geometry_tile[TILE_TEXELS];
+
+vec4 color_tap(TileWindow w, ivec2 q) {
+    return w.on ? color_tile[tile_index(w, q)] : imageLoad(color_in, q);
+}
+
+vec4 geometry_tap(TileWindow w, ivec2 q) {
+    return w.on ? geometry_tile[tile_index(w, q)] : imageLoad(geometry, q);
+}
+
 // The variance at p blurred by a 3×3 Gaussian ([1 2 1]/4 in each direction), which
-// steadies the luminance scale against the noise of the variance estimate itself.
-float prefiltered_variance(ivec2 p, ivec2 size) {
+// steadies the luminance scale against the noise of the variance estimate itself. (Its
+// taps, clamped to the image, lie within the window's margin of 2·step ≥ 2.)
+float prefiltered_variance(TileWindow w, ivec2 p, ivec2 size) {
     const float k[2] = float[](0.5, 0.25);
     float v = 0.0;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
             ivec2 q = clamp(p + ivec2(dx, dy), ivec2(0), size - 1);
-            v += k[abs(dx)] * k[abs(dy)] * imageLoad(color_in, q).a;
+            v += k[abs(dx)] * k[abs(dy)] * color_tap(w, q).a;
         }
     }
     return v;
@@ -46,12 +59,18 @@ float prefiltered_variance(ivec2 p, ivec2 size) {
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
+    TileWindow w = tile_window(pc.step);
+    if (w.on) {
+        TILE_LOAD(w, color_tile, color_in, size);
+        TILE_LOAD(w, geometry_tile, geometry, size);
+        barrier();
+    }
     if (p.x >= size.x || p.y >= size.y) return;
 
-    vec4 centre = imageLoad(color_in, p);
+    vec4 centre = color_tap(w, p);
     float lp = luminance(centre.rgb);
-    SvgfGeometry gp = svgf_unpack_geometry(imageLoad(geometry, p));
-    float phi_l = svgf_phi_l(pc.sigma_l, prefiltered_variance(p, size), pc.luminance_eps);
+    SvgfGeometry gp = svgf_unpack_geometry(geometry_tap(w, p));
+    float phi_l = svgf_phi_l(pc.sigma_l, prefiltered_variance(w, p, size), pc.luminance_eps);
 
     // The centre's edge-stopping weight is 1 by definition; only its kernel weight counts.
     float k0 = SVGF_B3[0] * SVGF_B3[0];
@@ -62,8 +81,8 @@ void main() {
         for (int dx = -2; dx <= 2; ++dx) {
             ivec2 q = p + ivec2(dx, dy) * pc.step;
             if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-            vec4 cq = imageLoad(color_in, q);
-            SvgfGeometry gq = svgf_unpack_geometry(imageLoad(geometry, q));
+            vec4 cq = color_tap(w, q);
+            SvgfGeometry gq = svgf_unpack_geometry(geometry_tap(w, q));
             float phi_z = svgf_phi_z(pc.sigma_z, gp.dz, float(pc.step) * length(vec2(dx, dy)));
             float w = SVGF_B3[abs(dx)] * SVGF_B3[abs(dy)]
                 * svgf_geometry_weight(gp.valid, gq.valid, gp.z, gq.z, phi_z, gp.n, gq.n, pc.sigma_n)

@@ -7,8 +7,9 @@
 // detail they resolved while young ones (after a change or a disocclusion) are averaged
 // over an ever wider footprint; each iteration passes on the variance of its output.
 #include "common.glsl"
+#include "atrous_tile.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = TILE, local_size_y = TILE) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D color_in;   // rgb prediction, a variance
 layout(binding = 1, rgba32f) uniform writeonly image2D color_out; // the same, filtered
@@ -26,11 +27,22 @@ layout(push_constant) uniform WrlsAtrousPush {
 
 const float B3[3] = float[](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
 
+shared vec4 tile[TILE_TEXELS];
+
+vec4 tap(TileWindow w, ivec2 q) {
+    return w.on ? tile[tile_index(w, q)] : imageLoad(color_in, q);
+}
+
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
+    TileWindow w = tile_window(pc.step);
+    if (w.on) {
+        TILE_LOAD(w, tile, color_in, size);
+        barrier();
+    }
     if (p.x >= size.x || p.y >= size.y) return;
-    vec4 centre = imageLoad(color_in, p);
+    vec4 centre = tap(w, p);
     float k0 = B3[0] * B3[0];
     vec3 sum = k0 * centre.rgb;
     float var_sum = k0 * k0 * centre.a;
@@ -39,7 +51,7 @@ void main() {
         for (int dx = -2; dx <= 2; ++dx) {
             ivec2 q = p + ivec2(dx, dy) * pc.step;
             if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-            vec4 cq = imageLoad(color_in, q);
+            vec4 cq = tap(w, q);
             vec3 d = cq.rgb - centre.rgb;
             float range = dot(d, d) / 3.0 / (pc.kappa * pc.kappa * (centre.a + cq.a) + 1e-10);
             float w = B3[abs(dx)] * B3[abs(dy)] * exp(-range);

@@ -341,6 +341,7 @@ mod tests {
             height: 8,
             spp: 2,
             denoisers: vec!["ours".into(), "svgf".into()],
+            shared_tiles: true,
         };
         let peak = PeakBandwidth {
             gb_per_s: 4.0,

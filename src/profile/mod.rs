@@ -106,6 +106,8 @@ pub struct RunInfo {
     pub height: u32,
     pub spp: u32,
     pub denoisers: Vec<String>,
+    /// The à-trous levels read their window through shared memory (GpuContext::shared_tiles).
+    pub shared_tiles: bool,
 }
 
 fn window_note(window: &Window, rendered: usize) -> String {
@@ -124,13 +126,18 @@ fn window_note(window: &Window, rendered: usize) -> String {
 pub fn table(p: &Profile) -> String {
     let r = &p.run;
     let mut s = format!(
-        "{} | {} | {}x{} | {} spp | denoisers: {}\n",
+        "{} | {} | {}x{} | {} spp | denoisers: {} | à-trous windows: {}\n",
         r.device,
         r.scene,
         r.width,
         r.height,
         r.spp,
-        r.denoisers.join(",")
+        r.denoisers.join(","),
+        if r.shared_tiles {
+            "shared-memory tiles"
+        } else {
+            "direct loads"
+        }
     );
     match &p.peak_bandwidth {
         Some(b) => s.push_str(&format!(
@@ -263,6 +270,7 @@ mod tests {
             height: 4,
             spp: 1,
             denoisers: vec!["none".into()],
+            shared_tiles: false,
         };
         let peak = PeakBandwidth {
             gb_per_s: 8.0,

@@ -148,7 +148,10 @@ impl Svgf {
                 &[("MOTION_SOURCE", SpecValue::I32(motion.spec()))],
             )?,
             variance: ctx.pipeline("svgf_variance", &[])?,
-            atrous: ctx.pipeline("svgf_atrous", &[])?,
+            atrous: ctx.pipeline(
+                "svgf_atrous",
+                &[("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles))],
+            )?,
             params: SvgfParams::default(),
             motion,
         })

@@ -47,6 +47,8 @@ pub struct GpuContext {
     pub debug_utils: Option<ash::ext::debug_utils::Device>,
     pub allocator: ManuallyDrop<Mutex<Allocator>>,
     pub validation_enabled: bool,
+    /// À-trous levels read their window through shared memory ([`ContextOptions::shared_tiles`]).
+    pub shared_tiles: bool,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     one_shot_pool: vk::CommandPool,
     /// Every pipeline built through [`GpuContext::pipeline`], destroyed with the device.
@@ -64,6 +66,25 @@ pub struct ContextOptions {
     pub instance_extensions: Vec<*const c_char>,
     /// Device extensions beyond the engine's own (the explorer adds the swapchain).
     pub device_extensions: Vec<*const c_char>,
+    /// Whether à-trous levels read their window through workgroup shared memory
+    /// (include/atrous_tile.glsl). Defaults to `DVR_SHARED_TILES=0|1`, else to on for
+    /// every device but a CPU implementation (lavapipe, where tiles are slower).
+    pub shared_tiles: Option<bool>,
+}
+
+/// `DVR_SHARED_TILES`: `1`/`0` forces shared-memory tiles on or off; unset leaves the
+/// choice to the device type.
+fn shared_tiles_requested() -> Result<Option<bool>> {
+    match std::env::var("DVR_SHARED_TILES").as_deref() {
+        Err(_) | Ok("") => Ok(None),
+        Ok("1") => Ok(Some(true)),
+        Ok("0") => Ok(Some(false)),
+        Ok(other) => Err(EngineError::InvalidSetting {
+            name: "DVR_SHARED_TILES",
+            value: other.to_string(),
+            allowed: "1 (shared-memory tiles on), 0 (off) or unset (on for GPUs)".into(),
+        }),
+    }
 }
 
 fn device_rank(t: vk::PhysicalDeviceType) -> u32 {
@@ -187,6 +208,12 @@ impl GpuContext {
         let one_shot_pool =
             unsafe { device.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
 
+        let shared_tiles = match options.shared_tiles {
+            Some(on) => on,
+            None => {
+                shared_tiles_requested()?.unwrap_or(info.device_type != vk::PhysicalDeviceType::CPU)
+            }
+        };
         log::info!("dvr: using {} ({:?})", info.name, info.device_type);
         Ok(Self {
             entry,
@@ -200,6 +227,7 @@ impl GpuContext {
             debug_utils,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             validation_enabled,
+            shared_tiles,
             messenger,
             one_shot_pool,
             pipelines: Default::default(),

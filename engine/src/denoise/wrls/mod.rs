@@ -289,7 +289,10 @@ impl Wrls {
                 .drift
                 .then(|| ctx.pipeline("wrls_drift", &[]))
                 .transpose()?,
-            atrous: ctx.pipeline("wrls_atrous", &[])?,
+            atrous: ctx.pipeline(
+                "wrls_atrous",
+                &[("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles))],
+            )?,
             paper_spatial,
         })
     }
