@@ -8,8 +8,9 @@
 // A residual far above the model's running noise level twice in a row restarts it (a
 // jump); a single far residual is a spike and is given little weight.
 //
-// State, two images: model (rgb β, a P) and stats (x running noise level: mean squared
-// a-priori residual over the three channels; y frames in a row with a far residual).
+// State, two images: model (rgba32f: rgb β, a P) and stats (rg32f: x running noise level,
+// the mean squared a-priori residual over the three channels; y frames in a row with a
+// far residual).
 // Outputs for the spatial pass: the prediction (rgb) with its variance (a), and the
 // a-posteriori residual for the pooled lag test (wrls_drift.comp).
 #include "common.glsl"
@@ -23,7 +24,7 @@ layout(binding = 1, rgba32f) uniform readonly image2D noisy;
 layout(binding = 2) uniform sampler2D model_prev;
 layout(binding = 3) uniform sampler2D stats_prev;
 layout(binding = 4, rgba32f) uniform writeonly image2D model_cur;
-layout(binding = 5, rgba32f) uniform writeonly image2D stats_cur;
+layout(binding = 5, rg32f) uniform writeonly image2D stats_cur;
 layout(binding = 6, rgba32f) uniform writeonly image2D prediction;  // rgb, a variance
 layout(binding = 7, rgba32f) uniform writeonly image2D residual;    // rgb, a variance (< 0: none)
 layout(binding = 8) uniform sampler2D drift_prev;                    // rgb mean, a variance

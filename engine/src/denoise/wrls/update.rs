@@ -104,7 +104,12 @@ impl Wrls {
         let desc = Self::state_desc(input);
         let n = &self.name;
         let model = graph.history(ctx, &format!("{n}.model"), desc)?;
-        let stats = graph.history(ctx, &format!("{n}.stats"), desc)?;
+        // Two channels are all the stats need: half the bytes of an rgba32f image.
+        let stats_desc = ImageDesc {
+            format: vk::Format::R32G32_SFLOAT,
+            ..desc
+        };
+        let stats = graph.history(ctx, &format!("{n}.stats"), stats_desc)?;
         let reproj = input.reprojection(&self.name, self.motion)?;
         let p = self.params;
         let size = input.size;
