@@ -154,8 +154,9 @@ void main() {
     imageStore(stats_cur, p, vec4(noise_level, streak, 0.0, 0.0));
     imageStore(prediction, p, vec4(max(beta, vec3(0.0)), noise * P));
     // What this frame's update left unexplained, for the pooled lag test; a fresh model
-    // has no history to lag.
+    // has no history to lag. Finite or none: the drift pass trusts it.
     float keep = 1.0 - q;
-    imageStore(residual, p, r.valid && !fresh ? vec4(keep * e, noise * keep * keep)
-                                              : vec4(0.0, 0.0, 0.0, -1.0));
+    vec4 res = vec4(keep * e, noise * keep * keep);
+    imageStore(residual, p, r.valid && !fresh && all_finite(res.rgb) && all_finite(res.aaa)
+                                ? res : vec4(0.0, 0.0, 0.0, -1.0));
 }

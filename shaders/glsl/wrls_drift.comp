@@ -25,12 +25,13 @@ void main() {
     vec3 sum = vec3(0.0);
     float var_sum = 0.0;
     float n = 0.0;
-    for (int dy = -pc.radius; dy <= pc.radius; ++dy) {
-        for (int dx = -pc.radius; dx <= pc.radius; ++dx) {
-            ivec2 q = p + ivec2(dx, dy);
-            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-            vec4 r = imageLoad(residual, q);
-            if (r.a < 0.0 || !all_finite(r.rgb)) continue;
+    // The window clipped to the image once, not tested per tap. (The update pass writes
+    // finite residuals, or a < 0 where there is none.)
+    ivec2 lo = max(p - pc.radius, ivec2(0)), hi = min(p + pc.radius, size - 1);
+    for (int y = lo.y; y <= hi.y; ++y) {
+        for (int x = lo.x; x <= hi.x; ++x) {
+            vec4 r = imageLoad(residual, ivec2(x, y));
+            if (r.a < 0.0) continue;
             sum += r.rgb;
             var_sum += r.a;
             n += 1.0;
