@@ -44,13 +44,13 @@ vec4 geometry_tap(TileWindow w, ivec2 q) {
 // The variance at p blurred by a 3×3 Gaussian ([1 2 1]/4 in each direction), which
 // steadies the luminance scale against the noise of the variance estimate itself. (Its
 // taps, clamped to the image, lie within the window's margin of 2·step ≥ 2.)
-float prefiltered_variance(TileWindow w, ivec2 p, ivec2 size) {
+float prefiltered_variance(TileWindow win, ivec2 p, ivec2 size) {
     const float k[2] = float[](0.5, 0.25);
     float v = 0.0;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
             ivec2 q = clamp(p + ivec2(dx, dy), ivec2(0), size - 1);
-            v += k[abs(dx)] * k[abs(dy)] * color_tap(w, q).a;
+            v += k[abs(dx)] * k[abs(dy)] * color_tap(win, q).a;
         }
     }
     return v;
@@ -59,18 +59,18 @@ float prefiltered_variance(TileWindow w, ivec2 p, ivec2 size) {
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
-    TileWindow w = tile_window(pc.step);
-    if (w.on) {
-        TILE_LOAD(w, color_tile, color_in, size);
-        TILE_LOAD(w, geometry_tile, geometry, size);
+    TileWindow win = tile_window(pc.step);
+    if (win.on) {
+        TILE_LOAD(win, color_tile, color_in, size);
+        TILE_LOAD(win, geometry_tile, geometry, size);
         barrier();
     }
     if (p.x >= size.x || p.y >= size.y) return;
 
-    vec4 centre = color_tap(w, p);
+    vec4 centre = color_tap(win, p);
     float lp = luminance(centre.rgb);
-    SvgfGeometry gp = svgf_unpack_geometry(geometry_tap(w, p));
-    float phi_l = svgf_phi_l(pc.sigma_l, prefiltered_variance(w, p, size), pc.luminance_eps);
+    SvgfGeometry gp = svgf_unpack_geometry(geometry_tap(win, p));
+    float phi_l = svgf_phi_l(pc.sigma_l, prefiltered_variance(win, p, size), pc.luminance_eps);
 
     // The centre's edge-stopping weight is 1 by definition; only its kernel weight counts.
     float k0 = SVGF_B3[0] * SVGF_B3[0];
@@ -81,8 +81,8 @@ void main() {
         for (int dx = -2; dx <= 2; ++dx) {
             ivec2 q = p + ivec2(dx, dy) * pc.step;
             if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-            vec4 cq = color_tap(w, q);
-            SvgfGeometry gq = svgf_unpack_geometry(geometry_tap(w, q));
+            vec4 cq = color_tap(win, q);
+            SvgfGeometry gq = svgf_unpack_geometry(geometry_tap(win, q));
             float phi_z = svgf_phi_z(pc.sigma_z, gp.dz, float(pc.step) * length(vec2(dx, dy)));
             float w = SVGF_B3[abs(dx)] * SVGF_B3[abs(dy)]
                 * svgf_geometry_weight(gp.valid, gq.valid, gp.z, gq.z, phi_z, gp.n, gq.n, pc.sigma_n)

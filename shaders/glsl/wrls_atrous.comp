@@ -36,13 +36,13 @@ vec4 tap(TileWindow w, ivec2 q) {
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
-    TileWindow w = tile_window(pc.step);
-    if (w.on) {
-        TILE_LOAD(w, tile, color_in, size);
+    TileWindow win = tile_window(pc.step);
+    if (win.on) {
+        TILE_LOAD(win, tile, color_in, size);
         barrier();
     }
     if (p.x >= size.x || p.y >= size.y) return;
-    vec4 centre = tap(w, p);
+    vec4 centre = tap(win, p);
     float k0 = B3[0] * B3[0];
     vec3 sum = k0 * centre.rgb;
     float var_sum = k0 * k0 * centre.a;
@@ -51,7 +51,7 @@ void main() {
         for (int dx = -2; dx <= 2; ++dx) {
             ivec2 q = p + ivec2(dx, dy) * pc.step;
             if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-            vec4 cq = tap(w, q);
+            vec4 cq = tap(win, q);
             vec3 d = cq.rgb - centre.rgb;
             float range = dot(d, d) / 3.0 / (pc.kappa * pc.kappa * (centre.a + cq.a) + 1e-10);
             float w = B3[abs(dx)] * B3[abs(dy)] * exp(-range);

@@ -14,9 +14,12 @@ layout(binding = 1, rgba32f) uniform writeonly image2D drift;    // rgb mean, a 
 layout(push_constant) uniform WrlsDriftPush {
     uint width;
     uint height;
-    int radius;
     uint pad0;
+    uint pad1;
 } pc;
+
+// The window's radius (5×5 at 2), a specialisation constant so the loops unroll.
+layout(constant_id = 15) const int DRIFT_RADIUS = 2;
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -25,12 +28,11 @@ void main() {
     vec3 sum = vec3(0.0);
     float var_sum = 0.0;
     float n = 0.0;
-    // The window clipped to the image once, not tested per tap. (The update pass writes
-    // finite residuals, or a < 0 where there is none.)
-    ivec2 lo = max(p - pc.radius, ivec2(0)), hi = min(p + pc.radius, size - 1);
-    for (int y = lo.y; y <= hi.y; ++y) {
-        for (int x = lo.x; x <= hi.x; ++x) {
-            vec4 r = imageLoad(residual, ivec2(x, y));
+    for (int dy = -DRIFT_RADIUS; dy <= DRIFT_RADIUS; ++dy) {
+        for (int dx = -DRIFT_RADIUS; dx <= DRIFT_RADIUS; ++dx) {
+            ivec2 q = p + ivec2(dx, dy);
+            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+            vec4 r = imageLoad(residual, q);
             if (r.a < 0.0) continue;
             sum += r.rgb;
             var_sum += r.a;
@@ -38,6 +40,6 @@ void main() {
         }
     }
     // Fewer than half the neighbours with a history: no estimate (variance infinite).
-    float min_n = 0.5 * float((2 * pc.radius + 1) * (2 * pc.radius + 1));
+    float min_n = 0.5 * float((2 * DRIFT_RADIUS + 1) * (2 * DRIFT_RADIUS + 1));
     imageStore(drift, p, n >= min_n ? vec4(sum / n, var_sum / (n * n)) : vec4(0.0, 0.0, 0.0, 1e30));
 }

@@ -16,8 +16,8 @@ gpu_block! {
     pub struct WrlsDriftPush {
         pub width: u32,
         pub height: u32,
-        pub radius: i32,
         pub pad0: u32,
+        pub pad1: u32,
     }
 }
 
@@ -70,8 +70,8 @@ impl Wrls {
         let push = WrlsDriftPush {
             width: size.width,
             height: size.height,
-            radius: self.params.drift_radius as i32,
             pad0: 0,
+            pad1: 0,
         };
         let name = format!("{}.drift", self.name);
         frame.add_compute(name, pipeline, push, size, |b| {
