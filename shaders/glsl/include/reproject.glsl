@@ -86,7 +86,10 @@ Reprojection reproject(ivec2 p, ivec2 size, bool history_valid, vec3 camera, flo
     for (int i = 0; i < 4; ++i) {
         ivec2 t = r.tap + offsets[i];
         bool inside = all(greaterThanEqual(t, ivec2(0))) && all(lessThan(t, size));
-        same[i] = inside && same_surface(t, delta, hit_now, tolerance, size, camera_still);
+        // A tap without bilinear weight is not tested (a still camera's pixel has one
+        // tap): it adds nothing, and the nearest tap always has weight.
+        same[i] = inside && bilinear[i] > 0.0 &&
+                  same_surface(t, delta, hit_now, tolerance, size, camera_still);
         if (same[i]) r.weights[i] = bilinear[i];
     }
     float total = dot(r.weights, vec4(1.0));
