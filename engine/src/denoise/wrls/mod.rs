@@ -80,6 +80,9 @@ pub struct WrlsParams {
 
     /// À-trous iterations of the spatial filter (steps 1, 2, 4, …).
     pub atrous_iterations: u32,
+    /// Relative standard error of a prediction below which the à-trous levels keep the
+    /// pixel as it is (a converged model; 0 filters every pixel).
+    pub atrous_keep: f32,
 }
 
 impl Default for WrlsParams {
@@ -103,6 +106,7 @@ impl Default for WrlsParams {
             drift_z: 3.0,
             drift_radius: 2,
             atrous_iterations: 3,
+            atrous_keep: 0.05,
         }
     }
 }
@@ -123,6 +127,7 @@ const OVERRIDABLE: &[(&str, fn(&mut WrlsParams, f32))] = &[
     ("drift_radius", |p, v| p.drift_radius = (v as u32).min(8)),
     ("stratum", |p, v| p.stratum = v as u32),
     ("atrous_iterations", |p, v| p.atrous_iterations = v as u32),
+    ("atrous_keep", |p, v| p.atrous_keep = v),
 ];
 
 impl WrlsParams {

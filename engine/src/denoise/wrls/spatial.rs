@@ -29,7 +29,7 @@ gpu_block! {
         pub step: i32,
         pub kappa: f32,
         pub last: u32,
-        pub pad0: u32,
+        pub keep: f32,
         pub pad1: u32,
         pub pad2: u32,
     }
@@ -117,7 +117,7 @@ impl Wrls {
                 step: 1 << i,
                 kappa: self.params.kappa,
                 last: last as u32,
-                pad0: 0,
+                keep: self.params.atrous_keep,
                 pad1: 0,
                 pad2: 0,
             };
