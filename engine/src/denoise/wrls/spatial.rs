@@ -117,7 +117,12 @@ impl Wrls {
                 step: 1 << i,
                 kappa: self.params.kappa,
                 last: last as u32,
-                keep: self.params.atrous_keep,
+                // Ours' addition to the filter; the paper's one-level variants blend all.
+                keep: if self.variant.atrous {
+                    self.params.atrous_keep
+                } else {
+                    0.0
+                },
                 pad1: 0,
                 pad2: 0,
             };
