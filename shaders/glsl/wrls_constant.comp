@@ -4,7 +4,8 @@
 // this frame's noisy colour. What changed is measured twice, before the update: the
 // temporal gradients scale the model by the ratio the re-traced samples show and lower
 // its forgetting factor in proportion (a light or TF change), and last frame's pooled
-// residual, where significant, is added to it (a lag no single pixel's noise reveals).
+// residual, where significant, is added to it and lowers the forgetting factor too (a
+// lag no single pixel's noise reveals).
 // A residual far above the model's running noise level twice in a row restarts it (a
 // jump); a single far residual is a spike and is given little weight.
 //
@@ -49,9 +50,9 @@ layout(push_constant) uniform WrlsConstantPush {
     float drift_z;        // pooled residual, in standard errors, that starts to count
     float spp;            // samples per pixel of the noisy frame
     float lambda_moving;  // forgetting factor of a pixel whose surface moved on screen
+    float drift_forget;   // share of the way to lambda_min at a clearly significant lag
+    float drift_forget_z; // pooled residual, in standard errors, from which it forgets
     float pad0;
-    float pad1;
-    float pad2;
 } pc;
 
 const float P_MAX = 1e6;
@@ -95,6 +96,10 @@ void main() {
         if (pc.drift_valid != 0u) {
             vec4 drift = history_fetch(drift_prev, r);
             beta += significant_drift(drift, pc.drift_z);
+            // A lag the neighbourhood shares is a change the gradients missed: forget in
+            // proportion too, from a lower significance than the correction needs.
+            float lag = drift_significance(drift, pc.drift_forget_z);
+            lambda = mix(lambda, pc.lambda_min, pc.drift_forget * lag);
         }
     }
 

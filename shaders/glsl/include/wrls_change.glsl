@@ -43,12 +43,17 @@ SceneChange scene_change(vec2 uv, ivec2 size, bool measured, uint stratum, float
     return sc;
 }
 
-// Last frame's pooled residual `drift` (rgb mean, a its variance; wrls_drift.comp) as a
-// correction to add to the models: nothing within `z` standard errors of zero, all of it
-// beyond 2z, a smooth step between (so noise is not mistaken for lag).
-vec3 significant_drift(vec4 drift, float z) {
+// How significant last frame's pooled residual `drift` (rgb mean, a its variance;
+// wrls_drift.comp) is: 0 within `z` standard errors of zero, 1 beyond 2z, a smooth step
+// between (so noise is not mistaken for lag).
+float drift_significance(vec4 drift, float z) {
     float z2 = dot(drift.rgb, drift.rgb) / 3.0 / max(drift.a, 1e-12);
-    return smoothstep(z * z, 4.0 * z * z, z2) * drift.rgb;
+    return smoothstep(z * z, 4.0 * z * z, z2);
+}
+
+// The drift as a correction to add to the models.
+vec3 significant_drift(vec4 drift, float z) {
+    return drift_significance(drift, z) * drift.rgb;
 }
 
 #endif

@@ -74,6 +74,10 @@ pub struct WrlsParams {
     /// Pooled residual, in standard errors of its mean, from which the pooled lag test
     /// starts to correct the models (fully at twice this).
     pub drift_z: f32,
+    /// Share of the way to λ_min the forgetting factor goes where the pooled residual
+    /// is clearly significant (from `drift_forget_z` standard errors, fully at twice that).
+    pub drift_forget: f32,
+    pub drift_forget_z: f32,
     /// Radius of the pooled lag test's square neighbourhood, in pixels (at most 8: the
     /// shader unrolls its window).
     pub drift_radius: u32,
@@ -104,6 +108,8 @@ impl Default for WrlsParams {
             change_gain: 4.0,
             shrink: 4.0,
             drift_z: 3.0,
+            drift_forget: 0.5,
+            drift_forget_z: 2.0,
             drift_radius: 2,
             atrous_iterations: 3,
             atrous_keep: 0.05,
@@ -125,6 +131,8 @@ const OVERRIDABLE: &[(&str, fn(&mut WrlsParams, f32))] = &[
     ("shrink", |p, v| p.shrink = v),
     ("drift_z", |p, v| p.drift_z = v),
     ("drift_radius", |p, v| p.drift_radius = (v as u32).min(8)),
+    ("drift_forget", |p, v| p.drift_forget = v),
+    ("drift_forget_z", |p, v| p.drift_forget_z = v),
     ("stratum", |p, v| p.stratum = v as u32),
     ("atrous_iterations", |p, v| p.atrous_iterations = v as u32),
     ("atrous_keep", |p, v| p.atrous_keep = v),

@@ -36,9 +36,9 @@ gpu_block! {
         pub drift_z: f32,
         pub spp: f32,
         pub lambda_moving: f32,
+        pub drift_forget: f32,
+        pub drift_forget_z: f32,
         pub pad0: f32,
-        pub pad1: f32,
-        pub pad2: f32,
     }
 }
 
@@ -132,9 +132,9 @@ impl Wrls {
             drift_z: p.drift_z,
             spp: input.spp as f32,
             lambda_moving: p.lambda_moving,
+            drift_forget: p.drift_forget,
+            drift_forget_z: p.drift_forget_z,
             pad0: 0.0,
-            pad1: 0.0,
-            pad2: 0.0,
         };
         let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
         frame.add_compute(format!("{n}.update"), pipeline, push, size, |b| {
