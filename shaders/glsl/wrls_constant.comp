@@ -159,9 +159,7 @@ void main() {
     imageStore(stats_cur, p, vec4(noise_level, streak, 0.0, 0.0));
     imageStore(prediction, p, vec4(max(beta, vec3(0.0)), noise * P));
     // What this frame's update left unexplained, for the pooled lag test; a fresh model
-    // has no history to lag. Finite or none: the drift pass trusts it.
+    // has no history to lag.
     float keep = 1.0 - q;
-    vec4 res = vec4(keep * e, noise * keep * keep);
-    imageStore(residual, p, r.valid && !fresh && all_finite(res.rgb) && all_finite(res.aaa)
-                                ? res : vec4(0.0, 0.0, 0.0, -1.0));
+    imageStore(residual, p, lag_residual(r.valid && !fresh, keep * e, noise * keep * keep));
 }

@@ -33,7 +33,7 @@ void main() {
             ivec2 q = p + ivec2(dx, dy);
             if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
             vec4 r = imageLoad(residual, q);
-            if (r.a < 0.0) continue;  // no history (the update passes write only finite residuals)
+            if (r.a < 0.0) continue;  // none (wrls_change.glsl's lag_residual)
             sum += r.rgb;
             var_sum += r.a;
             n += 1.0;

@@ -229,11 +229,9 @@ void main() {
     for (int c = 0; c < 3; ++c) beta[c] += q * e[c];
     // The a-posteriori residual (what this frame's update left unexplained) and its
     // variance, for the pooled lag test; fresh models have none.
-    // Finite or none: the drift pass trusts it.
     float keep = 1.0 - dot(x, q);
-    vec4 res = vec4(keep * e, max(noise_level, 0.0) / 3.0 * keep * keep);
-    imageStore(residual, p, r.valid && !fresh && all_finite(res.rgb) && all_finite(res.aaa)
-                                ? res : vec4(0.0, 0.0, 0.0, -1.0));
+    imageStore(residual, p, lag_residual(r.valid && !fresh, keep * e,
+                                         max(noise_level, 0.0) / 3.0 * keep * keep));
     P = (P - outerProduct(q, Px)) / lambda;
     // fp32 hygiene: keep P symmetric with a positive, bounded diagonal (wind-up guard
     // for predictors that stop exciting some direction on long static runs).

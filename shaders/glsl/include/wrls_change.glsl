@@ -7,7 +7,7 @@
 #include "common.glsl"
 
 // Temporal gradients pooled per S×S stratum of last frame's image (wrls_gradient.comp
-// re-traced one pixel per stratum, wrls_gradient_pool.comp summed 3×3 strata): the log
+// re-traced one pixel per stratum, wrls_gradient_pool.comp summed 3×3 or 5×5 strata): the log
 // luminance ratio of this frame's radiance to last frame's with its variance, and the
 // colour of the change.
 layout(binding = 23, rgba32f) uniform readonly image2D gradient_ratio;   // rgb colour, a log ratio
@@ -54,6 +54,14 @@ float drift_significance(vec4 drift, float z) {
 // The drift as a correction to add to the models.
 vec3 significant_drift(vec4 drift, float z) {
     return drift_significance(drift, z) * drift.rgb;
+}
+
+// The a-posteriori residual an update pass hands to the pooled lag test (wrls_drift.comp):
+// rgb the residual, a its variance; a < 0 where there is none (a new model, or a value
+// that is not finite), so the lag test need not check its taps.
+vec4 lag_residual(bool has_history, vec3 residual, float variance) {
+    vec4 r = vec4(residual, variance);
+    return has_history && all_finite(r.rgb) && all_finite(r.aaa) ? r : vec4(0.0, 0.0, 0.0, -1.0);
 }
 
 #endif
