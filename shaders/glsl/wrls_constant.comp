@@ -12,8 +12,9 @@
 // State, two images: model (rgba32f: rgb β, a P) and stats (rg32f: x running noise level,
 // the mean squared a-priori residual over the three channels; y frames in a row with a
 // far residual).
-// Outputs for the spatial pass: the prediction (rgb) with its variance (a), and the
-// a-posteriori residual for the pooled lag test (wrls_drift.comp).
+// Outputs for the spatial pass: the prediction (rgb) with its variance (a), and for the
+// pooled lag test (wrls_drift.comp) the running a-posteriori residual (a history: this
+// frame's blended with last frame's, wrls_change.glsl running_lag).
 #include "common.glsl"
 #include "reproject.glsl"
 #include "wrls.glsl"
@@ -30,6 +31,7 @@ layout(binding = 6, rgba32f) uniform writeonly image2D prediction;  // rgb, a va
 layout(binding = 7, rgba32f) uniform writeonly image2D residual;    // rgb, a variance (< 0: none)
 layout(binding = 8) uniform sampler2D drift_prev;                    // rgb mean, a variance
 layout(binding = 9, rgba32f) uniform readonly image2D moments;       // x mean, y 2nd moment of luminance
+layout(binding = 10) uniform sampler2D residual_prev;                // last frame's `residual`
 
 layout(push_constant) uniform WrlsConstantPush {
     vec4 camera;          // xyz camera position
@@ -46,12 +48,12 @@ layout(push_constant) uniform WrlsConstantPush {
     uint stratum;         // the gradients' stratum edge in pixels
     float lambda_min;     // forgetting factor at a sudden change
     float change_gain;    // change per frame over the noise at which the history is forgotten: 1/gain
-    float shrink;         // squared standard errors of the gradient ratio that halve it
     float drift_z;        // pooled residual, in standard errors, that starts to count
     float spp;            // samples per pixel of the noisy frame
     float lambda_moving;  // forgetting factor of a pixel whose surface moved on screen
     float drift_forget;   // share of the way to lambda_min at a clearly significant lag
     float drift_forget_z; // pooled residual, in standard errors, from which it forgets
+    float lag_alpha;      // weight of this frame's residual in the running one (1: its own)
     float pad0;
 } pc;
 
@@ -75,13 +77,14 @@ void main() {
     float P = pc.delta;
     float noise_level = -1.0;  // none yet
     float streak = 0.0;
+    vec4 lag_prev = vec4(0.0, 0.0, 0.0, -1.0);  // the running residual: none
     if (r.valid) {
         vec4 m = history_fetch(model_prev, r);
         vec4 st = history_fetch(stats_prev, r);
         // The scene changed: scale the model by the ratio the gradients measured, so it
         // follows the change instead of lagging, and forget in proportion to what the
         // scaling may have missed (below).
-        SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink);
+        SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum);
         float mean_ratio = dot(sc.ratio, vec3(1.0 / 3.0));
         beta = m.rgb * sc.ratio;
         P = m.a;
@@ -95,7 +98,14 @@ void main() {
         lambda = mix(lambda, pc.lambda_min, forget);
         if (pc.drift_valid != 0u) {
             vec4 drift = history_fetch(drift_prev, r);
-            beta += significant_drift(drift, pc.drift_z);
+            vec3 correction = significant_drift(drift, pc.drift_z);
+            beta += correction;
+            if (pc.lag_alpha < 1.0) {
+                // The running residual follows the change, and what was corrected is no
+                // longer a lag.
+                lag_prev = history_fetch(residual_prev, r);
+                lag_prev.rgb = lag_prev.rgb * sc.ratio - correction;
+            }
             // A lag the neighbourhood shares is a change the gradients missed: forget in
             // proportion too, from a lower significance than the correction needs.
             float lag = drift_significance(drift, pc.drift_forget_z);
@@ -161,5 +171,7 @@ void main() {
     // What this frame's update left unexplained, for the pooled lag test; a fresh model
     // has no history to lag.
     float keep = 1.0 - q;
-    imageStore(residual, p, lag_residual(r.valid && !fresh, keep * e, noise * keep * keep));
+    float variance = sample_variance(imageLoad(moments, p).xy, pc.spp) + noise * P;
+    imageStore(residual, p, running_lag(r.valid && !fresh, lag_prev, keep * e,
+                                        keep * keep * variance, pc.lag_alpha));
 }

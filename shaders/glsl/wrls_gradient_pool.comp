@@ -1,26 +1,32 @@
 #version 460
 // ours' temporal gradients pooled (wrls_gradient.comp measured them, one pixel per S×S
 // stratum): per stratum, the strata around it summed into a luminance ratio (as a log)
-// with its standard error and the colour of the change, over 3×3 strata or over 5×5,
-// whichever shows the change more clearly (the larger squared ratio of log ratio to
-// standard error): a small pool keeps a light's moving edge sharp, a large one finds a
-// change that a dark, noisy region hides from nine strata. Once per stratum, so the
-// update passes read one texel per pixel.
+// with its standard error and the colour of the change, over 3×3, 5×5 and 9×9 strata, and
+// shrunk level by level: the 9×9 ratio towards no change, the 5×5 towards the shrunk 9×9,
+// the 3×3 towards the shrunk 5×5, each keeping k²/(k² + shrink) of its departure when it
+// lies k standard errors away. A small pool keeps a light's moving edge sharp but is
+// noisy; shrunk towards no change, its noise was kept out but so was much of a real
+// change, and the models lagged where the light moved fastest (mri/point-light). Shrunk
+// towards the wider pools instead, a change the neighbourhood shows clearly is kept and
+// only the local departure from it must prove itself. Once per stratum, so the update
+// passes read one texel per pixel.
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D gradient_new;   // rgb re-traced
 layout(binding = 1, rgba32f) uniform readonly image2D gradient_old;   // rgb last frame's
-layout(binding = 2, rgba32f) uniform writeonly image2D gradient_ratio;   // rgb colour, a log ratio
-layout(binding = 3, rgba32f) uniform writeonly image2D gradient_spread;  // x variance, y measured
+layout(binding = 2, rgba32f) uniform writeonly image2D gradient_ratio;  // rgb colour, a log ratio
 
 layout(push_constant) uniform WrlsGradientPoolPush {
-    uint width;   // strata across
-    uint height;  // strata down
+    uint width;    // strata across
+    uint height;   // strata down
+    float shrink;  // squared standard errors of a departure that halve it
     uint pad0;
-    uint pad1;
 } pc;
+
+// The widest pool's radius in strata (9×9).
+const int WIDE = 4;
 
 struct Pooled {
     float L;       // log luminance ratio
@@ -73,22 +79,38 @@ Pooled pooled(Sums s) {
     return o;
 }
 
+// `L`, `var_l`, shrunk towards `prior`; `kept` the share of the departure kept.
+float shrunk(float L, float var_l, float prior, out float kept) {
+    float d = L - prior;
+    kept = d * d / (d * d + pc.shrink * var_l + 1e-12);
+    return prior + kept * d;
+}
+
 void main() {
     ivec2 s = ivec2(gl_GlobalInvocationID.xy);
     ivec2 strata = ivec2(pc.width, pc.height);
     if (s.x >= strata.x || s.y >= strata.y) return;
-    // One pass over the 5×5 strata sums both squares (each stratum loaded once).
-    Sums near = Sums(vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0, 0.0), wide = near;
-    for (int dy = -2; dy <= 2; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
+    // One pass over the 9×9 strata sums all three squares (each stratum loaded once).
+    Sums pools[3];
+    for (int i = 0; i < 3; ++i) pools[i] = Sums(vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0, 0.0);
+    for (int dy = -WIDE; dy <= WIDE; ++dy) {
+        for (int dx = -WIDE; dx <= WIDE; ++dx) {
             ivec2 k = clamp(s + ivec2(dx, dy), ivec2(0), strata - 1);
             vec3 a = imageLoad(gradient_new, k).rgb, b = imageLoad(gradient_old, k).rgb;
-            wide = add(wide, a, b);
-            if (max(abs(dx), abs(dy)) <= 1) near = add(near, a, b);
+            int r = max(abs(dx), abs(dy));
+            pools[2] = add(pools[2], a, b);
+            if (r <= 2) pools[1] = add(pools[1], a, b);
+            if (r <= 1) pools[0] = add(pools[0], a, b);
         }
     }
-    Pooled p = pooled(near), q = pooled(wide);
-    if (q.measured && (!p.measured || q.L * q.L * p.var_l > p.L * p.L * q.var_l)) p = q;
-    imageStore(gradient_ratio, s, vec4(p.colour, p.L));
-    imageStore(gradient_spread, s, vec4(p.var_l, p.measured ? 1.0 : 0.0, 0.0, 0.0));
+    // From the widest to the nearest; nothing measured: log ratio 0, colour 1 (no change).
+    float L = 0.0, kept;
+    vec3 colour = vec3(1.0);
+    for (int i = 2; i >= 0; --i) {
+        Pooled p = pooled(pools[i]);
+        if (!p.measured) continue;
+        L = shrunk(p.L, p.var_l, L, kept);
+        colour = mix(colour, p.colour, kept);
+    }
+    imageStore(gradient_ratio, s, vec4(colour, L));
 }

@@ -40,6 +40,8 @@ layout(binding = 25, rgba32f) uniform writeonly image2D prediction;
 // wrls_drift.comp pools into last frame's drift estimate read back here.
 layout(binding = 26, rgba32f) uniform writeonly image2D residual;
 layout(binding = 27) uniform sampler2D drift_prev;
+layout(binding = 28) uniform sampler2D residual_prev;            // last frame's `residual`
+layout(binding = 29, rgba32f) uniform readonly image2D moments;  // x mean, y 2nd moment of luminance
 
 layout(push_constant) uniform WrlsUpdatePush {
     vec4 camera;          // xyz camera position
@@ -58,11 +60,11 @@ layout(push_constant) uniform WrlsUpdatePush {
     uint stratum;         // their stratum edge in pixels
     float lambda_min;     // forgetting factor at a sudden change
     float change_gain;    // relative change at which the history is forgotten: 1/gain
-    float shrink;         // squared standard errors of the gradient ratio that halve it
     float drift_z;        // pooled residual, in standard errors, that starts to count
+    float lag_alpha;      // weight of this frame's residual in the running one (1: its own)
+    float spp;            // samples per pixel of the noisy frame
     float pad0;
     float pad1;
-    float pad2;
 } pc;
 
 const float P_MAX = 1e6;
@@ -96,8 +98,9 @@ void main() {
     float noise_level = -1.0;  // running mean of the squared a-priori residual
     float streak = 0.0;        // consecutive frames far above the noise level
     vec4 constant = vec4(0.0, 0.0, 0.0, pc.delta);
+    vec4 lag_prev = vec4(0.0, 0.0, 0.0, -1.0);  // the running residual: none
     vec3 errors = vec3(-1.0, -1.0, 0.0);  // a-priori errors (const, feature), const streak
-    SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum, pc.shrink);
+    SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum);
     // Forgetting in proportion to the measured change: a still scene keeps λ, a sudden
     // change falls to λ_min (what the scaling below did not explain is learned anew).
     float lambda = mix(pc.lambda_min, pc.lambda, 1.0 - min(1.0, pc.change_gain * sc.change));
@@ -135,6 +138,12 @@ void main() {
             vec3 d = significant_drift(history_fetch(drift_prev, r), pc.drift_z);
             for (int c = 0; c < 3; ++c) beta[c].x += d[c];
             constant.rgb += d;
+            if (pc.lag_alpha < 1.0) {
+                // As in wrls_constant.comp: the running residual follows the change, and
+                // what was corrected is no longer a lag.
+                lag_prev = history_fetch(residual_prev, r);
+                lag_prev.rgb = lag_prev.rgb * sc.ratio - d;
+            }
         }
     } else {
         // A new surface: start the models over.
@@ -227,11 +236,13 @@ void main() {
     vec4 Px = P * x;
     vec4 q = Px / (lambda / w + dot(x, Px));
     for (int c = 0; c < 3; ++c) beta[c] += q * e[c];
-    // The a-posteriori residual (what this frame's update left unexplained) and its
+    // The running a-posteriori residual (what the updates left unexplained) and its
     // variance, for the pooled lag test; fresh models have none.
     float keep = 1.0 - dot(x, q);
-    imageStore(residual, p, lag_residual(r.valid && !fresh, keep * e,
-                                         max(noise_level, 0.0) / 3.0 * keep * keep));
+    float variance = sample_variance(imageLoad(moments, p).xy, pc.spp) +
+                     max(noise_level, 0.0) / 3.0 * dot(x, Px);
+    imageStore(residual, p, running_lag(r.valid && !fresh, lag_prev, keep * e,
+                                        keep * keep * variance, pc.lag_alpha));
     P = (P - outerProduct(q, Px)) / lambda;
     // fp32 hygiene: keep P symmetric with a positive, bounded diagonal (wind-up guard
     // for predictors that stop exciting some direction on long static runs).

@@ -7,23 +7,21 @@
 #include "common.glsl"
 
 // Temporal gradients pooled per S×S stratum of last frame's image (wrls_gradient.comp
-// re-traced one pixel per stratum, wrls_gradient_pool.comp summed 3×3 or 5×5 strata): the log
-// luminance ratio of this frame's radiance to last frame's with its variance, and the
-// colour of the change.
-layout(binding = 23, rgba32f) uniform readonly image2D gradient_ratio;   // rgb colour, a log ratio
-layout(binding = 24, rgba32f) uniform readonly image2D gradient_spread;  // x its variance, y measured
+// re-traced one pixel per stratum, wrls_gradient_pool.comp pooled and shrunk 3×3, 5×5 and
+// 9×9 strata): the log luminance ratio of this frame's radiance to last frame's, and the
+// colour of the change (0 and 1 where nothing was measured).
+layout(binding = 23, rgba32f) uniform readonly image2D gradient_ratio;  // rgb colour, a log ratio
 
 // What the temporal gradients say about the scene around last frame's texture coordinate
 // `uv`: per channel, the ratio of this frame's radiance to last frame's (the same paths
 // traced in both scenes), and the relative change of luminance. No measurement
-// (`measured` false): ratio 1, change 0. `shrink`: squared standard errors of the log
-// ratio that halve its departure from 1.
+// (`measured` false): ratio 1, change 0.
 struct SceneChange {
     vec3 ratio;
     float change;
 };
 
-SceneChange scene_change(vec2 uv, ivec2 size, bool measured, uint stratum, float shrink) {
+SceneChange scene_change(vec2 uv, ivec2 size, bool measured, uint stratum) {
     SceneChange sc;
     sc.ratio = vec3(1.0);
     sc.change = 0.0;
@@ -31,15 +29,9 @@ SceneChange scene_change(vec2 uv, ivec2 size, bool measured, uint stratum, float
     ivec2 k = clamp(ivec2(floor(uv * vec2(size) / float(stratum))), ivec2(0),
                     imageSize(gradient_ratio) - 1);
     vec4 pooled = imageLoad(gradient_ratio, k);
-    vec2 spread = imageLoad(gradient_spread, k).xy;
-    if (spread.y <= 0.0) return sc;
-    // A ratio within its noise of 1 is shrunk towards 1, so noise is not mistaken for
-    // change and the history is kept.
-    float L = pooled.a, var_l = spread.x;
-    float keep = L * L / (L * L + shrink * var_l + 1e-12);
-    float Ra = exp(keep * L);
+    float Ra = exp(pooled.a);
     sc.change = abs(Ra - 1.0) / max(Ra, 1.0);
-    sc.ratio = mix(vec3(1.0), pooled.rgb, keep) * Ra;
+    sc.ratio = pooled.rgb * Ra;
     return sc;
 }
 
@@ -62,6 +54,29 @@ vec3 significant_drift(vec4 drift, float z) {
 vec4 lag_residual(bool has_history, vec3 residual, float variance) {
     vec4 r = vec4(residual, variance);
     return has_history && all_finite(r.rgb) && all_finite(r.aaa) ? r : vec4(0.0, 0.0, 0.0, -1.0);
+}
+
+// The running residual the pooled lag test averages (wrls_drift.comp): this frame's
+// a-posteriori residual `residual` (variance `variance`) blended with last frame's running
+// one `prev` (reprojected, already scaled by the measured change and with what this
+// frame's update corrected taken off; a < 0 or not finite: none) by `alpha`. A lag
+// persists from frame to frame while the noise does not, so the running residual shows a
+// lag too small for one frame's neighbourhood: with alpha 0.5 its variance is a third of
+// one frame's.
+vec4 running_lag(bool has_history, vec4 prev, vec3 residual, float variance, float alpha) {
+    if (prev.a > 0.0 && all_finite(prev.rgb) && !isinf(prev.a)) {
+        float b = 1.0 - alpha;
+        residual = b * prev.rgb + alpha * residual;
+        variance = b * b * prev.a + alpha * alpha * variance;
+    }
+    return lag_residual(has_history, residual, variance);
+}
+
+// The variance of this frame's pixel mean from its samples' luminance moments (x mean,
+// y second moment over `spp` samples): the sampling noise alone, which a change does not
+// inflate as it inflates the running residual.
+float sample_variance(vec2 moments, float spp) {
+    return max(moments.y - moments.x * moments.x, 0.0) / max(spp - 1.0, 1.0);
 }
 
 #endif

@@ -36,10 +36,10 @@ pub(super) struct Gradients {
     /// Re-traced radiance (this frame's scene) and last frame's, per stratum.
     pub new: ImageHandle,
     pub old: ImageHandle,
-    /// Pooled over 3×3 or 5×5 strata ([`super::gradient_pool`]): rgb the colour of the change, a
-    /// the log luminance ratio; x its variance, y 1 where measured.
+    /// Pooled and shrunk over 3×3, 5×5 and 9×9 strata ([`super::gradient_pool`]): rgb
+    /// the colour of the change, a the log luminance ratio (0 and 1 where nothing was
+    /// measured).
     pub ratio: ImageHandle,
-    pub spread: ImageHandle,
     /// Measured this frame (false: the scene did not change, or nothing to compare).
     pub valid: bool,
 }
@@ -68,7 +68,6 @@ impl Wrls {
             new: graph.image(ctx, &format!("{n}.gradient_new"), desc)?,
             old: graph.image(ctx, &format!("{n}.gradient_old"), desc)?,
             ratio: graph.image(ctx, &format!("{n}.gradient_ratio"), desc)?,
-            spread: graph.image(ctx, &format!("{n}.gradient_spread"), desc)?,
             valid: false,
         };
         let (Some(pipeline), Some(retrace)) = (&self.gradients, input.retrace) else {

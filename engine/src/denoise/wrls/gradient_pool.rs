@@ -1,7 +1,7 @@
 //! `<name>.gradient_pool` (wrls_gradient_pool.comp): ours' temporal gradients pooled over
-//! 3×3 or 5×5 strata (whichever shows the change more clearly), once per stratum, into
-//! the log luminance ratio, its variance and the colour of the change that the update
-//! passes read (one texel per pixel).
+//! 3×3, 5×5 and 9×9 strata and shrunk level by level (each towards the wider one's,
+//! the widest towards no change), once per stratum, into the log luminance ratio and the
+//! colour of the change that the update passes read (one texel per pixel).
 
 use super::gradient::Gradients;
 use super::Wrls;
@@ -13,8 +13,8 @@ gpu_block! {
     pub struct WrlsGradientPoolPush {
         pub width: u32,
         pub height: u32,
+        pub shrink: f32,
         pub pad0: u32,
-        pub pad1: u32,
     }
 }
 
@@ -27,8 +27,8 @@ impl Wrls {
         let push = WrlsGradientPoolPush {
             width: g.strata[0],
             height: g.strata[1],
+            shrink: self.params.shrink,
             pad0: 0,
-            pad1: 0,
         };
         let grid = [g.strata[0], g.strata[1], 1];
         frame.add_compute(
@@ -39,8 +39,7 @@ impl Wrls {
             |b| {
                 b.read("gradient_new", g.new)
                     .read("gradient_old", g.old)
-                    .write("gradient_ratio", g.ratio)
-                    .write("gradient_spread", g.spread);
+                    .write("gradient_ratio", g.ratio);
             },
         );
     }

@@ -5,7 +5,7 @@
 //! - `<name>.gradient` ([`gradient`], `wrls_gradient.comp`): temporal gradients, when the
 //!   scene changed: last frame's samples re-traced in this frame's scene;
 //! - `<name>.gradient_pool` ([`gradient_pool`], `wrls_gradient_pool.comp`): the gradients
-//!   pooled over 3×3 or 5×5 strata, once per stratum;
+//!   pooled over 3×3, 5×5 and 9×9 strata and shrunk, once per stratum;
 //! - `<name>.update` ([`update`]): the per-pixel models reprojected, adjusted for the
 //!   measured change and updated by weighted RLS: `wrls_constant.comp` for ours' constant
 //!   model p = [1] (two state images), `wrls_update.comp` for the paper's p = [1, z]
@@ -68,8 +68,9 @@ pub struct WrlsParams {
     /// frame against the pixel's noise, as a steady-state Kalman gain); the paper's
     /// models (`ours-feature`) by gain × relative change.
     pub change_gain: f32,
-    /// Shrinkage of the gradient ratio towards 1: a ratio `k` standard errors from 1
-    /// keeps k²/(k² + shrink) of its departure.
+    /// Shrinkage of the pooled gradient ratios, each towards the next wider pool's (the
+    /// widest towards 1): a ratio `k` standard errors away keeps k²/(k² + shrink) of its
+    /// departure.
     pub shrink: f32,
     /// Pooled residual, in standard errors of its mean, from which the pooled lag test
     /// starts to correct the models (fully at twice this).
@@ -81,6 +82,9 @@ pub struct WrlsParams {
     /// Radius of the pooled lag test's square neighbourhood, in pixels (at most 8: the
     /// shader unrolls its window).
     pub drift_radius: u32,
+    /// Weight of this frame's a-posteriori residual in the running residual the pooled
+    /// lag test averages (1: this frame's alone).
+    pub lag_alpha: f32,
 
     /// À-trous iterations of the spatial filter (steps 1, 2, 4, …).
     pub atrous_iterations: u32,
@@ -107,10 +111,11 @@ impl Default for WrlsParams {
             lambda_min: 0.1,
             change_gain: 4.0,
             shrink: 4.0,
-            drift_z: 3.0,
+            drift_z: 1.5,
             drift_forget: 0.5,
             drift_forget_z: 2.0,
             drift_radius: 2,
+            lag_alpha: 0.5,
             atrous_iterations: 3,
             atrous_keep: 0.05,
         }
@@ -133,6 +138,7 @@ const OVERRIDABLE: &[(&str, fn(&mut WrlsParams, f32))] = &[
     ("drift_radius", |p, v| p.drift_radius = (v as u32).min(8)),
     ("drift_forget", |p, v| p.drift_forget = v),
     ("drift_forget_z", |p, v| p.drift_forget_z = v),
+    ("lag_alpha", |p, v| p.lag_alpha = v.clamp(0.01, 1.0)),
     ("stratum", |p, v| p.stratum = v as u32),
     ("atrous_iterations", |p, v| p.atrous_iterations = v as u32),
     ("atrous_keep", |p, v| p.atrous_keep = v),
@@ -339,7 +345,7 @@ impl Denoiser for Wrls {
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
         let lag = spatial::LagImages {
             prediction: graph.image(ctx, &format!("{n}.prediction"), desc)?,
-            residual: graph.image(ctx, &format!("{n}.residual"), desc)?,
+            residual: graph.history(ctx, &format!("{n}.residual"), desc)?,
             drift: graph.history(ctx, &format!("{n}.drift"), desc)?,
         };
         let gradients = self.add_gradients(ctx, graph, frame, input)?;

@@ -56,7 +56,7 @@ pub(super) struct LagImages {
     /// Each pixel's prediction (rgb) and its variance (a).
     pub prediction: ImageHandle,
     /// Each pixel's a-posteriori residual (rgb) and its variance (a, < 0 where none).
-    pub residual: ImageHandle,
+    pub residual: History,
     /// The pooled residual: rgb mean, a its variance.
     pub drift: History,
 }
@@ -75,7 +75,7 @@ impl Wrls {
         };
         let name = format!("{}.drift", self.name);
         frame.add_compute(name, pipeline, push, size, |b| {
-            b.read("residual", lag.residual)
+            b.read("residual", lag.residual.cur)
                 .write("drift", lag.drift.cur);
         });
     }

@@ -32,12 +32,12 @@ gpu_block! {
         pub stratum: u32,
         pub lambda_min: f32,
         pub change_gain: f32,
-        pub shrink: f32,
         pub drift_z: f32,
         pub spp: f32,
         pub lambda_moving: f32,
         pub drift_forget: f32,
         pub drift_forget_z: f32,
+        pub lag_alpha: f32,
         pub pad0: f32,
     }
 }
@@ -61,11 +61,21 @@ gpu_block! {
         pub stratum: u32,
         pub lambda_min: f32,
         pub change_gain: f32,
-        pub shrink: f32,
         pub drift_z: f32,
+        pub lag_alpha: f32,
+        pub spp: f32,
         pub pad0: f32,
         pub pad1: f32,
-        pub pad2: f32,
+    }
+}
+
+/// The weight of this frame's residual in the running one the pooled lag test averages:
+/// its own where last frame's running residual does not exist.
+fn lag_alpha(p: super::WrlsParams, lag: &LagImages) -> f32 {
+    if lag.residual.valid {
+        p.lag_alpha
+    } else {
+        1.0
     }
 }
 
@@ -128,12 +138,12 @@ impl Wrls {
             stratum: p.stratum,
             lambda_min: p.lambda_min,
             change_gain: p.change_gain,
-            shrink: p.shrink,
             drift_z: p.drift_z,
             spp: input.spp as f32,
             lambda_moving: p.lambda_moving,
             drift_forget: p.drift_forget,
             drift_forget_z: p.drift_forget_z,
+            lag_alpha: lag_alpha(p, lag),
             pad0: 0.0,
         };
         let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
@@ -142,10 +152,10 @@ impl Wrls {
             b.read("noisy", noisy)
                 .read("moments", moments)
                 .read("gradient_ratio", g.ratio)
-                .read("gradient_spread", g.spread)
                 .sampled("drift_prev", lag.drift.prev)
                 .write("prediction", lag.prediction)
-                .write("residual", lag.residual)
+                .sampled("residual_prev", lag.residual.prev)
+                .write("residual", lag.residual.cur)
                 .sampled("model_prev", model.prev)
                 .write("model_cur", model.cur)
                 .sampled("stats_prev", stats.prev)
@@ -206,21 +216,22 @@ impl Wrls {
             stratum: p.stratum,
             lambda_min: p.lambda_min,
             change_gain: p.change_gain,
-            shrink: p.shrink,
             drift_z: p.drift_z,
+            lag_alpha: lag_alpha(p, lag),
+            spp: input.spp as f32,
             pad0: 0.0,
             pad1: 0.0,
-            pad2: 0.0,
         };
-        let (noisy, g, lag) = (input.noisy, *gradients, *lag);
+        let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
         frame.add_compute(format!("{n}.update"), pipeline, push, size, |b| {
             reproj.bind(b);
             b.read("noisy", noisy)
+                .read("moments", moments)
                 .read("gradient_ratio", g.ratio)
-                .read("gradient_spread", g.spread)
                 .sampled("drift_prev", lag.drift.prev)
+                .sampled("residual_prev", lag.residual.prev)
                 .write("prediction", lag.prediction)
-                .write("residual", lag.residual);
+                .write("residual", lag.residual.cur);
             let state: [(&'static str, &'static str, History); 9] = [
                 ("z_prev", "z_cur", m.z),
                 ("constant_prev", "constant_cur", m.constant),
