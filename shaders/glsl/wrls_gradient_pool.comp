@@ -55,6 +55,11 @@ Sums add(Sums s, vec3 a, vec3 b) {
     return s;
 }
 
+Sums merge(Sums s, Sums t) {
+    return Sums(s.new_rgb + t.new_rgb, s.old_rgb + t.old_rgb, s.nn + t.nn, s.no + t.no,
+                s.oo + t.oo, s.n + t.n);
+}
+
 Pooled pooled(Sums s) {
     Pooled o;
     o.L = 0.0;
@@ -90,19 +95,30 @@ void main() {
     ivec2 s = ivec2(gl_GlobalInvocationID.xy);
     ivec2 strata = ivec2(pc.width, pc.height);
     if (s.x >= strata.x || s.y >= strata.y) return;
-    // One pass over the 9×9 strata sums all three squares (each stratum loaded once).
-    Sums pools[3];
-    for (int i = 0; i < 3; ++i) pools[i] = Sums(vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0, 0.0);
+    // One pass over the 9×9 strata, each stratum loaded once and added to one ring (the
+    // 3×3, the rest of the 5×5, the rest of the 9×9); the squares are the rings' sums.
+    // (Adding each stratum to every square it lies in instead cost 3.4× as much on
+    // lavapipe: 2.5 against 0.7 ms at 256².)
+    Sums rings[3];
+    for (int i = 0; i < 3; ++i) rings[i] = Sums(vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0, 0.0);
     for (int dy = -WIDE; dy <= WIDE; ++dy) {
         for (int dx = -WIDE; dx <= WIDE; ++dx) {
             ivec2 k = clamp(s + ivec2(dx, dy), ivec2(0), strata - 1);
             vec3 a = imageLoad(gradient_new, k).rgb, b = imageLoad(gradient_old, k).rgb;
             int r = max(abs(dx), abs(dy));
-            pools[2] = add(pools[2], a, b);
-            if (r <= 2) pools[1] = add(pools[1], a, b);
-            if (r <= 1) pools[0] = add(pools[0], a, b);
+            if (r <= 1) {
+                rings[0] = add(rings[0], a, b);
+            } else if (r <= 2) {
+                rings[1] = add(rings[1], a, b);
+            } else {
+                rings[2] = add(rings[2], a, b);
+            }
         }
     }
+    Sums pools[3];
+    pools[0] = rings[0];
+    pools[1] = merge(pools[0], rings[1]);
+    pools[2] = merge(pools[1], rings[2]);
     // From the widest to the nearest; nothing measured: log ratio 0, colour 1 (no change).
     float L = 0.0, kept;
     vec3 colour = vec3(1.0);
