@@ -101,10 +101,7 @@ void main() {
             vec3 correction = significant_drift(drift, pc.drift_z);
             beta += correction;
             if (pc.lag_alpha < 1.0) {
-                // The running residual follows the change, and what was corrected is no
-                // longer a lag.
-                lag_prev = history_fetch(residual_prev, r);
-                lag_prev.rgb = lag_prev.rgb * sc.ratio - correction;
+                lag_prev = carried_lag(history_fetch(residual_prev, r), sc.ratio, correction);
             }
             // A lag the neighbourhood shares is a change the gradients missed: forget in
             // proportion too, from a lower significance than the correction needs.

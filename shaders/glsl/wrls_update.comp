@@ -139,10 +139,7 @@ void main() {
             for (int c = 0; c < 3; ++c) beta[c].x += d[c];
             constant.rgb += d;
             if (pc.lag_alpha < 1.0) {
-                // As in wrls_constant.comp: the running residual follows the change, and
-                // what was corrected is no longer a lag.
-                lag_prev = history_fetch(residual_prev, r);
-                lag_prev.rgb = lag_prev.rgb * sc.ratio - d;
+                lag_prev = carried_lag(history_fetch(residual_prev, r), sc.ratio, d);
             }
         }
     } else {

@@ -56,10 +56,16 @@ vec4 lag_residual(bool has_history, vec3 residual, float variance) {
     return has_history && all_finite(r.rgb) && all_finite(r.aaa) ? r : vec4(0.0, 0.0, 0.0, -1.0);
 }
 
+// Last frame's running residual `prev` (reprojected) carried into this frame: it follows
+// the measured change `ratio`, and the `correction` this frame's update added to the
+// models (significant_drift) is no longer a lag.
+vec4 carried_lag(vec4 prev, vec3 ratio, vec3 correction) {
+    return vec4(prev.rgb * ratio - correction, prev.a);
+}
+
 // The running residual the pooled lag test averages (wrls_drift.comp): this frame's
 // a-posteriori residual `residual` (variance `variance`) blended with last frame's running
-// one `prev` (reprojected, already scaled by the measured change and with what this
-// frame's update corrected taken off; a < 0 or not finite: none) by `alpha`. A lag
+// one `prev` (carried_lag; a < 0 or not finite: none) by `alpha`. A lag
 // persists from frame to frame while the noise does not, so the running residual shows a
 // lag too small for one frame's neighbourhood: with alpha 0.5 its variance is a third of
 // one frame's.
