@@ -34,6 +34,12 @@ pub fn rae_manifest(net: &str) -> PathBuf {
     assets_dir().join("rae").join(format!("{net}.json"))
 }
 
+/// The folder of a shipped scene set (`assets/scenes/<set>/`, one scene file each):
+/// `validation` and `static`, the frozen sets `dvr eval --scene <set>` runs.
+pub fn scene_set(set: &str) -> PathBuf {
+    assets_dir().join("scenes").join(set)
+}
+
 /// The folder of the shipped RAE networks.
 pub fn rae_dir() -> PathBuf {
     assets_dir().join("rae")

@@ -1,13 +1,39 @@
 //! Which scenes an eval runs, the folder each one's files go to, and where a scene's
 //! sudden change happens.
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use dvr_engine::renderer::FrameInputs;
 use dvr_engine::scene::Scene;
 
 /// Animations that make methods fail on purpose; `--scene stress` runs these and
 /// `--scene suite` leaves them out.
 pub const STRESS_ANIMATIONS: [&str; 3] = ["tf-jump", "light-jump", "fast-orbit"];
+
+/// Scene sets shipped as folders of scene files (`assets/scenes/<set>/*.toml`): the
+/// frozen validation set (48 frames of continuous change each, never tuned on) and the
+/// static views.
+pub const FILE_SETS: [&str; 2] = ["validation", "static"];
+
+/// The scene files of a shipped set, sorted by file name.
+fn set_files(set: &str) -> Result<Vec<String>> {
+    let dir = dvr_engine::assets::scene_set(set);
+    let entries = std::fs::read_dir(&dir)
+        .with_context(|| format!("reading the scene set {set:?} in {}", dir.display()))?;
+    let mut files = Vec::new();
+    for entry in entries {
+        let path = entry
+            .with_context(|| format!("reading {}", dir.display()))?
+            .path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            files.push(path.to_string_lossy().into_owned());
+        }
+    }
+    files.sort();
+    if files.is_empty() {
+        bail!("the scene set {set:?} has no scene files in {}", dir.display());
+    }
+    Ok(files)
+}
 
 /// Animations with one sudden change, after which frames to recover are measured.
 pub const SUDDEN_ANIMATIONS: [&str; 2] = ["tf-jump", "light-jump"];
@@ -25,6 +51,7 @@ pub fn select(spec: &str) -> Result<Vec<String>> {
         let add: Vec<String> = match item {
             "suite" => builtin.iter().filter(|n| !is_stress(n)).cloned().collect(),
             "stress" => builtin.iter().filter(|n| is_stress(n)).cloned().collect(),
+            set if FILE_SETS.contains(&set) => set_files(set)?,
             other => vec![other.to_string()],
         };
         for n in add {
@@ -120,6 +147,23 @@ mod tests {
             .all(|n| !STRESS_ANIMATIONS.contains(&animation(n))));
         assert!(stress.contains(&"cloud/tf-jump".to_string()));
         assert!(suite.contains(&"cloud/orbit".to_string()));
+    }
+
+    #[test]
+    fn the_file_sets_are_scene_files_that_load() {
+        let validation = select("validation").unwrap();
+        assert!(validation.len() >= 8, "{validation:?}");
+        let statics = select("static").unwrap();
+        assert!(statics.len() >= 2, "{statics:?}");
+        for file in validation.iter().chain(&statics) {
+            let scene = Scene::load(file).unwrap_or_else(|e| panic!("{file}: {e}"));
+            let set = if validation.contains(file) { "val/" } else { "static/" };
+            assert!(scene.name.starts_with(set), "{file}: named {:?}", scene.name);
+            assert!(scene.frames >= 48, "{file}: {} frames", scene.frames);
+        }
+        // Selected twice (or beside one of its files), each file runs once.
+        let both = select("validation,validation").unwrap();
+        assert_eq!(both, validation);
     }
 
     #[test]
