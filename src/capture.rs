@@ -53,6 +53,7 @@ pub fn capture(
     let request = FrameRequest {
         readback: true,
         reset: false,
+        aux: false,
     };
     let mut progress = Progress::new(f64::from(setup.frames));
     let mut rate = FrameRate::default();

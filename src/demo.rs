@@ -134,6 +134,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
             video,
             video_fps: video::DEFAULT_FPS,
         },
+        aux: false,
         note: Some(note),
     })?;
     Ok(())

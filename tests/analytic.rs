@@ -90,6 +90,7 @@ fn identical_seeds_give_identical_images() {
             &dvr_engine::renderer::FrameRequest {
                 readback: true,
                 reset: false,
+                aux: false,
             },
         )
         .expect("frame");

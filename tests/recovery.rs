@@ -54,6 +54,7 @@ fn recovery(scene_name: &str, method: &str) -> (usize, Option<usize>, Vec<f64>, 
     let request = FrameRequest {
         readback: true,
         reset: false,
+        aux: false,
     };
     for f in 0..FRAMES {
         if let Some(done) = r.frame(&setup.frame_inputs(f), &request).expect("frame") {

@@ -28,6 +28,7 @@ fn every_denoiser_stays_finite_and_bounded_on_every_built_in_animation() {
         let request = FrameRequest {
             readback: true,
             reset: false,
+            aux: false,
         };
         let mut results = Vec::new();
         for f in 0..8 {
@@ -82,6 +83,7 @@ fn ours_on_a_static_scene_beats_32_spp_after_64_frames() {
         let request = FrameRequest {
             readback: true,
             reset: false,
+            aux: false,
         };
         for _ in 0..64 {
             r.frame(&inputs, &request).expect("frame");

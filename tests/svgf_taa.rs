@@ -563,6 +563,7 @@ fn svgf_and_taa_stay_finite_and_bounded_for_50_frames() {
     let request = FrameRequest {
         readback: true,
         reset: false,
+        aux: false,
     };
     let mut results = Vec::new();
     for k in 0..60 {

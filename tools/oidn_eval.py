@@ -1,16 +1,21 @@
 #!/usr/bin/env python3
-"""Add Intel Open Image Denoise (OIDN) to a `dvr eval` folder, as method `oidn`.
+"""Add Intel Open Image Denoise (OIDN) to a `dvr eval` folder, as methods `oidn` and `oidn-aux`.
 
 Denoises the noisy input frames an eval keeps (`DIR/<scene>/none/NNNN.exr`, the
 `none` method, i.e. the raw path-traced frames) with OIDN's RT filter, scores them
 against the eval's references with the same metrics as `dvr eval`, writes
-`DIR/<scene>/oidn/NNNN.png`, and appends `oidn` rows to `DIR/metrics.csv` and
-`DIR/summary.csv` (replacing any from an earlier run of this script).
+`DIR/<scene>/<method>/NNNN.png`, and appends rows to `DIR/metrics.csv` and
+`DIR/summary.csv` (replacing any from an earlier run of this script):
 
-COLOUR ONLY: the eval does not write albedo/normal feature buffers to disk yet, so
-OIDN runs on the HDR colour alone (`hdr=True`, no auxiliary images). With albedo and
-normals it would do better on fine detail; these numbers are a lower bound for OIDN.
-It denoises every frame independently (no temporal information).
+  * `oidn`: the HDR colour alone (`hdr=True`, no auxiliary images);
+  * `oidn-aux`: colour with OIDN's albedo and normal auxiliary images, for the scenes
+    whose eval ran with `--aux` (`DIR/<scene>/aux/NNNN_albedo.exr`, `NNNN_normal.exr`:
+    the TF albedo and gradient normal composited along each pixel's ray with the
+    weights of its first scattering event, shaders/glsl/aux_features.comp). They are
+    deterministic (no noise), so OIDN takes them as clean (`clean_aux=True`, what its
+    documentation recommends for noise-free guides) instead of prefiltering them.
+
+Both denoise every frame independently (no temporal information).
 
 Metrics, exactly as `dvr eval` computes them (engine/src/metrics/):
   * Tone map (engine/src/metrics/tonemap.rs), per channel c, exposure e = 1:
@@ -56,6 +61,7 @@ except ImportError:
     sys.exit("oidn_eval: numpy is missing: pip install pyoidn numpy OpenEXR pillow flip-evaluator")
 
 METHOD = "oidn"
+METHOD_AUX = "oidn-aux"
 PSNR_CAP = 100.0
 RECOVERY_TOLERANCE_DB = 1.0
 RECOVERY_BASELINE_FRAMES = 5
@@ -249,43 +255,56 @@ def main():
         print("oidn_eval --check: largest |python - dvr| on `none`: " + ", ".join(f"{k} {v:.2e}" for k, v in worst.items()))
 
     new_rows, new_summary = [], []
-    cpu_ms = []
+    cpu_ms = {METHOD: [], METHOD_AUX: []}
     for s in scenes:
         d = os.path.join(args.out, dir_name(s))
-        os.makedirs(os.path.join(d, METHOD), exist_ok=True)
-
-        def denoised(f):
-            noisy = np.ascontiguousarray(read_exr(os.path.join(d, "none", f"{f:04d}.exr")))
-            t0 = time.perf_counter()
-            out = pyoidn.denoise(noisy, hdr=True, quality=args.quality)
-            cpu_ms.append(1e3 * (time.perf_counter() - t0))
-            return np.asarray(out, dtype=np.float32)
-
-        scored = score_sequence(args.out, s, frames[s], denoised, flip)
-        for r in scored:
-            write_png(os.path.join(d, METHOD, f"{r['frame']:04d}.png"), r["display"])
-            new_rows.append(
-                [s, METHOD, str(r["frame"]), f"{r['psnr']:.4f}", f"{r['ssim']:.6f}", fmt(r["flip"], 6), fmt(r["temporal_error"], 6), ""]
-            )
-        mean = lambda xs: sum(xs) / len(xs) if xs else None
-        te = [r["temporal_error"] for r in scored if r["temporal_error"] is not None]
-        fl = [r["flip"] for r in scored if r["flip"] is not None]
-        event = events.get(s)
-        if event is None and any(s.endswith(a) for a in ("/tf-jump", "/light-jump")):
-            event = len(scored) // 2
-        rec = ""
-        if event is not None:
-            n = frames_to_recover([r["psnr"] for r in scored], event, RECOVERY_TOLERANCE_DB)
-            rec = "never" if n is None else str(n)
-        new_summary.append(
-            [s, METHOD, f"{mean([r['psnr'] for r in scored]):.4f}", f"{mean([r['ssim'] for r in scored]):.6f}", fmt(mean(fl), 6), fmt(mean(te), 6), "", rec]
+        aux_dir = os.path.join(d, "aux")
+        has_aux = all(
+            os.path.exists(os.path.join(aux_dir, f"{f:04d}_{kind}.exr")) for f in frames[s] for kind in ("albedo", "normal")
         )
-        print(f"{s:<24} oidn  PSNR {new_summary[-1][2]} dB  SSIM {new_summary[-1][3]}  FLIP {new_summary[-1][4]}  temporal {new_summary[-1][5]}  recover {rec}")
+        for method in [METHOD] + ([METHOD_AUX] if has_aux else []):
+            os.makedirs(os.path.join(d, method), exist_ok=True)
+
+            def denoised(f, method=method):
+                noisy = np.ascontiguousarray(read_exr(os.path.join(d, "none", f"{f:04d}.exr")))
+                aux = {}
+                if method == METHOD_AUX:
+                    aux = {
+                        "albedo": np.ascontiguousarray(np.clip(read_exr(os.path.join(aux_dir, f"{f:04d}_albedo.exr")), 0.0, 1.0)),
+                        "normal": np.ascontiguousarray(np.clip(read_exr(os.path.join(aux_dir, f"{f:04d}_normal.exr")), -1.0, 1.0)),
+                        "clean_aux": True,
+                    }
+                t0 = time.perf_counter()
+                out = pyoidn.denoise(noisy, hdr=True, quality=args.quality, **aux)
+                cpu_ms[method].append(1e3 * (time.perf_counter() - t0))
+                return np.asarray(out, dtype=np.float32)
+
+            scored = score_sequence(args.out, s, frames[s], denoised, flip)
+            for r in scored:
+                write_png(os.path.join(d, method, f"{r['frame']:04d}.png"), r["display"])
+                new_rows.append(
+                    [s, method, str(r["frame"]), f"{r['psnr']:.4f}", f"{r['ssim']:.6f}", fmt(r["flip"], 6), fmt(r["temporal_error"], 6), ""]
+                )
+            mean = lambda xs: sum(xs) / len(xs) if xs else None
+            te = [r["temporal_error"] for r in scored if r["temporal_error"] is not None]
+            fl = [r["flip"] for r in scored if r["flip"] is not None]
+            event = events.get(s)
+            if event is None and any(s.endswith(a) for a in ("/tf-jump", "/light-jump")):
+                event = len(scored) // 2
+            rec = ""
+            if event is not None:
+                n = frames_to_recover([r["psnr"] for r in scored], event, RECOVERY_TOLERANCE_DB)
+                rec = "never" if n is None else str(n)
+            new_summary.append(
+                [s, method, f"{mean([r['psnr'] for r in scored]):.4f}", f"{mean([r['ssim'] for r in scored]):.6f}", fmt(mean(fl), 6), fmt(mean(te), 6), "", rec]
+            )
+            r = new_summary[-1]
+            print(f"{s:<24} {method:<9} PSNR {r[2]} dB  SSIM {r[3]}  FLIP {r[4]}  temporal {r[5]}  recover {rec}")
 
     def rewrite(path, header, extra):
         with open(path, newline="") as fh:
             lines = list(csv.reader(fh))
-        kept = [l for l in lines[1:] if len(l) > 1 and l[1] != METHOD]
+        kept = [l for l in lines[1:] if len(l) > 1 and l[1] not in (METHOD, METHOD_AUX)]
         with open(path + ".partial", "w", newline="") as fh:
             wr = csv.writer(fh, lineterminator="\n")
             fh.write(header + "\n")
@@ -295,11 +314,11 @@ def main():
     rewrite(metrics_path, METRICS_HEADER, new_rows)
     if os.path.exists(summary_path):
         rewrite(summary_path, SUMMARY_HEADER, new_summary)
-    ms = sorted(cpu_ms)
-    print(
-        f"oidn_eval: {len(new_rows)} frames of {len(scenes)} scene(s), colour-only OIDN ({args.quality}), "
-        f"CPU {ms[len(ms) // 2]:.1f} ms/frame median; appended `{METHOD}` rows to {metrics_path}"
-    )
+    for method, times in cpu_ms.items():
+        if times:
+            ms = sorted(times)
+            print(f"oidn_eval: {method} ({args.quality}): {len(ms)} frames, CPU {ms[len(ms) // 2]:.1f} ms/frame median")
+    print(f"oidn_eval: {len(new_rows)} rows of {len(scenes)} scene(s) appended to {metrics_path}")
 
 
 if __name__ == "__main__":

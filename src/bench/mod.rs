@@ -181,6 +181,7 @@ fn run_eval<'a>(args: &'a BenchArgs, denoisers: &[String]) -> Result<EvalRecord<
             video: false,
             video_fps: crate::video::DEFAULT_FPS,
         },
+        aux: false,
         note: None,
     };
     eprintln!(

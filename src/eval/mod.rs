@@ -20,6 +20,7 @@
 //! DIR/<scene>/reference/NNNN.{exr,png}      + reference.json (the cache key)
 //! DIR/<scene>/<method>/NNNN.png, flip_NNNN.png   (+ NNNN.exr for `none`, the noisy input)
 //! DIR/<scene>/timings.json        per-frame, per-pass GPU timings
+//! DIR/<scene>/aux/NNNN_{albedo,normal}.exr  with --aux: guide images for OIDN
 //! ```
 //!
 //! One file per responsibility: [`scenes`] (which scenes, folder names, the event frame),
@@ -84,6 +85,11 @@ pub struct EvalArgs {
     pub render: crate::RenderArgs,
     #[command(flatten)]
     pub video: crate::video::VideoArgs,
+    /// Also write each frame's guide images for single-frame denoisers
+    /// (`<scene>/aux/NNNN_albedo.exr`, `NNNN_normal.exr`: the TF albedo and gradient
+    /// normal composited along the ray, what `tools/oidn_eval.py` gives OIDN).
+    #[arg(long)]
+    pub aux: bool,
     /// A paragraph shown at the top of the results page (what was run, and why).
     #[arg(long)]
     pub note: Option<String>,

@@ -15,6 +15,7 @@ use crate::SceneArgs;
 use anyhow::{Context, Result};
 use dvr_engine::gpu::timestamps::{PassOwner, PassTiming};
 use dvr_engine::image_io::{to_rgb, write_exr};
+use dvr_engine::passes::aux_features;
 use dvr_engine::metrics::Rgb32Image;
 use dvr_engine::renderer::{FrameRequest, FrameResult};
 use rayon::prelude::*;
@@ -24,6 +25,9 @@ use std::sync::Arc;
 /// The method whose frames are also kept as EXR: the noisy input, for external
 /// denoisers (`tools/oidn_eval.py`).
 pub const NOISY_METHOD: &str = "none";
+
+/// The folder of a scene's guide images (`--aux`): `NNNN_albedo.exr`, `NNNN_normal.exr`.
+pub const AUX_DIR: &str = "aux";
 
 /// One scene as planned before anything renders.
 pub struct PlannedScene {
@@ -251,8 +255,25 @@ struct FrameState<'a> {
 
 impl FrameState<'_> {
     /// Hands one finished frame (frames arrive in order) to the scoring jobs.
-    fn process(&mut self, done: FrameResult) -> Result<()> {
+    fn process(&mut self, mut done: FrameResult) -> Result<()> {
         let f = done.index as u32;
+        // The guide images (`--aux`) are written for external denoisers, not scored.
+        let (aux, methods) = std::mem::take(&mut done.images)
+            .into_iter()
+            .partition(|(name, _)| name == aux_features::ALBEDO || name == aux_features::NORMAL);
+        done.images = methods;
+        if !aux.is_empty() {
+            let dir = self.scene.dir.join(AUX_DIR);
+            let (w, h) = (self.setup.width(), self.setup.height());
+            self.jobs.spawn(move || {
+                for (name, pixels) in aux {
+                    let kind = name.trim_start_matches("aux.");
+                    let path = dir.join(format!("{}_{kind}.exr", frame_name(f)));
+                    write_exr(&path, &to_rgb(w, h, &pixels))?;
+                }
+                Ok(Vec::new())
+            })?;
+        }
         let reference = Arc::new(self.scene.references.load(f)?);
         let gpu_ms = done
             .images
@@ -359,7 +380,8 @@ pub fn evaluate_scene(
 
     let names: Vec<&str> = methods.iter().map(String::as_str).collect();
     let mut renderer = setup.renderer(&names)?;
-    for m in methods {
+    let aux_dir = args.aux.then_some(AUX_DIR);
+    for m in methods.iter().map(String::as_str).chain(aux_dir) {
         let dir = scene.dir.join(m);
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     }
@@ -374,6 +396,7 @@ pub fn evaluate_scene(
     let request = FrameRequest {
         readback: true,
         reset: false,
+        aux: args.aux,
     };
     let frame_units = f64::from(setup.settings.spp()) + methods.len() as f64;
     let status = |f: u32| {

@@ -115,6 +115,7 @@ impl Explorer {
         let request = FrameRequest {
             readback: readback_hdr,
             reset: false,
+            aux: false,
         };
         let result = renderer.frame_presented(&inputs, &request, Some(&target))?;
         if !gfx.swapchain.present(&gfx.ctx, &image)? {

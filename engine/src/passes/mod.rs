@@ -4,6 +4,7 @@
 //! variable each resource binds to.
 
 pub mod accumulate;
+pub mod aux_features;
 pub mod bandwidth;
 pub mod motion;
 pub mod path_trace;

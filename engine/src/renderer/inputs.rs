@@ -59,6 +59,13 @@ pub struct FrameRequest {
     pub readback: bool,
     /// Restart every history (a cut).
     pub reset: bool,
+    /// Also render the guide images of single-frame denoisers and read them back with the
+    /// methods' outputs (as [`aux_features::ALBEDO`] and [`aux_features::NORMAL`]; needs
+    /// `readback`).
+    ///
+    /// [`aux_features::ALBEDO`]: crate::passes::aux_features::ALBEDO
+    /// [`aux_features::NORMAL`]: crate::passes::aux_features::NORMAL
+    pub aux: bool,
 }
 
 /// Results of a completed frame.

@@ -25,6 +25,7 @@ use crate::passes::accumulate::Accumulate;
 use crate::passes::motion::Motion;
 use crate::passes::path_trace::{PathTrace, PathTraceFeatures};
 use crate::passes::present::Present;
+use crate::passes::aux_features::{self, AuxFeatures};
 use crate::passes::surface_features::SurfaceFeatures;
 use crate::passes::SceneBindings;
 use crate::scene::RenderSettings;
@@ -91,6 +92,8 @@ struct Passes {
     accumulate: Accumulate,
     /// Built on the first presented frame (offscreen renderers never need it).
     present: Option<Present>,
+    /// Built on the first frame that asks for the guide images (`FrameRequest::aux`).
+    aux: Option<AuxFeatures>,
 }
 
 pub struct Renderer {
@@ -144,6 +147,7 @@ impl Renderer {
             motion: Motion::new(&ctx)?,
             accumulate: Accumulate::new(&ctx)?,
             present: None,
+            aux: None,
         };
         let denoisers = create_methods(&ctx, &config, features, denoisers)?;
         let pool_info = vk::CommandPoolCreateInfo::default()
@@ -345,6 +349,9 @@ impl Renderer {
         if present.is_some() && self.passes.present.is_none() {
             self.passes.present = Some(Present::new(&self.ctx)?);
         }
+        if request.aux && self.passes.aux.is_none() {
+            self.passes.aux = Some(AuxFeatures::new(&self.ctx)?);
+        }
         let reset = request.reset || std::mem::take(&mut self.pending_reset);
         let changes = self.changes(inputs, reset);
         if reset {
@@ -426,8 +433,15 @@ impl Renderer {
             outputs.push((name.to_string(), out));
         }
 
+        // The guide images of single-frame denoisers, read back beside the methods.
+        let mut read = outputs.clone();
+        if let (true, Some(pass)) = (request.aux, &passes.aux) {
+            let (albedo, normal) = pass.add(ctx, graph, &mut frame, &scene, size)?;
+            read.push((aux_features::ALBEDO.to_string(), albedo));
+            read.push((aux_features::NORMAL.to_string(), normal));
+        }
         let readbacks = if request.readback {
-            add_readbacks(ctx, graph, &mut frame, slot, &outputs, size)?
+            add_readbacks(ctx, graph, &mut frame, slot, &read, size)?
         } else {
             Vec::new()
         };
