@@ -1,6 +1,7 @@
 //! Denoiser properties on synthetic input (static scene, exact control over the noisy
 //! frames): no NaN/Inf and bounded output over a long static run (P wind-up), wRLS's
-//! robustness to spikes compared with plain RLS, and convergence on a static input.
+//! robustness to spikes compared with plain RLS, convergence on a static input, and a
+//! sudden change followed within a few frames.
 
 mod common;
 
@@ -117,42 +118,9 @@ fn step_recovery(name: &str) -> usize {
 #[test]
 fn ours_follows_a_sudden_change_within_a_few_frames() {
     let ours = step_recovery("ours");
-    let fixed = step_recovery("ours-fixed-lambda");
+    let no_lag = step_recovery("ours-no-lag");
     let paper = step_recovery("wrls-paper");
-    println!("frames to within 5% after a 3× step: ours {ours}, fixed λ {fixed}, paper {paper}");
+    println!("frames to within 5% after a 3× step: ours {ours}, without the lag test {no_lag}, paper {paper}");
     assert!(ours <= 8, "ours took {ours} frames");
-    assert_validation_clean();
-}
-
-/// Mean absolute error of the output's mean over the last 20 frames of a slow ramp
-/// (mean 1 → 3 over 60 frames, after 40 static frames).
-fn ramp_lag(name: &str) -> f32 {
-    let mut h = Harness::new(name, W, H);
-    let n = (W * H) as usize;
-    for f in 0..40u64 {
-        h.step(&noisy_frame(n, 1.0, 0.5, 4000 + f));
-    }
-    let mut err = 0.0;
-    for k in 0..60u64 {
-        let mean = 1.0 + 2.0 * (k + 1) as f32 / 60.0;
-        let out = h.step(&noisy_frame(n, mean, 0.5 * mean, 5000 + k));
-        if k >= 40 {
-            let got = out.iter().map(|p| p[0]).sum::<f32>() / n as f32;
-            err += (got - mean).abs() / 20.0;
-        }
-    }
-    err
-}
-
-/// A gradual change with no scene to re-trace (so no temporal gradients): one pixel's
-/// residual stays within its 2-spp noise, so the paper's constant model averages the
-/// ramp in and lags; ours' pooled lag test sees the shared residual of the
-/// neighbourhood and follows it.
-#[test]
-fn ours_follows_a_slow_ramp_that_the_constant_model_lags() {
-    let ours = ramp_lag("ours");
-    let constant = ramp_lag("wrls-nf");
-    println!("mean error on a ramp: ours {ours:.4}, wrls-nf {constant:.4}");
-    assert!(ours * 2.0 < constant, "ours {ours} vs wrls-nf {constant}");
     assert_validation_clean();
 }

@@ -1,24 +1,16 @@
 #version 460
-// ours' temporal pass: per pixel, a weighted-RLS model p = [1] (its RGB coefficient β and
-// scalar P) reprojected from last frame, adjusted for what changed, then updated with
-// this frame's noisy colour. What changed is measured twice, before the update: the
-// temporal gradients scale the model by the ratio the re-traced samples show and lower
-// its forgetting factor in proportion (a light or TF change), and last frame's pooled
-// residual, where significant, is added to it and lowers the forgetting factor too (a
-// lag no single pixel's noise reveals).
-// A residual far above the model's running noise level twice in a row restarts it (a
-// jump); a single far residual is a spike and is given little weight.
+// The paper's Fig. 8 ablations without the temporal feature (`wrls-nf`, `rls-nf`): per
+// pixel, a weighted-RLS model p = [1] (its RGB coefficient β and scalar P) reprojected
+// from last frame and updated with this frame's noisy colour. A residual far above the
+// model's running noise level twice in a row restarts it (a jump); a single far residual
+// is a spike and is given little weight (`wrls-nf`; `rls-nf` weighs every sample 1).
 //
 // State, two images: model (rgba32f: rgb β, a P) and stats (rg32f: x running noise level,
 // the mean squared a-priori residual over the three channels; y frames in a row with a
-// far residual).
-// Outputs for the spatial pass: the prediction (rgb) with its variance (a), and for the
-// pooled lag test (wrls_drift.comp) the running a-posteriori residual (a history: this
-// frame's blended with last frame's, wrls_change.glsl running_lag).
+// far residual). Output for the spatial pass: the prediction (rgb) with its variance (a).
 #include "common.glsl"
 #include "reproject.glsl"
 #include "wrls.glsl"
-#include "wrls_change.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -28,10 +20,7 @@ layout(binding = 3) uniform sampler2D stats_prev;
 layout(binding = 4, rgba32f) uniform writeonly image2D model_cur;
 layout(binding = 5, rg32f) uniform writeonly image2D stats_cur;
 layout(binding = 6, rgba32f) uniform writeonly image2D prediction;  // rgb, a variance
-layout(binding = 7, rgba32f) uniform writeonly image2D residual;    // rgb, a variance (< 0: none)
-layout(binding = 8) uniform sampler2D drift_prev;                    // rgb mean, a variance
 layout(binding = 9, rgba32f) uniform readonly image2D moments;       // x mean, y 2nd moment of luminance
-layout(binding = 10) uniform sampler2D residual_prev;                // last frame's `residual`
 
 layout(push_constant) uniform WrlsConstantPush {
     vec4 camera;          // xyz camera position
@@ -43,18 +32,10 @@ layout(push_constant) uniform WrlsConstantPush {
     float tolerance;      // disocclusion tolerance in pixels
     float change_ratio;   // squared residual over the noise level that counts as far
     float outlier_sigmas; // k in the weights exp(-r²/(k²·noise level))
-    uint gradient_valid;  // the gradient images were measured this frame
-    uint drift_valid;     // drift_prev holds last frame's pooled residuals
-    uint stratum;         // the gradients' stratum edge in pixels
-    float lambda_min;     // forgetting factor at a sudden change
-    float change_gain;    // change per frame over the noise at which the history is forgotten: 1/gain
-    float drift_z;        // pooled residual, in standard errors, that starts to count
     float spp;            // samples per pixel of the noisy frame
     float lambda_moving;  // forgetting factor of a pixel whose surface moved on screen
-    float drift_forget;   // share of the way to lambda_min at a clearly significant lag
-    float drift_forget_z; // pooled residual, in standard errors, from which it forgets
-    float lag_alpha;      // weight of this frame's residual in the running one (1: its own)
     float pad0;
+    float pad1;
 } pc;
 
 const float P_MAX = 1e6;
@@ -77,37 +58,13 @@ void main() {
     float P = pc.delta;
     float noise_level = -1.0;  // none yet
     float streak = 0.0;
-    vec4 lag_prev = vec4(0.0, 0.0, 0.0, -1.0);  // the running residual: none
     if (r.valid) {
         vec4 m = history_fetch(model_prev, r);
         vec4 st = history_fetch(stats_prev, r);
-        // The scene changed: scale the model by the ratio the gradients measured, so it
-        // follows the change instead of lagging, and forget in proportion to what the
-        // scaling may have missed (below).
-        SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum);
-        float mean_ratio = dot(sc.ratio, vec3(1.0 / 3.0));
-        beta = m.rgb * sc.ratio;
+        beta = m.rgb;
         P = m.a;
-        noise_level = st.x * mean_ratio * mean_ratio;
+        noise_level = st.x;
         streak = st.y;
-        // Forget in proportion to the change per frame against this pixel's noise (a
-        // steady-state Kalman gain grows as the change over the noise): a bright pixel
-        // under a moving light keeps a short history, a dim, noisy one a longer one.
-        float sigma = sqrt(max(noise_level, 0.0) / 3.0);
-        float forget = min(1.0, pc.change_gain * sc.change * luminance(beta) / (sigma + 1e-6));
-        lambda = mix(lambda, pc.lambda_min, forget);
-        if (pc.drift_valid != 0u) {
-            vec4 drift = history_fetch(drift_prev, r);
-            vec3 correction = significant_drift(drift, pc.drift_z);
-            beta += correction;
-            if (pc.lag_alpha < 1.0) {
-                lag_prev = carried_lag(history_fetch(residual_prev, r), sc.ratio, correction);
-            }
-            // A lag the neighbourhood shares is a change the gradients missed: forget in
-            // proportion too, from a lower significance than the correction needs.
-            float lag = drift_significance(drift, pc.drift_forget_z);
-            lambda = mix(lambda, pc.lambda_min, pc.drift_forget * lag);
-        }
     }
 
     vec3 e = I - beta;
@@ -165,10 +122,4 @@ void main() {
     imageStore(model_cur, p, vec4(beta, P));
     imageStore(stats_cur, p, vec4(noise_level, streak, 0.0, 0.0));
     imageStore(prediction, p, vec4(max(beta, vec3(0.0)), noise * P));
-    // What this frame's update left unexplained, for the pooled lag test; a fresh model
-    // has no history to lag.
-    float keep = 1.0 - q;
-    float variance = sample_variance(imageLoad(moments, p).xy, pc.spp) + noise * P;
-    imageStore(residual, p, running_lag(r.valid && !fresh, lag_prev, keep * e,
-                                        keep * keep * variance, pc.lag_alpha));
 }

@@ -7,7 +7,6 @@
 #include "common.glsl"
 #include "reproject.glsl"
 #include "wrls.glsl"
-#include "wrls_change.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -35,13 +34,6 @@ layout(binding = 19, rgba32f) uniform writeonly image2D errors_cur;
 // This pixel's prediction after the update (rgb) and its variance per channel (a), what
 // the à-trous spatial filter (wrls_atrous.comp) starts from.
 layout(binding = 25, rgba32f) uniform writeonly image2D prediction;
-// Lag detection pooled over a neighbourhood (DRIFT): this frame's a-posteriori residual
-// per pixel (rgb; a its variance, negative where there is no history), which
-// wrls_drift.comp pools into last frame's drift estimate read back here.
-layout(binding = 26, rgba32f) uniform writeonly image2D residual;
-layout(binding = 27) uniform sampler2D drift_prev;
-layout(binding = 28) uniform sampler2D residual_prev;            // last frame's `residual`
-layout(binding = 29, rgba32f) uniform readonly image2D moments;  // x mean, y 2nd moment of luminance
 
 layout(push_constant) uniform WrlsUpdatePush {
     vec4 camera;          // xyz camera position
@@ -55,14 +47,6 @@ layout(push_constant) uniform WrlsUpdatePush {
     float tolerance;      // disocclusion tolerance, relative to camera distance
     float change_ratio;   // residual / noise-level ratio that counts as a change
     float outlier_sigmas; // residual weights: k in exp(-r²/(k²·noise level))
-    uint gradient_valid;  // the gradient images were measured this frame
-    uint drift_valid;     // drift_prev holds last frame's pooled residuals
-    uint stratum;         // their stratum edge in pixels
-    float lambda_min;     // forgetting factor at a sudden change
-    float change_gain;    // relative change at which the history is forgotten: 1/gain
-    float drift_z;        // pooled residual, in standard errors, that starts to count
-    float lag_alpha;      // weight of this frame's residual in the running one (1: its own)
-    float spp;            // samples per pixel of the noisy frame
     float pad0;
     float pad1;
 } pc;
@@ -98,15 +82,11 @@ void main() {
     float noise_level = -1.0;  // running mean of the squared a-priori residual
     float streak = 0.0;        // consecutive frames far above the noise level
     vec4 constant = vec4(0.0, 0.0, 0.0, pc.delta);
-    vec4 lag_prev = vec4(0.0, 0.0, 0.0, -1.0);  // the running residual: none
     vec3 errors = vec3(-1.0, -1.0, 0.0);  // a-priori errors (const, feature), const streak
-    SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum);
-    // Forgetting in proportion to the measured change: a still scene keeps λ, a sudden
-    // change falls to λ_min (what the scaling below did not explain is learned anew).
-    float lambda = mix(pc.lambda_min, pc.lambda, 1.0 - min(1.0, pc.change_gain * sc.change));
+    float lambda = pc.lambda;
     if (r.valid) {
         vec4 zq = history_fetch(z_prev, r);
-        z_hist = clamp(zq.rgb * sc.ratio, lo, hi);
+        z_hist = clamp(zq.rgb, lo, hi);
         z = pc.alpha * z_hist + (1.0 - pc.alpha) * I;
         age = zq.w + 1.0;
         beta[0] = history_fetch(beta_r_prev, r);
@@ -119,28 +99,6 @@ void main() {
         if (MODEL_SELECTION) {
             constant = history_fetch(constant_prev, r);
             errors = history_fetch(errors_prev, r).xyz;
-        }
-        // The scene changed: scale every model's prediction by the measured ratio (the
-        // feature's coefficients by the ratio of output to input channel, since the
-        // feature is scaled too), so the models follow the change instead of lagging.
-        for (int c = 0; c < 3; ++c) {
-            beta[c].x *= sc.ratio[c];
-            beta[c].yzw *= sc.ratio[c] / sc.ratio;
-        }
-        constant.rgb *= sc.ratio;
-        float ratio2 = dot(sc.ratio, vec3(1.0 / 3.0));
-        noise_level *= ratio2 * ratio2;
-        // Lag the pooled residuals revealed last frame: what the neighbourhood's models
-        // still miss on average, once it is clearly more than noise, is added to the
-        // constant term (a drift too slow for one pixel's change test, a view-dependent
-        // change under camera motion, a change the gradients did not see).
-        if (pc.drift_valid != 0u) {
-            vec3 d = significant_drift(history_fetch(drift_prev, r), pc.drift_z);
-            for (int c = 0; c < 3; ++c) beta[c].x += d[c];
-            constant.rgb += d;
-            if (pc.lag_alpha < 1.0) {
-                lag_prev = carried_lag(history_fetch(residual_prev, r), sc.ratio, d);
-            }
         }
     } else {
         // A new surface: start the models over.
@@ -233,13 +191,6 @@ void main() {
     vec4 Px = P * x;
     vec4 q = Px / (lambda / w + dot(x, Px));
     for (int c = 0; c < 3; ++c) beta[c] += q * e[c];
-    // The running a-posteriori residual (what the updates left unexplained) and its
-    // variance, for the pooled lag test; fresh models have none.
-    float keep = 1.0 - dot(x, q);
-    float variance = sample_variance(imageLoad(moments, p).xy, pc.spp) +
-                     max(noise_level, 0.0) / 3.0 * dot(x, Px);
-    imageStore(residual, p, running_lag(r.valid && !fresh, lag_prev, keep * e,
-                                        keep * keep * variance, pc.lag_alpha));
     P = (P - outerProduct(q, Px)) / lambda;
     // fp32 hygiene: keep P symmetric with a positive, bounded diagonal (wind-up guard
     // for predictors that stop exciting some direction on long static runs).

@@ -30,7 +30,10 @@ fn set_files(set: &str) -> Result<Vec<String>> {
     }
     files.sort();
     if files.is_empty() {
-        bail!("the scene set {set:?} has no scene files in {}", dir.display());
+        bail!(
+            "the scene set {set:?} has no scene files in {}",
+            dir.display()
+        );
     }
     Ok(files)
 }
@@ -157,8 +160,16 @@ mod tests {
         assert!(statics.len() >= 2, "{statics:?}");
         for file in validation.iter().chain(&statics) {
             let scene = Scene::load(file).unwrap_or_else(|e| panic!("{file}: {e}"));
-            let set = if validation.contains(file) { "val/" } else { "static/" };
-            assert!(scene.name.starts_with(set), "{file}: named {:?}", scene.name);
+            let set = if validation.contains(file) {
+                "val/"
+            } else {
+                "static/"
+            };
+            assert!(
+                scene.name.starts_with(set),
+                "{file}: named {:?}",
+                scene.name
+            );
             assert!(scene.frames >= 48, "{file}: {} frames", scene.frames);
         }
         // Selected twice (or beside one of its files), each file runs once.

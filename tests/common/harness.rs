@@ -144,7 +144,9 @@ impl Harness {
                 height: h,
             },
             camera: glam::Vec3::new(0.0, 0.0, 1.0),
-            spp: 2,
+            // One sample per pixel: the moments above are those of one sample (no variance), so
+            // a method that estimates noise from them must use the frame's spread instead.
+            spp: 1,
             changes: Changes {
                 camera: self.frame == 0,
                 lights: false,

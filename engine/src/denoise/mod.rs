@@ -3,20 +3,22 @@
 //! differences between methods are the denoisers' alone.
 
 mod accum;
+pub mod ours;
 mod passthrough;
 pub mod rae;
 pub mod registry;
 pub mod svgf;
 pub mod taa;
-pub mod wrls;
+pub mod wrls_paper;
 
 pub use accum::Accum;
+pub use ours::{Ours, OursVariant};
 pub use passthrough::Passthrough;
 pub use rae::{Rae, RaeWeights};
 pub use registry::{DenoiserConfig, DenoiserInfo, FeatureUse, DENOISERS};
 pub use svgf::Svgf;
 pub use taa::Taa;
-pub use wrls::{Wrls, WrlsVariant};
+pub use wrls_paper::{Wrls, WrlsVariant};
 
 use crate::error::{EngineError, Result};
 use crate::gpu::GpuContext;

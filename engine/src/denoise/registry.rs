@@ -4,7 +4,7 @@
 //! reads [`DENOISERS`].
 
 use super::{Accum, Denoiser, MotionSource, Passthrough, Rae, RaeWeights, Svgf, Taa};
-use super::{Wrls, WrlsVariant};
+use super::{Ours, OursVariant, Wrls, WrlsVariant};
 use crate::error::{EngineError, Result};
 use crate::gpu::GpuContext;
 use crate::passes::path_trace::PathTraceFeatures;
@@ -40,7 +40,9 @@ enum Kind {
     Accum,
     Taa,
     Svgf,
-    /// A member of the wRLS family, with its switches.
+    /// Ours or one of its ablations, with its switches.
+    Ours(OursVariant),
+    /// A member of the paper's wRLS family, with its switches.
     Wrls(WrlsVariant),
     /// The recurrent autoencoder: the shipped network `net` (None: the one trained on
     /// the scene's dataset, see [`super::rae::network_for`]) at `precision`.
@@ -101,6 +103,15 @@ const fn rae(
     )
 }
 
+const fn ours(name: &'static str, description: &'static str, variant: OursVariant) -> DenoiserInfo {
+    entry(
+        name,
+        description,
+        FeatureUse::ForMotion,
+        Kind::Ours(variant),
+    )
+}
+
 const fn wrls(name: &'static str, description: &'static str, variant: WrlsVariant) -> DenoiserInfo {
     entry(
         name,
@@ -110,9 +121,9 @@ const fn wrls(name: &'static str, description: &'static str, variant: WrlsVarian
     )
 }
 
-/// Ours, and the paper's model (see [`WrlsVariant`]).
-const OURS: WrlsVariant = WrlsVariant::OURS;
-const PAPER: WrlsVariant = WrlsVariant::PAPER;
+/// Ours (see [`OursVariant`]), and the paper's model family (see [`WrlsVariant`]).
+const OURS: OursVariant = OursVariant::OURS;
+const PAPER: WrlsVariant = WrlsVariant::BASE;
 
 use FeatureUse::{Always, ForMotion, Never};
 
@@ -137,36 +148,26 @@ pub const DENOISERS: &[DenoiserInfo] = &[
         Always,
         Kind::Svgf,
     ),
-    wrls(
+    ours(
         "ours",
-        "weighted RLS on the constant model with temporal gradients, a pooled lag test and an à-trous filter",
+        "a per-pixel Kalman filter told by temporal gradients how much the scene changed, with a pooled lag test and an à-trous filter",
         OURS,
     ),
     // Ablations of ours: one part each.
-    wrls(
-        "ours-feature",
-        "ours with the temporal feature and model selection",
-        WrlsVariant { feature: true, model_selection: true, ..OURS },
-    ),
-    wrls(
+    ours(
         "ours-no-gradient",
         "ours without temporal gradients",
-        WrlsVariant { gradients: false, ..OURS },
+        OursVariant { gradients: false, ..OURS },
     ),
-    wrls(
-        "ours-no-atrous",
-        "ours with the paper's 5×5 model blending instead of the à-trous filter",
-        WrlsVariant { atrous: false, ..OURS },
-    ),
-    wrls(
-        "ours-no-drift",
+    ours(
+        "ours-no-lag",
         "ours without the pooled lag test",
-        WrlsVariant { drift: false, ..OURS },
+        OursVariant { lag: false, ..OURS },
     ),
-    wrls(
-        "ours-fixed-lambda",
-        "ours with a fixed forgetting factor (no restarts, gradients or lag test)",
-        WrlsVariant { restart_on_change: false, gradients: false, drift: false, ..OURS },
+    ours(
+        "ours-no-atrous",
+        "ours without the à-trous filter (the per-pixel estimates)",
+        OursVariant { atrous: false, ..OURS },
     ),
     wrls(
         "wrls-paper",
@@ -221,9 +222,10 @@ impl DenoiserInfo {
             Kind::Accum => Box::new(Accum::new(ctx, self.name)?),
             Kind::Taa => Box::new(Taa::new(ctx, self.name, motion)?),
             Kind::Svgf => Box::new(Svgf::new(ctx, self.name, motion)?),
-            Kind::Wrls(variant) => {
-                Box::new(Wrls::new(ctx, self.name, variant, motion, config.features)?)
+            Kind::Ours(variant) => {
+                Box::new(Ours::new(ctx, self.name, variant, motion, config.features)?)
             }
+            Kind::Wrls(variant) => Box::new(Wrls::new(ctx, self.name, variant, motion)?),
             Kind::Rae { .. } => {
                 let (net, precision) = self
                     .rae_network(config.dataset)
@@ -274,18 +276,33 @@ mod tests {
         for (i, n) in all.iter().enumerate() {
             assert!(!all[..i].contains(n), "{n} is listed twice");
         }
-        // Each wRLS row is a different variant (a copied row would rename one).
+        // Each wRLS or ours row is a different variant (a copied row would rename one).
         let variants: Vec<_> = DENOISERS
             .iter()
-            .filter_map(|d| match d.kind {
-                Kind::Wrls(v) => Some(v),
-                _ => None,
-            })
+            .filter(|d| matches!(d.kind, Kind::Wrls(_) | Kind::Ours(_)))
+            .map(|d| d.kind)
             .collect();
         for (i, v) in variants.iter().enumerate() {
             assert!(!variants[..i].contains(v), "{v:?} is listed twice");
         }
         assert!(DENOISERS.iter().all(|d| !d.description.is_empty()));
+    }
+
+    #[test]
+    fn each_ablation_of_ours_switches_one_part_off() {
+        let parts = |v: OursVariant| [v.gradients, v.lag, v.atrous];
+        let ours = parts(OURS);
+        assert!(ours.iter().all(|&on| on), "ours has every part");
+        let mut ablations = 0;
+        for d in DENOISERS {
+            if let Kind::Ours(v) = d.kind {
+                let off = ours.iter().zip(parts(v)).filter(|(a, b)| a != &b).count();
+                let expected = usize::from(d.name != "ours");
+                assert_eq!(off, expected, "{} differs from ours in {off} parts", d.name);
+                ablations += expected;
+            }
+        }
+        assert_eq!(ablations, 3, "one ablation per part");
     }
 
     #[test]

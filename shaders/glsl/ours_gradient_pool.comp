@@ -1,5 +1,5 @@
 #version 460
-// ours' temporal gradients pooled (wrls_gradient.comp measured them, one pixel per S×S
+// ours' temporal gradients pooled (ours_gradient.comp measured them, one pixel per S×S
 // stratum): per stratum, the strata around it summed into a luminance ratio (as a log)
 // with its standard error and the colour of the change, over 3×3, 5×5 and 9×9 strata, and
 // shrunk level by level: the 9×9 ratio towards no change, the 5×5 towards the shrunk 9×9,
@@ -18,7 +18,7 @@ layout(binding = 0, rgba32f) uniform readonly image2D gradient_new;   // rgb re-
 layout(binding = 1, rgba32f) uniform readonly image2D gradient_old;   // rgb last frame's
 layout(binding = 2, rgba32f) uniform writeonly image2D gradient_ratio;  // rgb colour, a log ratio
 
-layout(push_constant) uniform WrlsGradientPoolPush {
+layout(push_constant) uniform OursGradientPoolPush {
     uint width;    // strata across
     uint height;   // strata down
     float shrink;  // squared standard errors of a departure that halve it
@@ -27,6 +27,12 @@ layout(push_constant) uniform WrlsGradientPoolPush {
 
 // The widest pool's radius in strata (9×9).
 const int WIDE = 4;
+// A ratio of more than 4× per frame is taken as 4×: the scaled model then starts closer
+// to the new value and the update's jump test takes the rest.
+const float RATIO_MAX = 4.0;
+// Channels darker than this share of the luminance are damped towards no change (their
+// ratios are noise over almost nothing).
+const float DARK_CHANNEL = 0.01;
 
 struct Pooled {
     float L;       // log luminance ratio
@@ -74,11 +80,11 @@ Pooled pooled(Sums s) {
     float R = y_new / y_old;
     float scatter = max(s.nn - 2.0 * R * s.no + R * R * s.oo, 0.0);
     float var_r = scatter / (y_old * y_old) * (s.n / (s.n - 1.0));
-    o.L = log(clamp(R, 0.25, 4.0));
+    o.L = log(clamp(R, 1.0 / RATIO_MAX, RATIO_MAX));
     o.var_l = var_r / (R * R + 1e-12);
     // Channels far darker than the luminance are damped towards no change.
-    float eps = 0.01 * y_max;
-    vec3 ratio = clamp((s.new_rgb + eps) / (s.old_rgb + eps), vec3(0.25), vec3(4.0));
+    float eps = DARK_CHANNEL * y_max;
+    vec3 ratio = clamp((s.new_rgb + eps) / (s.old_rgb + eps), vec3(1.0 / RATIO_MAX), vec3(RATIO_MAX));
     o.colour = ratio / exp(o.L);
     o.measured = true;
     return o;

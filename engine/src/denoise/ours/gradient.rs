@@ -1,9 +1,9 @@
-//! `<name>.gradient` (wrls_gradient.comp): ours' temporal gradients. When the scene (a
+//! `<name>.gradient` (ours_gradient.comp): ours' temporal gradients. When the scene (a
 //! light or the TF) changed since last frame, one pixel per S×S stratum of last frame's
 //! image is traced again with last frame's camera and random numbers in this frame's
-//! scene; the update pass compares the two per stratum.
+//! scene; the pooling pass compares the two per stratum.
 
-use super::Wrls;
+use super::Ours;
 use crate::denoise::DenoiseInputs;
 use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc};
@@ -13,8 +13,8 @@ use ash::vk;
 use glam::{Mat4, Vec4};
 
 gpu_block! {
-    /// `WrlsGradientPush` in wrls_gradient.comp.
-    pub struct WrlsGradientPush {
+    /// `OursGradientPush` in ours_gradient.comp.
+    pub struct OursGradientPush {
         pub prev_inv_view_proj: Mat4,
         pub prev_camera: Vec4,
         pub width: u32,
@@ -44,7 +44,7 @@ pub(super) struct Gradients {
     pub valid: bool,
 }
 
-impl Wrls {
+impl Ours {
     /// Adds the temporal-gradient pass and its pooling when the scene changed since last
     /// frame; the images exist either way (the update pass binds them, and reads them
     /// only when `valid`).
@@ -73,7 +73,7 @@ impl Wrls {
         let (Some(pipeline), Some(retrace)) = (&self.gradients, input.retrace) else {
             return Ok(g);
         };
-        let push = WrlsGradientPush {
+        let push = OursGradientPush {
             prev_inv_view_proj: retrace.inv_view_proj_prev,
             prev_camera: retrace.camera_prev.extend(1.0),
             width: size.width,

@@ -1,17 +1,15 @@
-//! `<name>.update`: the per-pixel models reprojected from last frame, adjusted for what
-//! the temporal gradients and the pooled lag test measured, and updated by weighted RLS
-//! with this frame's noisy colour. Ours' constant model p = [1] (`wrls_constant.comp`,
-//! two state images) or the paper's p = [1, z] (`wrls_update.comp`, nine: the feature, β
-//! per channel, the shared P, the constant model and both models' errors for selection).
+//! `<name>.update`: the per-pixel models reprojected from last frame and updated by
+//! weighted RLS with this frame's noisy colour: the constant model p = [1]
+//! (`wrls_constant.comp`, two state images) or the paper's p = [1, z] (`wrls_update.comp`,
+//! nine: the feature, β per channel, the shared P, and the constant model and both
+//! models' errors that the shaders' model selection would use).
 
-use super::gradient::Gradients;
-use super::spatial::LagImages;
 use super::Wrls;
 use crate::denoise::DenoiseInputs;
 use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline};
 use crate::gpu_block;
-use crate::graph::{Frame, History, RenderGraph};
+use crate::graph::{Frame, History, ImageHandle, RenderGraph};
 use ash::vk;
 use glam::Vec4;
 
@@ -27,18 +25,10 @@ gpu_block! {
         pub tolerance: f32,
         pub change_ratio: f32,
         pub outlier_sigmas: f32,
-        pub gradient_valid: u32,
-        pub drift_valid: u32,
-        pub stratum: u32,
-        pub lambda_min: f32,
-        pub change_gain: f32,
-        pub drift_z: f32,
         pub spp: f32,
         pub lambda_moving: f32,
-        pub drift_forget: f32,
-        pub drift_forget_z: f32,
-        pub lag_alpha: f32,
         pub pad0: f32,
+        pub pad1: f32,
     }
 }
 
@@ -56,26 +46,8 @@ gpu_block! {
         pub tolerance: f32,
         pub change_ratio: f32,
         pub outlier_sigmas: f32,
-        pub gradient_valid: u32,
-        pub drift_valid: u32,
-        pub stratum: u32,
-        pub lambda_min: f32,
-        pub change_gain: f32,
-        pub drift_z: f32,
-        pub lag_alpha: f32,
-        pub spp: f32,
         pub pad0: f32,
         pub pad1: f32,
-    }
-}
-
-/// The weight of this frame's residual in the running one the pooled lag test averages:
-/// its own where last frame's running residual does not exist.
-fn lag_alpha(p: super::WrlsParams, lag: &LagImages) -> f32 {
-    if lag.residual.valid {
-        p.lag_alpha
-    } else {
-        1.0
     }
 }
 
@@ -98,8 +70,8 @@ impl Wrls {
         )
     }
 
-    /// Ours' constant model: `model` (rgb β, a P) and `stats` (running noise level,
-    /// frames in a row with a far residual).
+    /// The constant model: `model` (rgb β, a P) and `stats` (running noise level, frames
+    /// in a row with a far residual); writes its prediction with its variance.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn add_constant_update<'f>(
         &'f self,
@@ -108,8 +80,7 @@ impl Wrls {
         graph: &mut RenderGraph,
         frame: &mut Frame<'f>,
         input: &DenoiseInputs,
-        gradients: &Gradients,
-        lag: &LagImages,
+        prediction: ImageHandle,
     ) -> Result<()> {
         let desc = Self::state_desc(input);
         let n = &self.name;
@@ -133,29 +104,17 @@ impl Wrls {
             tolerance: p.tolerance,
             change_ratio: p.change_ratio,
             outlier_sigmas: p.outlier_sigmas,
-            gradient_valid: gradients.valid as u32,
-            drift_valid: (self.drift.is_some() && lag.drift.valid) as u32,
-            stratum: p.stratum,
-            lambda_min: p.lambda_min,
-            change_gain: p.change_gain,
-            drift_z: p.drift_z,
             spp: input.spp as f32,
             lambda_moving: p.lambda_moving,
-            drift_forget: p.drift_forget,
-            drift_forget_z: p.drift_forget_z,
-            lag_alpha: lag_alpha(p, lag),
             pad0: 0.0,
+            pad1: 0.0,
         };
-        let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
+        let (noisy, moments) = (input.noisy, input.moments);
         frame.add_compute(format!("{n}.update"), pipeline, push, size, |b| {
             reproj.bind(b);
             b.read("noisy", noisy)
                 .read("moments", moments)
-                .read("gradient_ratio", g.ratio)
-                .sampled("drift_prev", lag.drift.prev)
-                .write("prediction", lag.prediction)
-                .sampled("residual_prev", lag.residual.prev)
-                .write("residual", lag.residual.cur)
+                .write("prediction", prediction)
                 .sampled("model_prev", model.prev)
                 .write("model_cur", model.cur)
                 .sampled("stats_prev", stats.prev)
@@ -164,8 +123,8 @@ impl Wrls {
         Ok(())
     }
 
-    /// The paper's models (and ours-feature): the temporal feature z, β per channel, the
-    /// shared P, and for model selection the constant model and both models' errors.
+    /// The paper's models: the temporal feature z, β per channel, the shared P, and the
+    /// constant model and both models' errors its spatial pass binds.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn add_feature_update<'f>(
         &'f self,
@@ -174,8 +133,7 @@ impl Wrls {
         graph: &mut RenderGraph,
         frame: &mut Frame<'f>,
         input: &DenoiseInputs,
-        gradients: &Gradients,
-        lag: &LagImages,
+        prediction: ImageHandle,
     ) -> Result<FeatureModels> {
         let desc = Self::state_desc(input);
         let n = &self.name;
@@ -211,27 +169,13 @@ impl Wrls {
             tolerance: p.tolerance,
             change_ratio: p.change_ratio,
             outlier_sigmas: p.outlier_sigmas,
-            gradient_valid: gradients.valid as u32,
-            drift_valid: (self.drift.is_some() && lag.drift.valid) as u32,
-            stratum: p.stratum,
-            lambda_min: p.lambda_min,
-            change_gain: p.change_gain,
-            drift_z: p.drift_z,
-            lag_alpha: lag_alpha(p, lag),
-            spp: input.spp as f32,
             pad0: 0.0,
             pad1: 0.0,
         };
-        let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
+        let noisy = input.noisy;
         frame.add_compute(format!("{n}.update"), pipeline, push, size, |b| {
             reproj.bind(b);
-            b.read("noisy", noisy)
-                .read("moments", moments)
-                .read("gradient_ratio", g.ratio)
-                .sampled("drift_prev", lag.drift.prev)
-                .sampled("residual_prev", lag.residual.prev)
-                .write("prediction", lag.prediction)
-                .write("residual", lag.residual.cur);
+            b.read("noisy", noisy).write("prediction", prediction);
             let state: [(&'static str, &'static str, History); 9] = [
                 ("z_prev", "z_cur", m.z),
                 ("constant_prev", "constant_cur", m.constant),

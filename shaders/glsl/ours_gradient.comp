@@ -18,7 +18,7 @@ layout(binding = 7, rgba32f) uniform readonly image2D noisy_prev;  // last frame
 layout(binding = 8, rgba32f) uniform writeonly image2D gradient_new;  // rgb re-traced, a 1
 layout(binding = 9, rgba32f) uniform writeonly image2D gradient_old;  // rgb last frame's
 
-layout(push_constant) uniform WrlsGradientPush {
+layout(push_constant) uniform OursGradientPush {
     mat4 prev_inv_view_proj;  // last frame's camera
     vec4 prev_camera;         // xyz its position
     uint width;

@@ -1,0 +1,252 @@
+//! `ours`: a per-pixel local-level Kalman filter on the radiance, told by temporal
+//! gradients how much the scene changed, checked by a pooled lag test, and filtered in
+//! space by an à-trous wavelet on the filters' own variances.
+//!
+//! The model (what the state is, what the noise is, where each comes from) is stated in
+//! `shaders/glsl/ours_update.comp`; in short, per pixel x_t = g_t ∘ x_{t−1} + w_t (Q_t)
+//! and y_t = x_t + v_t (R_t), with g_t the measured change, Q_t what the prediction may
+//! have missed (a share of the measured change, camera motion, a shift the lag test found),
+//! and R_t the samples' own variance.
+//!
+//! Passes of a frame, in order (each in its own file here):
+//! - `<name>.gradient` ([`gradient`], `ours_gradient.comp`): temporal gradients, when the
+//!   scene changed: last frame's samples re-traced in this frame's scene;
+//! - `<name>.gradient_pool` ([`gradient_pool`], `ours_gradient_pool.comp`): the gradients
+//!   pooled over 3×3, 5×5 and 9×9 strata and shrunk, once per stratum;
+//! - `<name>.update` ([`update`], `ours_update.comp`): the Kalman filter's predict and
+//!   update;
+//! - `<name>.lag` ([`lag`], `ours_lag.comp`): the pooled lag test, read by next frame's
+//!   update;
+//! - `<name>.atrous0..k` ([`atrous`], `ours_atrous.comp`): the à-trous spatial filter.
+//!
+//! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-atrous`) switch one part
+//! off each ([`OursVariant`]).
+
+mod atrous;
+mod gradient;
+mod gradient_pool;
+mod lag;
+mod update;
+
+use super::{DenoiseInputs, Denoiser, MotionSource};
+use crate::error::{EngineError, Result};
+use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::passes::path_trace::{self, PathTraceFeatures};
+use ash::vk;
+use atrous::OursAtrousPush;
+use gradient::OursGradientPush;
+use gradient_pool::OursGradientPoolPush;
+use lag::OursLagPush;
+use update::OursUpdatePush;
+
+/// Ours' tunables, each with what it buys (README, "ours").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OursParams {
+    /// Edge of the temporal-gradient strata in pixels: one pixel in S×S is re-traced.
+    pub stratum: u32,
+    /// Shrinkage of the pooled gradient ratios, each towards the next wider pool's (the
+    /// widest towards 1): a ratio `k` standard errors away keeps k²/(k² + shrink) of its
+    /// departure.
+    pub shrink: f32,
+    /// Process noise of a measured change: the pixel's own change may differ from its
+    /// neighbourhood's measured one by this share of it (Q = (change_q · change · L)²).
+    pub change_q: f32,
+    /// Process noise of a pixel whose surface moved on screen, in units of its
+    /// measurement noise (the view-dependent change of a semi-transparent volume).
+    pub motion_q: f32,
+    /// Pooled residual, in standard errors of its mean, below which it is noise; beyond,
+    /// the positive-part shrinkage of it is taken as a shift of the state.
+    pub lag_z: f32,
+    /// Innovation, in standard deviations, beyond which a sample is clipped (and, twice
+    /// in a row, taken as a jump).
+    pub outlier_z: f32,
+    /// Standard errors by which a neighbour's estimate may differ from the pixel's and
+    /// still be blended (the à-trous range term).
+    pub kappa: f32,
+    /// Relative standard error of an estimate below which the à-trous levels keep the
+    /// pixel as it is (blending could only pull a converged estimate towards noisier
+    /// neighbours).
+    pub keep: f32,
+}
+
+impl Default for OursParams {
+    fn default() -> Self {
+        Self {
+            stratum: 4,
+            shrink: 4.0,
+            change_q: 3.0,
+            motion_q: 0.01,
+            lag_z: 1.5,
+            outlier_z: 6.0,
+            kappa: 2.5,
+            keep: 0.05,
+        }
+    }
+}
+
+/// The parameters `DVR_OURS` may set (for parameter studies with `dvr eval`), with the
+/// range each takes.
+#[allow(clippy::type_complexity)]
+const OVERRIDABLE: &[(&str, f32, f32, fn(&mut OursParams, f32))] = &[
+    ("stratum", 1.0, 16.0, |p, v| p.stratum = v as u32),
+    ("shrink", 0.0, 1e3, |p, v| p.shrink = v),
+    ("change_q", 0.0, 1e3, |p, v| p.change_q = v),
+    ("motion_q", 0.0, 1e3, |p, v| p.motion_q = v),
+    ("lag_z", 0.0, 1e3, |p, v| p.lag_z = v),
+    ("outlier_z", 0.5, 1e3, |p, v| p.outlier_z = v),
+    ("kappa", 0.0, 1e3, |p, v| p.kappa = v),
+    ("keep", 0.0, 1.0, |p, v| p.keep = v),
+];
+
+impl OursParams {
+    /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
+    /// `DVR_OURS="change_q=2,kappa=3"`; a value outside its range (or not finite) is an
+    /// error naming the range.
+    pub fn with_overrides(mut self, spec: Option<&str>) -> Result<Self> {
+        let Some(spec) = spec else { return Ok(self) };
+        for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let bad = |problem: String| EngineError::InvalidSetting {
+                name: "DVR_OURS",
+                value: format!("{item:?}"),
+                allowed: problem,
+            };
+            let (name, value) = item
+                .split_once('=')
+                .ok_or_else(|| bad("expected name=value pairs, comma-separated".into()))?;
+            let v: f64 = value
+                .trim()
+                .parse()
+                .map_err(|e| bad(format!("the value must be a number ({e})")))?;
+            let (_, lo, hi, set) = OVERRIDABLE
+                .iter()
+                .find(|(n, ..)| *n == name.trim())
+                .ok_or_else(|| {
+                    let known: Vec<&str> = OVERRIDABLE.iter().map(|(n, ..)| *n).collect();
+                    bad(format!("parameters: {}", known.join(", ")))
+                })?;
+            if !(v >= f64::from(*lo) && v <= f64::from(*hi)) {
+                return Err(bad(format!("{} must be in [{lo}, {hi}]", name.trim())));
+            }
+            set(&mut self, v as f32);
+        }
+        Ok(self)
+    }
+}
+
+/// Which parts run: `ours` has all; each ablation switches exactly one off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OursVariant {
+    /// Temporal gradients: the measured change g_t and its process noise (without them
+    /// g = 1 and Q has no change term).
+    pub gradients: bool,
+    /// The pooled lag test: shifts the neighbourhood's residuals reveal.
+    pub lag: bool,
+    /// The à-trous spatial filter (without it the estimate is the output).
+    pub atrous: bool,
+}
+
+impl OursVariant {
+    pub const OURS: Self = Self {
+        gradients: true,
+        lag: true,
+        atrous: true,
+    };
+}
+
+/// The pipelines of one variant.
+pub struct Ours {
+    name: String,
+    pub params: OursParams,
+    /// What the filter reprojects with.
+    pub motion: MotionSource,
+    gradients: Option<Pipeline<OursGradientPush>>,
+    gradient_pool: Option<Pipeline<OursGradientPoolPush>>,
+    update: Pipeline<OursUpdatePush>,
+    lag: Option<Pipeline<OursLagPush>>,
+    atrous: Option<Pipeline<OursAtrousPush>>,
+}
+
+/// The pooled lag test's window radius (5×5).
+const LAG_RADIUS: i32 = 2;
+
+/// À-trous levels (steps 1, 2, 4: up to 17×17 pixels). Fixed, not tuned: two levels
+/// measured 0.06 dB lower on the development subset (README, "ours").
+pub const ATROUS_LEVELS: u32 = 3;
+
+impl Ours {
+    pub fn new(
+        ctx: &GpuContext,
+        name: &str,
+        variant: OursVariant,
+        motion: MotionSource,
+        features: PathTraceFeatures,
+    ) -> Result<Self> {
+        let params =
+            OursParams::default().with_overrides(std::env::var("DVR_OURS").ok().as_deref())?;
+        let motion_source = ("MOTION_SOURCE", SpecValue::I32(motion.spec()));
+        Ok(Self {
+            name: name.to_string(),
+            params,
+            motion,
+            // The gradient pass traces paths: it is specialised like the path tracer.
+            gradients: variant
+                .gradients
+                .then(|| ctx.pipeline("ours_gradient", &path_trace::specialization(features)))
+                .transpose()?,
+            gradient_pool: variant
+                .gradients
+                .then(|| ctx.pipeline("ours_gradient_pool", &[]))
+                .transpose()?,
+            update: ctx.pipeline("ours_update", &[motion_source])?,
+            lag: variant
+                .lag
+                .then(|| {
+                    let radius = SpecValue::I32(LAG_RADIUS);
+                    ctx.pipeline("ours_lag", &[("LAG_RADIUS", radius)])
+                })
+                .transpose()?,
+            atrous: variant
+                .atrous
+                .then(|| {
+                    ctx.pipeline(
+                        "ours_atrous",
+                        &[("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles))],
+                    )
+                })
+                .transpose()?,
+        })
+    }
+}
+
+impl Denoiser for Ours {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn add<'f>(
+        &'f self,
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        frame: &mut Frame<'f>,
+        input: &DenoiseInputs,
+    ) -> Result<ImageHandle> {
+        let desc = ImageDesc::d2(
+            input.size.width,
+            input.size.height,
+            vk::Format::R32G32B32A32_SFLOAT,
+        );
+        let n = &self.name;
+        let lag = lag::LagImages {
+            residual: graph.history(ctx, &format!("{n}.residual"), desc)?,
+            pooled: graph.history(ctx, &format!("{n}.lag"), desc)?,
+        };
+        let gradients = self.add_gradients(ctx, graph, frame, input)?;
+        let estimate = self.add_update(ctx, graph, frame, input, &gradients, &lag)?;
+        self.add_lag(frame, input.size, &lag);
+        match &self.atrous {
+            Some(pipeline) => self.add_atrous(pipeline, ctx, graph, frame, input.size, estimate),
+            None => Ok(estimate),
+        }
+    }
+}

@@ -1,0 +1,92 @@
+//! `<name>.update` (ours_update.comp): the Kalman filter's predict (the estimate
+//! reprojected, scaled by the measured change, shifted by a significant pooled lag) and
+//! update with this frame's noisy colour. State: `model` (rgb estimate, a its variance)
+//! and `noise` (the measurement noise, frames in a row with a far innovation).
+
+use super::gradient::Gradients;
+use super::lag::LagImages;
+use super::Ours;
+use crate::denoise::DenoiseInputs;
+use crate::error::Result;
+use crate::gpu::{GpuContext, ImageDesc};
+use crate::gpu_block;
+use crate::graph::{Frame, ImageHandle, RenderGraph};
+use ash::vk;
+use glam::Vec4;
+
+gpu_block! {
+    /// `OursUpdatePush` in ours_update.comp.
+    pub struct OursUpdatePush {
+        pub camera: Vec4,
+        pub width: u32,
+        pub height: u32,
+        pub history_valid: u32,
+        pub gradient_valid: u32,
+        pub lag_valid: u32,
+        pub stratum: u32,
+        pub spp: f32,
+        pub tolerance: f32,
+        pub change_q: f32,
+        pub motion_q: f32,
+        pub lag_z: f32,
+        pub outlier_z: f32,
+    }
+}
+
+impl Ours {
+    /// Adds the update; returns the estimate (rgb) with its variance (a).
+    pub(super) fn add_update<'f>(
+        &'f self,
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        frame: &mut Frame<'f>,
+        input: &DenoiseInputs,
+        gradients: &Gradients,
+        lag: &LagImages,
+    ) -> Result<ImageHandle> {
+        let size = input.size;
+        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let n = &self.name;
+        let model = graph.history(ctx, &format!("{n}.model"), desc)?;
+        // Two channels are all the noise state needs.
+        let noise_desc = ImageDesc {
+            format: vk::Format::R32G32_SFLOAT,
+            ..desc
+        };
+        let noise = graph.history(ctx, &format!("{n}.noise"), noise_desc)?;
+        let estimate = graph.image(ctx, &format!("{n}.estimate"), desc)?;
+        let reproj = input.reprojection(n, self.motion)?;
+        let p = self.params;
+        let push = OursUpdatePush {
+            camera: input.camera.extend(1.0),
+            width: size.width,
+            height: size.height,
+            history_valid: (model.valid && reproj.valid) as u32,
+            gradient_valid: gradients.valid as u32,
+            lag_valid: (self.lag.is_some() && lag.pooled.valid) as u32,
+            stratum: p.stratum.max(1),
+            spp: input.spp as f32,
+            tolerance: crate::denoise::REPROJECTION_TOLERANCE_PX,
+            change_q: p.change_q,
+            motion_q: p.motion_q,
+            lag_z: p.lag_z,
+            outlier_z: p.outlier_z,
+        };
+        let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
+        frame.add_compute(format!("{n}.update"), &self.update, push, size, |b| {
+            reproj.bind(b);
+            b.read("noisy", noisy)
+                .read("moments", moments)
+                .read("gradient_ratio", g.ratio)
+                .sampled("lag_prev", lag.pooled.prev)
+                .write("prediction", estimate)
+                .sampled("residual_prev", lag.residual.prev)
+                .write("residual", lag.residual.cur)
+                .sampled("model_prev", model.prev)
+                .write("model_cur", model.cur)
+                .sampled("noise_prev", noise.prev)
+                .write("noise_cur", noise.cur);
+        });
+        Ok(estimate)
+    }
+}

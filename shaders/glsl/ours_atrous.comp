@@ -1,0 +1,78 @@
+#version 460
+// ours' spatial filter: one à-trous iteration (a 5×5 B3-spline kernel with taps `step`
+// pixels apart) over the per-pixel Kalman estimates, dispatched with step 1, 2, 4. A
+// neighbour is weighted by how far its estimate lies from this pixel's in units of their
+// standard errors (the filters' own variances P), so converged estimates keep the detail
+// they resolved while young ones (after a change or a disocclusion) are averaged over an
+// ever wider footprint; each iteration passes on the variance of its output.
+#include "common.glsl"
+#include "atrous_tile.glsl"
+
+layout(local_size_x = TILE, local_size_y = TILE) in;
+
+layout(binding = 0, rgba32f) uniform readonly image2D color_in;   // rgb prediction, a variance
+layout(binding = 1, rgba32f) uniform writeonly image2D color_out; // the same, filtered
+
+layout(push_constant) uniform OursAtrousPush {
+    uint width;
+    uint height;
+    int step;     // tap spacing in pixels
+    float kappa;  // standard errors two predictions may differ by and still be blended
+    uint last;    // the last iteration writes the denoiser's output (alpha 1)
+    float keep;   // relative standard error below which a pixel is kept as it is
+    uint pad1;
+    uint pad2;
+} pc;
+
+const float B3[3] = float[](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
+
+shared vec4 tile[TILE_TEXELS];
+
+vec4 tap(TileWindow w, ivec2 q) {
+    return w.on ? tile[tile_index(w, q)] : imageLoad(color_in, q);
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = ivec2(pc.width, pc.height);
+    TileWindow win = tile_window(pc.step);
+    if (win.on) {
+        TILE_LOAD(win, tile, color_in, size);
+        barrier();
+    }
+    if (p.x >= size.x || p.y >= size.y) return;
+    vec4 centre = tap(win, p);
+    // A pixel whose prediction is already precise (standard error below `keep` of its
+    // value: a converged model) is kept as it is. Blending could only pull it towards
+    // neighbours whose larger variances let their values in (the range term sums both),
+    // which softened the MRI's folds (FLIP) for no gain in PSNR; and it costs a load and
+    // a store instead of 25 taps.
+    if (centre.a < pc.keep * pc.keep * dot(centre.rgb, centre.rgb) / 3.0) {
+        imageStore(color_out, p, vec4(max(centre.rgb, vec3(0.0)), pc.last != 0u ? 1.0 : centre.a));
+        return;
+    }
+    float k0 = B3[0] * B3[0];
+    vec3 sum = k0 * centre.rgb;
+    float var_sum = k0 * k0 * centre.a;
+    float wsum = k0;
+    for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+            ivec2 q = p + ivec2(dx, dy) * pc.step;
+            if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
+            vec4 cq = tap(win, q);
+            vec3 d = cq.rgb - centre.rgb;
+            float range = dot(d, d) / 3.0 / (pc.kappa * pc.kappa * (centre.a + cq.a) + 1e-10);
+            float w = B3[abs(dx)] * B3[abs(dy)] * exp(-range);
+            sum += w * cq.rgb;
+            var_sum += w * w * cq.a;
+            wsum += w;
+        }
+    }
+    vec3 colour = sum / wsum;
+    float variance = var_sum / (wsum * wsum);
+    if (!all_finite(colour) || isnan(variance) || isinf(variance)) {
+        colour = centre.rgb;
+        variance = centre.a;
+    }
+    imageStore(color_out, p, vec4(max(colour, vec3(0.0)), pc.last != 0u ? 1.0 : variance));
+}

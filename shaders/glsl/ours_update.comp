@@ -1,0 +1,194 @@
+#version 460
+// ours' temporal pass: per pixel, a local-level Kalman filter on the pixel's radiance.
+//
+// Model. State x_t (rgb, the pixel's true radiance), observed through this frame's noisy
+// pixel mean y_t:
+//     x_t = g_t ∘ x_{t−1} + w_t,   w_t ~ N(0, Q_t)      (the scene changes by g_t)
+//     y_t = x_t + v_t,             v_t ~ N(0, R_t)      (Monte Carlo noise)
+// with one variance per pixel shared by the channels (P for the estimate, Q, R):
+//   - g_t, the measured change: the temporal gradients' ratio of this frame's radiance to
+//     last frame's on re-traced paths (ours_gradient*.comp), 1 where nothing changed;
+//   - Q_t, what the prediction may have missed: (change_q · change · luminance)² for a
+//     change the gradients measured (their ratio is a neighbourhood's, the pixel's own may
+//     differ in proportion), motion_q · R for a pixel whose surface moved on screen (the
+//     view-dependent change of a semi-transparent volume), and a shift the pooled lag test
+//     found (its own size);
+//   - R_t, the variance of one frame's pixel mean, estimated from the samples' own
+//     luminance moments (at 1 spp: from the innovations), averaged over the filter's own
+//     memory and scaled with the radiance by g_t.
+// Predict: x⁻ = g ∘ x, P⁻ = ḡ² P + Q. Update: K = P⁻ / (P⁻ + R), x = x⁻ + K (y − x⁻),
+// P = (1 − K) P⁻. With nothing changing Q = 0 and K = 1/n: the running mean, which only
+// improves.
+// Outliers and jumps from the normalised innovation ν² = |y − x⁻|² / 3 / (P⁻ + R): beyond
+// outlier_z standard deviations a sample counts only as far as outlier_z (a Huber weight:
+// R is raised by ν² / outlier_z²); a second such innovation in a row is a jump, and its
+// square is added to P⁻ so the filter follows it.
+//
+// State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (rg32f:
+// x the measurement noise R, y frames in a row with a far innovation).
+// Outputs: the estimate with its variance for the à-trous filter (ours_atrous.comp), and
+// the a-posteriori residual with its variance for the pooled lag test (ours_lag.comp).
+#include "common.glsl"
+#include "reproject.glsl"
+#include "ours_change.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = 1, rgba32f) uniform readonly image2D noisy;
+layout(binding = 2) uniform sampler2D model_prev;
+layout(binding = 3) uniform sampler2D noise_prev;
+layout(binding = 4, rgba32f) uniform writeonly image2D model_cur;
+layout(binding = 5, rg32f) uniform writeonly image2D noise_cur;
+layout(binding = 6, rgba32f) uniform writeonly image2D prediction;  // rgb, a variance
+layout(binding = 7, rgba32f) uniform writeonly image2D residual;    // rgb, a variance (< 0: none)
+layout(binding = 8) uniform sampler2D lag_prev;                      // rgb mean, a variance
+layout(binding = 9, rgba32f) uniform readonly image2D moments;       // x mean, y 2nd moment of luminance
+layout(binding = 10) uniform sampler2D residual_prev;                // last frame's `residual`
+
+layout(push_constant) uniform OursUpdatePush {
+    vec4 camera;          // xyz camera position
+    uint width;
+    uint height;
+    uint history_valid;
+    uint gradient_valid;  // the gradient images were measured this frame
+    uint lag_valid;       // lag_prev holds last frame's pooled residuals
+    uint stratum;         // the gradients' stratum edge in pixels
+    float spp;            // samples per pixel of the noisy frame
+    float tolerance;      // disocclusion tolerance in pixels
+    float change_q;       // share of a measured change the pixel's own may differ by
+    float motion_q;       // process noise of a moving pixel, in units of R
+    float lag_z;          // pooled residual, in standard errors, that is a shift
+    float outlier_z;      // innovation, in standard deviations, beyond which it is clipped
+} pc;
+
+// Guards against division by zero (radiance² units).
+const float TINY = 1e-12;
+// Motion on screen, in pixels, below which a pixel counts as still.
+const float STILL_PX = 0.01;
+// The residual the lag test pools is a running one: this share of this frame's, the rest
+// last frame's (carried along with the change and less the shift it caused). A lag
+// persists from frame to frame while the noise does not, so at one half the running
+// residual has a third of one frame's noise variance.
+const float LAG_BLEND = 0.5;
+
+// The variance of this frame's pixel mean at `q` from its samples' luminance moments.
+float moment_noise(ivec2 q) {
+    vec2 m = imageLoad(moments, q).xy;
+    return max(m.y - m.x * m.x, 0.0) / max(pc.spp - 1.0, 1.0);
+}
+
+// R of a pixel without history: the moments' noise over the 3×3 neighbourhood (one
+// pixel's two samples say too little); at 1 spp, which has no moments, the spread of the
+// 3×3 pixels' luminance (signal detail included: an overestimate, which only slows the
+// first frames).
+float fresh_noise(ivec2 p, ivec2 size) {
+    float sum = 0.0, s1 = 0.0, s2 = 0.0;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 q = clamp(p + ivec2(dx, dy), ivec2(0), size - 1);
+            if (pc.spp >= 2.0) {
+                sum += moment_noise(q);
+            } else {
+                vec3 c = imageLoad(noisy, q).rgb;
+                float y = all_finite(c) ? luminance(c) : 0.0;
+                s1 += y;
+                s2 += y * y;
+            }
+        }
+    }
+    if (pc.spp >= 2.0) return sum / 9.0 + TINY;
+    return max(s2 / 9.0 - (s1 / 9.0) * (s1 / 9.0), 0.0) * 9.0 / 8.0 + TINY;
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = ivec2(pc.width, pc.height);
+    if (p.x >= size.x || p.y >= size.y) return;
+
+    vec3 y = imageLoad(noisy, p).rgb;
+    if (!all_finite(y)) y = vec3(0.0);
+    Reprojection r = reproject(p, size, pc.history_valid != 0u, pc.camera.xyz, pc.tolerance);
+
+    vec3 x;
+    float P, R, streak = 0.0;
+    vec4 res = vec4(0.0, 0.0, 0.0, -1.0);  // no residual (a new filter has no history to lag)
+    vec4 m = r.valid ? history_fetch(model_prev, r) : vec4(0.0);
+    bool fresh = !r.valid || !all_finite(m.rgb) || !(m.a >= 0.0) || isinf(m.a);
+    if (fresh) {
+        x = y;
+        R = fresh_noise(p, size);
+        P = R;
+    } else {
+        vec2 st = history_fetch(noise_prev, r).xy;
+        // Predict: the measured change scales the estimate, its variance and the noise.
+        SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum);
+        float g = dot(sc.ratio, vec3(1.0 / 3.0));
+        x = m.rgb * sc.ratio;
+        P = m.a * g * g;
+        R = max(st.x * g * g, TINY);
+        streak = st.y;
+        float level = luminance(max(x, vec3(0.0)));
+        float Q = pc.change_q * sc.change * level;
+        Q *= Q;
+        if (length(r.motion) > STILL_PX) Q += pc.motion_q * R;
+        vec3 shift = vec3(0.0);
+        if (pc.lag_valid != 0u) {
+            // A residual the neighbourhood shares, beyond lag_z standard errors, is a
+            // measurement of what this frame's prediction missed, whose prior variance
+            // is the process noise Q: it is added with the gain Q / (Q + its variance),
+            // and its size is uncertain. Where nothing changes (Q = 0) nothing is added:
+            // a static view only averages.
+            vec4 lag = history_fetch(lag_prev, r);
+            float z2 = dot(lag.rgb, lag.rgb) / 3.0 / max(lag.a, TINY);
+            // The lag accumulates what the filter missed over its memory, about
+            // (P + R) / P frames of process noise.
+            float B = Q * (P + Q + R) / max(P + Q, TINY);
+            if (z2 > pc.lag_z * pc.lag_z) shift = B / (B + max(lag.a, TINY)) * lag.rgb;
+            x += shift;
+            Q += dot(shift, shift) / 3.0;
+        }
+        float P_prior = P + Q;
+
+        // Update, with the innovation's outliers clipped and jumps followed.
+        vec3 e = y - x;
+        float e2 = dot(e, e) / 3.0;
+        float nu2 = e2 / max(P_prior + R, TINY);
+        float z2 = pc.outlier_z * pc.outlier_z;
+        bool far = nu2 > z2;
+        streak = far ? streak + 1.0 : 0.0;
+        float R_eff = R;
+        P = P_prior;
+        if (far && streak >= 2.0) {
+            P += e2;  // a jump: the level moved by about the innovation
+            streak = 0.0;
+        } else if (far) {
+            R_eff = R * nu2 / z2;  // a spike counts as far as outlier_z deviations
+        }
+        float K = P / (P + R_eff);
+        x += K * e;
+        P = (1.0 - K) * P;
+        // The noise estimate over the filter's own memory: this frame's moments, or at
+        // 1 spp the innovation's excess over the prediction's variance.
+        float sample_R = fresh_noise(p, size);
+        R = max(R + K * (sample_R - R), TINY);
+        // What the update left unexplained, with the clipped innovation (a spike must not
+        // look like a shared lag), for the pooled lag test.
+        float clip = far ? sqrt(z2 / nu2) : 1.0;
+        res = vec4((1.0 - K) * clip * e, (1.0 - K) * (1.0 - K) * (P_prior + R_eff));
+        vec4 prev = history_fetch(residual_prev, r);
+        if (pc.lag_valid != 0u && prev.a > 0.0 && all_finite(prev.rgb)) {
+            vec3 carried = prev.rgb * sc.ratio - shift;
+            res.rgb = mix(carried, res.rgb, LAG_BLEND);
+        }
+        if (!all_finite(res.rgb) || !all_finite(res.aaa)) res = vec4(0.0, 0.0, 0.0, -1.0);
+    }
+    if (!all_finite(x) || !(P >= 0.0) || isinf(P)) {
+        x = y;
+        R = fresh_noise(p, size);
+        P = R;
+    }
+    imageStore(model_cur, p, vec4(x, P));
+    imageStore(noise_cur, p, vec4(R, streak, 0.0, 0.0));
+    imageStore(prediction, p, vec4(max(x, vec3(0.0)), P));
+    imageStore(residual, p, res);
+}
