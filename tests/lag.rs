@@ -4,9 +4,9 @@
 //! Run through the built binary's `dvr eval` at 32×32, 48 frames, against 64-spp
 //! references, so the per-frame curves are the ones `dvr eval` reports.
 //!
-//! (The mri moving-light scenes still lag at the end of their sweep at this size, where a
-//! terminator crosses the cortex faster than 4×4 strata resolve it; README, "Following
-//! change", gives the numbers. They are not asserted here.)
+//! (mri/point-light lags at the end of its sweep, where a terminator crosses the cortex
+//! faster than 4×4 strata resolve it; the README's gallery gives the numbers. It is not
+//! asserted here.)
 
 use std::collections::HashMap;
 use std::path::Path;

@@ -26,6 +26,52 @@ use crate::graph::{Bindings, BufferHandle, Extent, Frame, History, ImageHandle, 
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::SceneBindings;
 
+/// One overridable parameter of a denoiser: its name, the range it takes, and where it
+/// goes.
+pub type Overridable<P> = (&'static str, f32, f32, fn(&mut P, f32));
+
+/// `params` with the `name=value` pairs of `spec` (comma-separated, e.g. from the
+/// environment variable `variable`) applied, for parameter studies with `dvr eval`. An
+/// unknown name lists the known ones; a value outside its range (or not finite) is an
+/// error naming the range.
+pub fn with_overrides<P>(
+    mut params: P,
+    variable: &'static str,
+    spec: Option<&str>,
+    table: &[Overridable<P>],
+) -> Result<P> {
+    let Some(spec) = spec else {
+        return Ok(params);
+    };
+    for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let bad = |problem: String| EngineError::InvalidSetting {
+            name: variable,
+            value: format!("{item:?}"),
+            allowed: problem,
+        };
+        let (name, value) = item
+            .split_once('=')
+            .ok_or_else(|| bad("expected name=value pairs, comma-separated".into()))?;
+        let v: f64 = value
+            .trim()
+            .parse()
+            .map_err(|e| bad(format!("the value must be a number ({e})")))?;
+        let (_, lo, hi, set) = table
+            .iter()
+            .find(|(n, ..)| *n == name.trim())
+            .ok_or_else(|| {
+                let known: Vec<&str> = table.iter().map(|(n, ..)| *n).collect();
+                bad(format!("parameters: {}", known.join(", ")))
+            })?;
+        // Checked as given (f64), so the documented inclusive bounds hold.
+        if !(v >= f64::from(*lo) && v <= f64::from(*hi)) {
+            return Err(bad(format!("{} must be in [{lo}, {hi}]", name.trim())));
+        }
+        set(&mut params, v as f32);
+    }
+    Ok(params)
+}
+
 /// Disocclusion tolerance of the shared reprojection (include/reproject.glsl): how far,
 /// in pixels, last frame's surface may land from this pixel when projected back.
 pub const REPROJECTION_TOLERANCE_PX: f32 = 1.5;

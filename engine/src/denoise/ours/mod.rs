@@ -28,8 +28,8 @@ mod gradient_pool;
 mod lag;
 mod update;
 
-use super::{DenoiseInputs, Denoiser, MotionSource};
-use crate::error::{EngineError, Result};
+use super::{DenoiseInputs, Denoiser, MotionSource, Overridable};
+use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::path_trace::{self, PathTraceFeatures};
@@ -87,8 +87,7 @@ impl Default for OursParams {
 
 /// The parameters `DVR_OURS` may set (for parameter studies with `dvr eval`), with the
 /// range each takes.
-#[allow(clippy::type_complexity)]
-const OVERRIDABLE: &[(&str, f32, f32, fn(&mut OursParams, f32))] = &[
+const OVERRIDABLE: &[Overridable<OursParams>] = &[
     ("stratum", 1.0, 16.0, |p, v| p.stratum = v as u32),
     ("shrink", 0.0, 1e3, |p, v| p.shrink = v),
     ("change_q", 0.0, 1e3, |p, v| p.change_q = v),
@@ -101,36 +100,9 @@ const OVERRIDABLE: &[(&str, f32, f32, fn(&mut OursParams, f32))] = &[
 
 impl OursParams {
     /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
-    /// `DVR_OURS="change_q=2,kappa=3"`; a value outside its range (or not finite) is an
-    /// error naming the range.
-    pub fn with_overrides(mut self, spec: Option<&str>) -> Result<Self> {
-        let Some(spec) = spec else { return Ok(self) };
-        for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let bad = |problem: String| EngineError::InvalidSetting {
-                name: "DVR_OURS",
-                value: format!("{item:?}"),
-                allowed: problem,
-            };
-            let (name, value) = item
-                .split_once('=')
-                .ok_or_else(|| bad("expected name=value pairs, comma-separated".into()))?;
-            let v: f64 = value
-                .trim()
-                .parse()
-                .map_err(|e| bad(format!("the value must be a number ({e})")))?;
-            let (_, lo, hi, set) = OVERRIDABLE
-                .iter()
-                .find(|(n, ..)| *n == name.trim())
-                .ok_or_else(|| {
-                    let known: Vec<&str> = OVERRIDABLE.iter().map(|(n, ..)| *n).collect();
-                    bad(format!("parameters: {}", known.join(", ")))
-                })?;
-            if !(v >= f64::from(*lo) && v <= f64::from(*hi)) {
-                return Err(bad(format!("{} must be in [{lo}, {hi}]", name.trim())));
-            }
-            set(&mut self, v as f32);
-        }
-        Ok(self)
+    /// `DVR_OURS="change_q=2,kappa=3"`.
+    pub fn with_overrides(self, spec: Option<&str>) -> Result<Self> {
+        super::with_overrides(self, "DVR_OURS", spec, OVERRIDABLE)
     }
 }
 
@@ -248,5 +220,38 @@ impl Denoiser for Ours {
             Some(pipeline) => self.add_atrous(pipeline, ctx, graph, frame, input.size, estimate),
             None => Ok(estimate),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overrides_are_named_and_range_checked() {
+        let p = OursParams::default()
+            .with_overrides(Some("change_q=2, kappa=3"))
+            .expect("valid overrides");
+        assert_eq!((p.change_q, p.kappa), (2.0, 3.0));
+        assert_eq!(
+            OursParams::default().with_overrides(None).ok(),
+            Some(OursParams::default())
+        );
+        for (spec, says) in [
+            ("kappa=nan", "kappa must be in"),
+            ("keep=1e30", "keep must be in"),
+            ("outlier_z=0.1", "outlier_z must be in"),
+            ("lambda=0.9", "parameters: stratum"),
+            ("kappa", "name=value"),
+            ("kappa=x", "a number"),
+        ] {
+            let e = OursParams::default()
+                .with_overrides(Some(spec))
+                .expect_err(spec)
+                .to_string();
+            assert!(e.contains("DVR_OURS") && e.contains(says), "{spec}: {e}");
+        }
+        // Inclusive bounds hold for the value as given.
+        assert!(OursParams::default().with_overrides(Some("keep=1")).is_ok());
     }
 }

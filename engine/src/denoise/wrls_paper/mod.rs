@@ -13,8 +13,8 @@
 mod spatial;
 mod update;
 
-use super::{DenoiseInputs, Denoiser, MotionSource};
-use crate::error::{EngineError, Result};
+use super::{DenoiseInputs, Denoiser, MotionSource, Overridable};
+use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use ash::vk;
@@ -67,8 +67,7 @@ impl Default for WrlsParams {
 }
 
 /// The parameters `DVR_WRLS` may set, the range each takes, and where each goes.
-#[allow(clippy::type_complexity)]
-const OVERRIDABLE: &[(&str, f32, f32, fn(&mut WrlsParams, f32))] = &[
+const OVERRIDABLE: &[Overridable<WrlsParams>] = &[
     ("lambda", 0.01, 1.0, |p, v| p.lambda = v),
     ("lambda_moving", 0.01, 1.0, |p, v| p.lambda_moving = v),
     ("alpha", 0.0, 1.0, |p, v| p.alpha = v),
@@ -80,36 +79,9 @@ const OVERRIDABLE: &[(&str, f32, f32, fn(&mut WrlsParams, f32))] = &[
 
 impl WrlsParams {
     /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
-    /// `DVR_WRLS="lambda=0.99,kappa=3"`: for parameter studies with `dvr eval`. A value
-    /// outside its range (or not finite) is an error naming the range.
-    pub fn with_overrides(mut self, spec: Option<&str>) -> Result<Self> {
-        let Some(spec) = spec else { return Ok(self) };
-        for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let bad = |problem: String| EngineError::InvalidSetting {
-                name: "DVR_WRLS",
-                value: format!("{item:?}"),
-                allowed: problem,
-            };
-            let (name, value) = item
-                .split_once('=')
-                .ok_or_else(|| bad("expected name=value pairs, comma-separated".into()))?;
-            let v: f64 = value
-                .trim()
-                .parse()
-                .map_err(|e| bad(format!("the value must be a number ({e})")))?;
-            let (_, lo, hi, set) = OVERRIDABLE
-                .iter()
-                .find(|(n, ..)| *n == name.trim())
-                .ok_or_else(|| {
-                    let known: Vec<&str> = OVERRIDABLE.iter().map(|(n, ..)| *n).collect();
-                    bad(format!("parameters: {}", known.join(", ")))
-                })?;
-            if !(v >= f64::from(*lo) && v <= f64::from(*hi)) {
-                return Err(bad(format!("{} must be in [{lo}, {hi}]", name.trim())));
-            }
-            set(&mut self, v as f32);
-        }
-        Ok(self)
+    /// `DVR_WRLS="lambda=0.99,kappa=3"`.
+    pub fn with_overrides(self, spec: Option<&str>) -> Result<Self> {
+        super::with_overrides(self, "DVR_WRLS", spec, OVERRIDABLE)
     }
 }
 
