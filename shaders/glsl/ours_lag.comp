@@ -27,6 +27,8 @@ layout(constant_id = 15) const int LAG_RADIUS = 2;
 // Share of the window that must hold a residual for the mean to count (next to a
 // disocclusion, a few old pixels say little about a region).
 const float MIN_SHARE = 0.5;
+// The variance written where there is no estimate: so large that no mean is significant.
+const float NO_ESTIMATE = 1e30;
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -49,7 +51,7 @@ void main() {
     // Fewer than half the neighbours with a residual: no estimate (variance infinite).
     float min_n = MIN_SHARE * float((2 * LAG_RADIUS + 1) * (2 * LAG_RADIUS + 1));
     if (n < min_n) {
-        imageStore(lag, p, vec4(0.0, 0.0, 0.0, 1e30));
+        imageStore(lag, p, vec4(0.0, 0.0, 0.0, NO_ESTIMATE));
         return;
     }
     // The variance of the mean from the residuals' own scatter (a t-test): Monte Carlo

@@ -26,7 +26,7 @@
 //
 // State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (rg32f:
 // x the measurement noise R, y frames in a row with a far innovation).
-// Outputs: the estimate with its variance for the à-trous filter (ours_atrous.comp), and
+// Outputs: the estimate with its variance for the à-trous filter (variance_atrous.comp), and
 // the a-posteriori residual with its variance for the pooled lag test (ours_lag.comp).
 #include "common.glsl"
 #include "reproject.glsl"

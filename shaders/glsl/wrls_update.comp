@@ -32,7 +32,7 @@ layout(binding = 17) uniform sampler2D errors_prev;
 layout(binding = 18, rgba32f) uniform writeonly image2D constant_cur;
 layout(binding = 19, rgba32f) uniform writeonly image2D errors_cur;
 // This pixel's prediction after the update (rgb) and its variance per channel (a), what
-// the à-trous spatial filter (wrls_atrous.comp) starts from.
+// the à-trous spatial filter (variance_atrous.comp) starts from.
 layout(binding = 25, rgba32f) uniform writeonly image2D prediction;
 
 layout(push_constant) uniform WrlsUpdatePush {

@@ -9,6 +9,7 @@ pub mod rae;
 pub mod registry;
 pub mod svgf;
 pub mod taa;
+pub mod variance_atrous;
 pub mod wrls_paper;
 
 pub use accum::Accum;

@@ -1,4 +1,4 @@
-// The shared-memory window of an à-trous level (ours' wrls_atrous.comp, SVGF's
+// The shared-memory window of an à-trous level (variance_atrous.comp and SVGF's
 // svgf_atrous.comp). The 8×8 outputs of a workgroup read a (8 + 4·step)² window of their
 // inputs; for steps up to TILE_MAX_STEP the group loads it into shared memory once, each
 // texel once instead of up to 25 times from memory, and the taps read it there. Wider

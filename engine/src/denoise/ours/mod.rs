@@ -17,7 +17,7 @@
 //!   update;
 //! - `<name>.lag` ([`lag`], `ours_lag.comp`): the pooled lag test, read by next frame's
 //!   update;
-//! - `<name>.atrous0..k` ([`atrous`], `ours_atrous.comp`): the à-trous spatial filter.
+//! - `<name>.atrous0..2` ([`atrous`], `variance_atrous.comp`): the à-trous spatial filter.
 //!
 //! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-atrous`) switch one part
 //! off each ([`OursVariant`]).
@@ -28,13 +28,13 @@ mod gradient_pool;
 mod lag;
 mod update;
 
+use super::variance_atrous::{self, VarianceAtrousPush};
 use super::{DenoiseInputs, Denoiser, MotionSource, Overridable};
 use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::path_trace::{self, PathTraceFeatures};
 use ash::vk;
-use atrous::OursAtrousPush;
 use gradient::OursGradientPush;
 use gradient_pool::OursGradientPoolPush;
 use lag::OursLagPush;
@@ -136,7 +136,7 @@ pub struct Ours {
     gradient_pool: Option<Pipeline<OursGradientPoolPush>>,
     update: Pipeline<OursUpdatePush>,
     lag: Option<Pipeline<OursLagPush>>,
-    atrous: Option<Pipeline<OursAtrousPush>>,
+    atrous: Option<Pipeline<VarianceAtrousPush>>,
 }
 
 /// The pooled lag test's window radius (5×5).
@@ -180,12 +180,7 @@ impl Ours {
                 .transpose()?,
             atrous: variant
                 .atrous
-                .then(|| {
-                    ctx.pipeline(
-                        "ours_atrous",
-                        &[("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles))],
-                    )
-                })
+                .then(|| variance_atrous::pipeline(ctx))
                 .transpose()?,
         })
     }

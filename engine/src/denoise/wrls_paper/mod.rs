@@ -7,18 +7,19 @@
 //!   weighted RLS: `wrls_update.comp` for the paper's p = [1, z] (nine state images),
 //!   `wrls_constant.comp` for p = [1] (two);
 //! - `<name>.spatial` (`wrls_spatial.comp`): the paper's 5×5 model blending, or for p =
-//!   [1] `<name>.atrous0` (`wrls_atrous.comp`): one 5×5 level over the predictions
+//!   [1] `<name>.atrous0` (`variance_atrous.comp`): one 5×5 level over the predictions
 //!   ([`spatial`]).
 
 mod spatial;
 mod update;
 
+use super::variance_atrous::{self, VarianceAtrousPush};
 use super::{DenoiseInputs, Denoiser, MotionSource, Overridable};
 use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use ash::vk;
-use spatial::{WrlsAtrousPush, WrlsSpatialPush};
+use spatial::WrlsSpatialPush;
 use update::{WrlsConstantPush, WrlsUpdatePush};
 
 /// The paper's parameters (λ, α, h, δ, the 5×5 blending) and the weights and restarts
@@ -115,7 +116,7 @@ impl WrlsVariant {
 /// The update's and the spatial pass's pipelines: the constant model with one à-trous
 /// level over its predictions, or the paper's feature models with their 5×5 blending.
 enum Passes {
-    Constant(Pipeline<WrlsConstantPush>, Pipeline<WrlsAtrousPush>),
+    Constant(Pipeline<WrlsConstantPush>, Pipeline<VarianceAtrousPush>),
     Feature(Pipeline<WrlsUpdatePush>, Pipeline<WrlsSpatialPush>),
 }
 
@@ -162,10 +163,7 @@ impl Wrls {
         } else {
             Passes::Constant(
                 ctx.pipeline("wrls_constant", &[weighted, motion_source, restart])?,
-                ctx.pipeline(
-                    "wrls_atrous",
-                    &[("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles))],
-                )?,
+                variance_atrous::pipeline(ctx)?,
             )
         };
         let params =

@@ -1,28 +1,15 @@
 //! The spatial pass: the paper's 5×5 model blending (`<name>.spatial`, wrls_spatial.comp)
 //! for the feature models, or for the constant model one 5×5 level of the à-trous filter
-//! over the predictions (`<name>.atrous0`, wrls_atrous.comp), edge-stopped by their
+//! over the predictions (`<name>.atrous0`, variance_atrous.comp), edge-stopped by their
 //! standard errors.
 
 use super::update::FeatureModels;
 use super::Wrls;
+use crate::denoise::variance_atrous::{add_level, Level, VarianceAtrousPush};
 use crate::denoise::DenoiseInputs;
 use crate::gpu::Pipeline;
 use crate::gpu_block;
 use crate::graph::{Extent, Frame, ImageHandle};
-
-gpu_block! {
-    /// `WrlsAtrousPush` in wrls_atrous.comp.
-    pub struct WrlsAtrousPush {
-        pub width: u32,
-        pub height: u32,
-        pub step: i32,
-        pub kappa: f32,
-        pub last: u32,
-        pub keep: f32,
-        pub pad1: u32,
-        pub pad2: u32,
-    }
-}
 
 gpu_block! {
     /// `WrlsSpatialPush` in wrls_spatial.comp.
@@ -42,31 +29,20 @@ impl Wrls {
     /// One 5×5 level over the constant model's predictions, from `prediction` into `out`.
     pub(super) fn add_atrous<'f>(
         &'f self,
-        pipeline: &'f Pipeline<WrlsAtrousPush>,
+        pipeline: &'f Pipeline<VarianceAtrousPush>,
         frame: &mut Frame<'f>,
         size: Extent,
         prediction: ImageHandle,
         out: ImageHandle,
     ) {
-        let push = WrlsAtrousPush {
-            width: size.width,
-            height: size.height,
+        let level = Level {
             step: 1,
             kappa: self.params.kappa,
-            last: 1,
             keep: 0.0,
-            pad1: 0,
-            pad2: 0,
+            last: true,
         };
-        frame.add_compute(
-            format!("{}.atrous0", self.name),
-            pipeline,
-            push,
-            size,
-            |b| {
-                b.read("color_in", prediction).write("color_out", out);
-            },
-        );
+        let name = format!("{}.atrous0", self.name);
+        add_level(frame, pipeline, name, size, level, prediction, out);
     }
 
     /// The paper's spatial pass: each pixel blends the predictions of the 25 models of

@@ -1,11 +1,12 @@
 #version 460
-// ours' spatial filter: one à-trous iteration (a 5×5 B3-spline kernel with taps `step`
-// pixels apart) over the per-pixel model predictions, dispatched with step 1, 2, 4, ….
-// A neighbour is weighted by how far its prediction lies from this pixel's in units of
-// their standard errors (what weighted RLS knows of its own uncertainty: the residual
-// noise level over the model's effective sample count), so converged models keep the
-// detail they resolved while young ones (after a change or a disocclusion) are averaged
-// over an ever wider footprint; each iteration passes on the variance of its output.
+// One à-trous iteration (a 5×5 B3-spline kernel with taps `step` pixels apart) over
+// per-pixel estimates that carry their own variance, dispatched with step 1, 2, 4, …: ours'
+// spatial filter over its Kalman estimates (three levels) and the one 5×5 level of the
+// paper's p = [1] models (`wrls-nf`, `rls-nf`, keep 0). A neighbour is weighted by how far
+// its estimate lies from this pixel's in units of their standard errors, so converged
+// estimates keep the detail they resolved while young ones (after a change or a
+// disocclusion) are averaged over an ever wider footprint; each iteration passes on the
+// variance of its output.
 #include "common.glsl"
 #include "atrous_tile.glsl"
 
@@ -14,7 +15,7 @@ layout(local_size_x = TILE, local_size_y = TILE) in;
 layout(binding = 0, rgba32f) uniform readonly image2D color_in;   // rgb prediction, a variance
 layout(binding = 1, rgba32f) uniform writeonly image2D color_out; // the same, filtered
 
-layout(push_constant) uniform WrlsAtrousPush {
+layout(push_constant) uniform VarianceAtrousPush {
     uint width;
     uint height;
     int step;     // tap spacing in pixels
