@@ -24,6 +24,8 @@ fn long_static_runs_stay_finite_and_bounded_for_every_temporal_method() {
     for name in [
         "ours",
         "wrls-paper",
+        "rls-paper",
+        "wrls",
         "rls",
         "wrls-nf",
         "rls-nf",
@@ -69,12 +71,12 @@ fn spike_response(name: &str) -> f32 {
 
 #[test]
 fn weighted_rls_gives_spikes_far_less_influence_than_rls() {
-    let ours = spike_response("ours");
+    let wrls = spike_response("wrls");
     let rls = spike_response("rls");
-    println!("mean output change at 100× spikes: ours {ours:.4}, rls {rls:.4}");
+    println!("mean output change at 100× spikes: wrls {wrls:.4}, rls {rls:.4}");
     assert!(
-        ours * 5.0 < rls,
-        "ours {ours} vs rls {rls}: weighting should suppress spikes"
+        wrls * 5.0 < rls,
+        "wrls {wrls} vs rls {rls}: weighting should suppress spikes"
     );
     let ours_nf = spike_response("wrls-nf");
     let rls_nf = spike_response("rls-nf");

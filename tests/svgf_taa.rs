@@ -11,7 +11,7 @@ mod common;
 
 use ash::vk;
 use common::*;
-use dvr_engine::denoise::svgf::{edge, SvgfParams, ITERATIONS};
+use dvr_engine::denoise::svgf::{edge, SvgfParams};
 use dvr_engine::denoise::{self, Changes, DenoiseInputs, Denoiser};
 use dvr_engine::gpu::{GpuContext, ImageDesc};
 use dvr_engine::graph::Extent;
@@ -348,7 +348,7 @@ fn cpu_svgf_frame0(s: &Scene, noisy: &[Px], p: &SvgfParams) -> Vec<[f32; 3]> {
         }
     }
     // À-trous iterations.
-    for it in 0..ITERATIONS {
+    for it in 0..p.iterations {
         let step = 1i32 << it;
         let mut next = Vec::with_capacity(W * H);
         for y in 0..H as i32 {

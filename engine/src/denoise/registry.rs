@@ -174,7 +174,17 @@ pub const DENOISERS: &[DenoiserInfo] = &[
         "the paper's weighted RLS denoiser (TVCG §5–6) as published",
         WrlsVariant { paper_predictor: true, restart_on_change: false, ..PAPER },
     ),
-    // The paper's ablations (Fig. 8).
+    wrls(
+        "rls-paper",
+        "wrls-paper without its weights (w = 1): the paper's RLS-F ablation on its own predictor",
+        WrlsVariant { weighted: false, paper_predictor: true, restart_on_change: false, ..PAPER },
+    ),
+    wrls(
+        "wrls",
+        "the paper's weighted RLS on the family's base: the feature from the reprojected history, residual weights, restarts",
+        PAPER,
+    ),
+    // The paper's ablations (Fig. 8) of `wrls`.
     wrls(
         "rls",
         "the paper's RLS-F ablation: unweighted RLS",

@@ -83,9 +83,6 @@ gpu_block! {
     }
 }
 
-/// Number of à-trous iterations (steps 1, 2, 4, 8, 16).
-pub const ITERATIONS: usize = 5;
-
 /// The paper's parameters, and this implementation's few extra constants.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SvgfParams {
@@ -105,6 +102,10 @@ pub struct SvgfParams {
     pub demod_eps: f32,
     /// Disocclusion tolerance in pixels (see [`super::REPROJECTION_TOLERANCE_PX`]).
     pub tolerance: f32,
+    /// À-trous iterations (steps 1, 2, 4, …).
+    pub iterations: u32,
+    /// The iteration (0-based) whose output becomes the colour history.
+    pub feedback: u32,
 }
 
 impl SvgfParams {
@@ -119,8 +120,38 @@ impl SvgfParams {
         luminance_eps: 1e-6,
         demod_eps: 0.01,
         tolerance: super::REPROJECTION_TOLERANCE_PX,
+        iterations: 5,
+        feedback: 0,
     };
+
+    /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
+    /// `DVR_SVGF="color_alpha=0.05,sigma_l=10"`.
+    pub fn with_overrides(self, spec: Option<&str>) -> Result<Self> {
+        let p = super::with_overrides(self, "DVR_SVGF", spec, OVERRIDABLE)?;
+        if p.feedback + 1 >= p.iterations {
+            return Err(crate::error::EngineError::InvalidSetting {
+                name: "DVR_SVGF",
+                value: format!("feedback={}, iterations={}", p.feedback, p.iterations),
+                allowed: "a fed-back iteration before the last (feedback < iterations - 1)".into(),
+            });
+        }
+        Ok(p)
+    }
 }
+
+/// The parameters `DVR_SVGF` may set (for parameter studies with `dvr eval`), with the
+/// range each takes.
+const OVERRIDABLE: &[super::Overridable<SvgfParams>] = &[
+    ("color_alpha", 0.0, 1.0, |p, v| p.color_alpha = v),
+    ("moments_alpha", 0.0, 1.0, |p, v| p.moments_alpha = v),
+    ("min_history", 1.0, 1e3, |p, v| p.min_history = v),
+    ("sigma_z", 0.0, 1e3, |p, v| p.sigma_z = v),
+    ("sigma_n", 0.0, 1e4, |p, v| p.sigma_n = v),
+    ("sigma_l", 0.0, 1e3, |p, v| p.sigma_l = v),
+    ("demod_eps", 1e-6, 1e6, |p, v| p.demod_eps = v),
+    ("iterations", 1.0, 8.0, |p, v| p.iterations = v as u32),
+    ("feedback", 0.0, 7.0, |p, v| p.feedback = v as u32),
+];
 
 impl Default for SvgfParams {
     fn default() -> Self {
@@ -141,6 +172,8 @@ pub struct Svgf {
 
 impl Svgf {
     pub fn new(ctx: &GpuContext, name: &'static str, motion: MotionSource) -> Result<Self> {
+        let params =
+            SvgfParams::default().with_overrides(std::env::var("DVR_SVGF").ok().as_deref())?;
         Ok(Self {
             name,
             temporal: ctx.pipeline(
@@ -152,7 +185,7 @@ impl Svgf {
                 "svgf_atrous",
                 &[("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles))],
             )?,
-            params: SvgfParams::default(),
+            params,
             motion,
         })
     }
@@ -226,15 +259,19 @@ impl Denoiser for Svgf {
                 .write("estimated", pong);
         });
 
-        // pong → colour history → ping → pong → ping → out.
+        // pong → … → out, the output of iteration `feedback` into the colour history
+        // (with the paper's 5 and 0: pong → colour history → ping → pong → ping → out).
         let mut src = pong;
-        for i in 0..ITERATIONS {
-            let last = i + 1 == ITERATIONS;
-            let dst = match i {
-                0 => color.cur,
-                _ if last => out,
-                _ if i % 2 == 1 => ping,
-                _ => pong,
+        for i in 0..p.iterations {
+            let last = i + 1 == p.iterations;
+            let dst = if last {
+                out
+            } else if i == p.feedback {
+                color.cur
+            } else if src == ping {
+                pong
+            } else {
+                ping
             };
             let apush = SvgfAtrousPush {
                 width: size.width,
@@ -439,6 +476,37 @@ pub mod edge {
             assert!((s1 - 1.0).abs() < 1e-7);
             let s2: f32 = k.iter().flat_map(|a| k.iter().map(move |b| a * b)).sum();
             assert!((s2 - 1.0).abs() < 1e-6);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SvgfParams;
+
+    #[test]
+    fn overrides_are_named_range_checked_and_consistent() {
+        let p = SvgfParams::default()
+            .with_overrides(Some(
+                "color_alpha=0.05, sigma_l=10, iterations=4, feedback=1",
+            ))
+            .expect("valid overrides");
+        assert_eq!(
+            (p.color_alpha, p.sigma_l, p.iterations, p.feedback),
+            (0.05, 10.0, 4, 1)
+        );
+        for (spec, says) in [
+            ("color_alpha=2", "color_alpha must be in"),
+            ("iterations=0", "iterations must be in"),
+            ("feedback=4", "before the last"),
+            ("iterations=1", "before the last"),
+            ("alpha=0.1", "parameters: color_alpha"),
+        ] {
+            let e = SvgfParams::default()
+                .with_overrides(Some(spec))
+                .expect_err(spec)
+                .to_string();
+            assert!(e.contains("DVR_SVGF") && e.contains(says), "{spec}: {e}");
         }
     }
 }

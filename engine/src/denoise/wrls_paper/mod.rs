@@ -1,6 +1,8 @@
-//! The paper's weighted-RLS family (TVCG §5–6): `wrls-paper` (its exact formulation),
-//! and its Fig. 8 ablations `rls` (no weighting), `wrls-nf` (no temporal feature, p =
-//! [1]) and `rls-nf` (neither), from the same passes through specialisation constants.
+//! The paper's weighted-RLS family (TVCG §5–6): `wrls-paper` (its exact formulation) and
+//! `rls-paper` (the same without weights), the family's base `wrls` (the feature from the
+//! reprojected history, residual weights, restarts) and its Fig. 8 ablations `rls` (no
+//! weighting), `wrls-nf` (no temporal feature, p = [1]) and `rls-nf` (neither), from the
+//! same passes through specialisation constants.
 //!
 //! Passes of a frame, in order (each in its own file here):
 //! - `<name>.update` ([`update`]): the per-pixel models reprojected and updated by
