@@ -303,10 +303,17 @@ fn cpu_svgf_frame0(s: &Scene, noisy: &[Px], p: &SvgfParams) -> Vec<[f32; 3]> {
                 }
             };
             let n = s.normal[i];
+            // As svgf_temporal packs it: no threshold surface is the medium where the
+            // ray meets any (an expected collision), else the background.
+            let class = match (valid(i), s.position[i][3] > 0.0) {
+                (true, _) => z,
+                (false, true) => edge::MEDIUM,
+                (false, false) => edge::BACKGROUND,
+            };
             geo.push(Geo {
                 valid: valid(i),
                 n: Vec3::new(n[0], n[1], n[2]),
-                z,
+                z: class,
                 slope: edge::depth_slope(axis(1, 0).max(axis(0, 1)), quantum),
             });
         }

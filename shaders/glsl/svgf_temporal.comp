@@ -69,7 +69,8 @@ void main() {
                              axis_gradient(p, ivec2(0, 1), size, nz.w));
         dz = svgf_depth_slope(gradient, quantum);
     }
-    imageStore(geometry, p, svgf_pack_geometry(valid, nz.xyz, nz.w, dz));
+    bool medium = imageLoad(position_cur, p).w > 0.0;
+    imageStore(geometry, p, svgf_pack_geometry(valid, medium, nz.xyz, nz.w, dz));
 
     vec3 c = imageLoad(noisy, p).rgb;
     if (!all_finite(c)) c = vec3(0.0);

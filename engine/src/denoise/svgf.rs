@@ -325,8 +325,14 @@ pub mod edge {
         sigma_l * variance.max(0.0).sqrt() + eps
     }
 
-    /// `svgf_geometry_weight`: depth × normal weight, 0 between valid and invalid pixels,
-    /// 1 between two invalid ones.
+    /// `z` of a pixel without a threshold surface whose ray meets nothing
+    /// (`SVGF_BACKGROUND`) or still meets the medium (`SVGF_MEDIUM`).
+    pub const BACKGROUND: f32 = -1.0;
+    pub const MEDIUM: f32 = -2.0;
+
+    /// `svgf_geometry_weight`: depth × normal weight between two surface pixels; the
+    /// background mixes only with itself; the medium with the medium and with surfaces
+    /// (weight 1).
     #[allow(clippy::too_many_arguments)]
     pub fn geometry_weight(
         valid_p: bool,
@@ -338,11 +344,10 @@ pub mod edge {
         n_q: Vec3,
         sigma_n: f32,
     ) -> f32 {
-        if valid_p != valid_q {
-            return 0.0;
-        }
-        if !valid_p {
-            return 1.0;
+        if !valid_p || !valid_q {
+            let zp = if valid_p { MEDIUM } else { z_p };
+            let zq = if valid_q { MEDIUM } else { z_q };
+            return if zp == zq { 1.0 } else { 0.0 };
         }
         let w_n = n_p.dot(n_q).max(0.0).powf(sigma_n);
         let e_z = (z_p - z_q).abs() / phi_z.max(1e-20);
@@ -452,12 +457,18 @@ pub mod edge {
         }
 
         #[test]
-        fn invalid_pixels_mix_only_with_invalid_ones() {
+        fn background_mixes_only_with_itself_and_medium_with_all_but_background() {
             let phi = phi_z(P.sigma_z, 0.01, 1.0);
-            let g = |vp, vq| geometry_weight(vp, vq, 1.0, -1.0, phi, Vec3::Z, Vec3::ZERO, 128.0);
-            assert_eq!(g(true, false), 0.0);
-            assert_eq!(g(false, true), 0.0);
-            assert_eq!(g(false, false), 1.0);
+            let g = |vp, zp, vq, zq| geometry_weight(vp, vq, zp, zq, phi, Vec3::Z, Vec3::Z, 128.0);
+            // Surface (z 1) and background.
+            assert_eq!(g(true, 1.0, false, BACKGROUND), 0.0);
+            assert_eq!(g(false, BACKGROUND, true, 1.0), 0.0);
+            assert_eq!(g(false, BACKGROUND, false, BACKGROUND), 1.0);
+            // Medium with surface and medium, not with background.
+            assert_eq!(g(true, 1.0, false, MEDIUM), 1.0);
+            assert_eq!(g(false, MEDIUM, true, 1.0), 1.0);
+            assert_eq!(g(false, MEDIUM, false, MEDIUM), 1.0);
+            assert_eq!(g(false, MEDIUM, false, BACKGROUND), 0.0);
         }
 
         #[test]

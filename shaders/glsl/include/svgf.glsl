@@ -19,8 +19,12 @@ vec3 svgf_demod_factor(vec4 albedo, float eps) {
 
 // Edge-stopping features of one pixel, packed by svgf_temporal into one rgba32f texel:
 // octahedral normal (xy), linear depth along the ray (z), depth slope (w, see
-// svgf_depth_slope) in depth units per pixel; an invalid pixel (no surface: features.albedo.w = 0, the same flag as
-// features.position.w) is stored as z = -1.
+// svgf_depth_slope) in depth units per pixel. A pixel without a threshold surface
+// (features.albedo.w = 0) is stored as z = SVGF_MEDIUM where its ray still meets the
+// medium (a semi-transparent layer: features.position.w = 1, its expected collision) and
+// as z = SVGF_BACKGROUND where it meets nothing.
+const float SVGF_BACKGROUND = -1.0;
+const float SVGF_MEDIUM = -2.0;
 struct SvgfGeometry {
     bool valid;
     vec3 n;
@@ -32,8 +36,8 @@ vec2 svgf_sign_not_zero(vec2 v) {
     return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);
 }
 
-vec4 svgf_pack_geometry(bool valid, vec3 n, float z, float dz) {
-    if (!valid) return vec4(0.0, 0.0, -1.0, 0.0);
+vec4 svgf_pack_geometry(bool valid, bool medium, vec3 n, float z, float dz) {
+    if (!valid) return vec4(0.0, 0.0, medium ? SVGF_MEDIUM : SVGF_BACKGROUND, 0.0);
     n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-20);
     vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * svgf_sign_not_zero(n.xy);
     return vec4(e, z, dz);
@@ -71,12 +75,18 @@ float svgf_phi_l(float sigma_l, float variance, float eps) {
 }
 
 // Depth and normal part of the weight between centre p and tap q, with the validity
-// rule: valid and invalid pixels never mix (weight 0); two invalid pixels (background)
-// have no geometry to differ in (weight 1). [mirror]
+// rule: the background (no medium: z = SVGF_BACKGROUND) mixes only with itself; a pixel
+// in the semi-transparent medium (z = SVGF_MEDIUM) has no geometry to differ in and
+// mixes with the medium and with surfaces (weight 1, the luminance decides), so a few
+// pixels whose rays reach the opacity threshold at a vessel or along a rim are not left
+// to filter among themselves. [mirror]
 float svgf_geometry_weight(bool valid_p, bool valid_q, float z_p, float z_q, float phi_z,
                            vec3 n_p, vec3 n_q, float sigma_n) {
-    if (valid_p != valid_q) return 0.0;
-    if (!valid_p) return 1.0;
+    if (!valid_p || !valid_q) {
+        float zp = valid_p ? SVGF_MEDIUM : z_p;
+        float zq = valid_q ? SVGF_MEDIUM : z_q;
+        return zp == zq ? 1.0 : 0.0;
+    }
     float w_n = pow(max(0.0, dot(n_p, n_q)), sigma_n);
     float e_z = abs(z_p - z_q) / max(phi_z, 1e-20);
     return exp(-e_z) * w_n;
