@@ -21,6 +21,9 @@ layout(binding = 5) uniform sampler2D moments_prev;  // m1, m2, history length
 layout(binding = 6, rgba32f) uniform writeonly image2D integrated;  // demodulated rgb, a variance
 layout(binding = 7, rgba32f) uniform writeonly image2D moments_cur;
 layout(binding = 8, rgba32f) uniform writeonly image2D geometry;    // see svgf.glsl
+// The surface features' position (w = 1 where the ray meets the medium), whatever the
+// motion source: the medium/background class must not follow a noisy first collision.
+layout(binding = 9, rgba32f) uniform readonly image2D feature_position;
 
 layout(push_constant) uniform SvgfTemporalPush {
     vec4 camera;          // xyz camera position
@@ -69,7 +72,7 @@ void main() {
                              axis_gradient(p, ivec2(0, 1), size, nz.w));
         dz = svgf_depth_slope(gradient, quantum);
     }
-    bool medium = imageLoad(position_cur, p).w > 0.0;
+    bool medium = imageLoad(feature_position, p).w > 0.0;
     imageStore(geometry, p, svgf_pack_geometry(valid, medium, nz.xyz, nz.w, dz));
 
     vec3 c = imageLoad(noisy, p).rgb;

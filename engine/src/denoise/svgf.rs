@@ -217,7 +217,7 @@ impl Denoiser for Svgf {
         let p = self.params;
         let noisy = input.noisy;
         let features = input.features(self.name())?;
-        let (albedo, normal) = (features.albedo, features.normal);
+        let (albedo, normal, position) = (features.albedo, features.normal, features.position.cur);
 
         let push = SvgfTemporalPush {
             camera: input.camera.extend(1.0),
@@ -235,6 +235,7 @@ impl Denoiser for Svgf {
             b.read("noisy", noisy)
                 .read("feature_albedo", albedo)
                 .read("feature_normal", normal)
+                .read("feature_position", position)
                 .sampled("color_prev", color.prev)
                 .sampled("moments_prev", moments.prev)
                 .write("integrated", ping)
@@ -345,9 +346,11 @@ pub mod edge {
         sigma_n: f32,
     ) -> f32 {
         if !valid_p || !valid_q {
-            let zp = if valid_p { MEDIUM } else { z_p };
-            let zq = if valid_q { MEDIUM } else { z_q };
-            return if zp == zq { 1.0 } else { 0.0 };
+            return if (z_p == BACKGROUND) == (z_q == BACKGROUND) {
+                1.0
+            } else {
+                0.0
+            };
         }
         let w_n = n_p.dot(n_q).max(0.0).powf(sigma_n);
         let e_z = (z_p - z_q).abs() / phi_z.max(1e-20);

@@ -82,11 +82,7 @@ float svgf_phi_l(float sigma_l, float variance, float eps) {
 // to filter among themselves. [mirror]
 float svgf_geometry_weight(bool valid_p, bool valid_q, float z_p, float z_q, float phi_z,
                            vec3 n_p, vec3 n_q, float sigma_n) {
-    if (!valid_p || !valid_q) {
-        float zp = valid_p ? SVGF_MEDIUM : z_p;
-        float zq = valid_q ? SVGF_MEDIUM : z_q;
-        return zp == zq ? 1.0 : 0.0;
-    }
+    if (!valid_p || !valid_q) return (z_p == SVGF_BACKGROUND) == (z_q == SVGF_BACKGROUND) ? 1.0 : 0.0;
     float w_n = pow(max(0.0, dot(n_p, n_q)), sigma_n);
     float e_z = abs(z_p - z_q) / max(phi_z, 1e-20);
     return exp(-e_z) * w_n;
