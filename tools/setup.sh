@@ -3,7 +3,8 @@
 # lavapipe (CPU Vulkan), the validation layers, glslang/shaderc/SPIRV-Tools (static
 # archives that build.rs links), Xvfb for window tests, a TrueType font for the plots of
 # `dvr eval` (fonts-dejavu-core), Chromium, in which a test opens the eval's results
-# page headless, and ffmpeg, which encodes the videos of `--video` and the main job.
+# page headless, ffmpeg, which encodes the videos of `--video` and the main job, and
+# Python 3 with venv, for the Python package (`python/`) and its tests.
 # Idempotent: it installs only what is missing, so the README's commands can call it
 # every time.
 set -euo pipefail
@@ -12,6 +13,7 @@ packages=(
   mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers vulkan-tools
   libshaderc-dev glslang-dev glslang-tools spirv-tools
   pkg-config cmake
+  python3 python3-venv python3-pip
   fonts-dejavu-core chromium ffmpeg
   xvfb libx11-xcb1 libxcursor1 libxi6 libxrandr2 libxkbcommon-x11-0
 )

@@ -1,10 +1,22 @@
 #!/usr/bin/env bash
 # The test command: installs what is missing, then checks formatting and lints, and runs
 # every test on the Vulkan device (lavapipe on a machine without a GPU) with the
-# validation layer on. Any validation message fails the test that caused it.
+# validation layer on. Any validation message fails the test that caused it. Last, the
+# Python package: its wheel built and installed into a virtual environment
+# (target/py), and python/tests run against the installed wheel.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 DVR_VALIDATION=1 cargo test --workspace "$@"
+
+py=target/py/bin/python
+[ -x "$py" ] || python3 -m venv target/py
+"$py" -m pip install --quiet --disable-pip-version-check -r python/requirements-test.txt
+# The dev profile shares the engine's build with `cargo test` above.
+rm -rf target/wheels
+"$py" -m maturin build --quiet -m python/Cargo.toml -o target/wheels
+"$py" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps target/wheels/dvr-*.whl
+# From outside the checkout, so `import dvr` is the installed wheel, not python/dvr.
+(cd target && DVR_VALIDATION=1 DVR_BIN="$PWD/debug/dvr" "$PWD/py/bin/python" -m pytest -q ../python/tests)

@@ -35,7 +35,7 @@ pub fn rae_manifest(net: &str) -> PathBuf {
 }
 
 /// The folder of a shipped scene set (`assets/scenes/<set>/`, one scene file each):
-/// `validation` and `static`, the frozen sets `dvr eval --scene <set>` runs.
+/// `validation`, `static` and `paper`, the sets `dvr eval --scene <set>` runs.
 pub fn scene_set(set: &str) -> PathBuf {
     assets_dir().join("scenes").join(set)
 }

@@ -5,12 +5,12 @@
 
 use super::overlap::Overlap;
 use super::reference::ReferenceCache;
-use super::score::{score, FrameReference};
 use super::timing::Timing;
 use crate::progress::Progress;
 use crate::setup::Setup;
 use anyhow::Result;
 use dvr_engine::image_io::to_rgb;
+use dvr_engine::metrics::{score, FrameReference};
 use dvr_engine::renderer::Renderer;
 use std::sync::Arc;
 

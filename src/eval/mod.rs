@@ -37,7 +37,6 @@ pub mod plots;
 pub(crate) mod reference;
 pub mod run;
 mod scenes;
-mod score;
 pub mod timing;
 mod videos;
 
@@ -47,8 +46,9 @@ use anyhow::{Context, Result};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// Exposure of the tone map every metric and PNG of an eval uses.
-pub const EXPOSURE: f32 = 1.0;
+/// Exposure of the tone map every metric and PNG of an eval uses: the PNGs' own, so
+/// what is measured is what is shown (and what `dvr.metrics` in Python measures).
+pub const EXPOSURE: f32 = dvr_engine::image_io::PNG_EXPOSURE;
 
 /// A method's PSNR must come back within this many dB of its level before a sudden
 /// change for the change to count as recovered from.
@@ -61,8 +61,9 @@ pub const GPU_WARMUP_FRAMES: usize = crate::profile::WARMUP_FRAMES;
 #[derive(clap::Args, Clone, Debug)]
 pub struct EvalArgs {
     /// `suite` (every built-in scene but the stress ones), `stress` (the tf-jump,
-    /// light-jump and fast-orbit scenes), or a comma-separated list of built-in scene
-    /// names and scene files.
+    /// light-jump and fast-orbit scenes), a shipped set (`validation`, `static`,
+    /// `paper`: `assets/scenes/<set>/`), or a comma-separated list of these, built-in
+    /// scene names and scene files.
     #[arg(long, default_value = "suite")]
     pub scene: String,
     /// Frames of each animation (default: each scene's own length).

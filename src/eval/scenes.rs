@@ -10,9 +10,10 @@ use dvr_engine::scene::Scene;
 pub const STRESS_ANIMATIONS: [&str; 3] = ["tf-jump", "light-jump", "fast-orbit"];
 
 /// Scene sets shipped as folders of scene files (`assets/scenes/<set>/*.toml`): the
-/// frozen validation set (48 frames of continuous change each, never tuned on) and the
-/// static views.
-pub const FILE_SETS: [&str; 2] = ["validation", "static"];
+/// frozen validation set (48 frames of continuous change each, never tuned on), the
+/// static views, and `paper`, the TVCG paper's conditions (ray marching, single
+/// scattering with the hybrid phase, emission, one animation type per scene).
+pub const FILE_SETS: [&str; 3] = ["validation", "static", "paper"];
 
 /// The scene files of a shipped set, sorted by file name.
 fn set_files(set: &str) -> Result<Vec<String>> {
@@ -158,10 +159,14 @@ mod tests {
         assert!(validation.len() >= 8, "{validation:?}");
         let statics = select("static").unwrap();
         assert!(statics.len() >= 2, "{statics:?}");
-        for file in validation.iter().chain(&statics) {
+        let paper = select("paper").unwrap();
+        assert!(paper.len() >= 5, "{paper:?}");
+        for file in validation.iter().chain(&statics).chain(&paper) {
             let scene = Scene::load(file).unwrap_or_else(|e| panic!("{file}: {e}"));
             let set = if validation.contains(file) {
                 "val/"
+            } else if paper.contains(file) {
+                "paper/"
             } else {
                 "static/"
             };

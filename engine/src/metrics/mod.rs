@@ -23,6 +23,7 @@
 mod flip;
 mod psnr;
 mod recovery;
+mod score;
 mod ssim;
 mod temporal;
 mod tonemap;
@@ -30,6 +31,7 @@ mod tonemap;
 pub use flip::{flip, flip_colormap, FlipReference, FlipResult, DEFAULT_PPD};
 pub use psnr::{psnr, PSNR_CAP};
 pub use recovery::{frames_to_recover, RECOVERY_BASELINE_FRAMES};
+pub use score::{display, score, FrameReference, Scores};
 pub use ssim::ssim;
 pub use temporal::temporal_error;
 pub use tonemap::tonemap_srgb;

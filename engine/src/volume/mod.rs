@@ -65,7 +65,7 @@ pub use error::VolumeError;
 pub use majorant::MajorantGrid;
 pub use raw::{RawFormat, RawParams};
 
-use samples::Stored;
+use samples::{Samples, Stored};
 
 /// Largest accepted dimension along any axis.
 pub const MAX_DIM: u32 = 4096;
@@ -85,6 +85,16 @@ pub struct Volume {
     pub window: [f32; 2],
     /// The densities, x fastest, then y, then z.
     pub data: VolumeData,
+}
+
+/// Stored voxels as an application hands them over (x fastest), before normalisation:
+/// see [`Volume::from_voxels`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum Voxels {
+    U8(Vec<u8>),
+    U16(Vec<u16>),
+    I16(Vec<i16>),
+    F32(Vec<f32>),
 }
 
 /// Normalised voxel data: unorm integers or floats in `[0, 1]`, x fastest, then y, then z.
@@ -304,6 +314,34 @@ impl Volume {
             VolumeData::U16(v) => constant(v).map(|x| f32::from(x) / 65535.0),
             VolumeData::F32(v) => constant(v),
         }
+    }
+
+    /// A volume from stored voxels an application holds (the Python package's numpy
+    /// arrays), x fastest, normalised by the rule every file loader follows (see the
+    /// module docs): a float array already in `[0, 1]` is density as it is, anything
+    /// else is windowed. `name` stands in for a path in errors.
+    pub fn from_voxels(
+        name: &str,
+        dims: [u32; 3],
+        spacing: [f32; 3],
+        voxels: Voxels,
+    ) -> Result<Volume, VolumeError> {
+        let path = Path::new(name);
+        let dims = validate_dims(path, dims.map(i64::from))?;
+        let spacing = validate_spacing(path, "spacing", spacing.map(f64::from))?;
+        let samples = match voxels {
+            Voxels::U8(v) => Samples::U8(v),
+            Voxels::U16(v) => Samples::U16(v),
+            Voxels::I16(v) => Samples::I16(v),
+            Voxels::F32(v) => Samples::F32(v),
+        };
+        Volume::from_stored(
+            path,
+            name.to_string(),
+            dims,
+            spacing,
+            Stored::plain(samples),
+        )
     }
 
     /// Normalises decoded samples and wraps them (shared tail of every loader).

@@ -1,10 +1,11 @@
 //! The metrics of one frame of one method against its reference, all on tone-mapped
-//! sRGB display values (the same tone map and exposure as the PNGs).
+//! sRGB display values (the same tone map and exposure as the PNGs): what `dvr eval`
+//! reports and what the Python package's `dvr.metrics` computes.
 
-use super::EXPOSURE;
-use dvr_engine::metrics::{
+use super::{
     psnr, ssim, temporal_error, tonemap_srgb, FlipReference, Rgb32Image, DEFAULT_PPD, PSNR_CAP,
 };
+use crate::image_io::PNG_EXPOSURE as EXPOSURE;
 
 /// A reference frame prepared for scoring every method against it.
 pub struct FrameReference {

@@ -1,0 +1,73 @@
+"""The renderer: a scene at one size with its denoisers on one Vulkan device."""
+
+from . import _native
+from .scene import Scene
+
+__all__ = ["Renderer", "denoisers"]
+
+def denoisers() -> dict:
+    """The names :class:`Renderer` accepts in ``denoisers`` (the CLI's ``--denoiser``
+    names), each with its one-line description."""
+    return dict(_native.denoiser_names())
+
+
+class Renderer:
+    """Renders ``scene`` at ``size`` = (width, height) with ``spp`` samples per pixel per
+    frame (default: the scene's) and runs each of ``denoisers`` on the same noisy
+    frames. The temporal state lives here: calling :meth:`render` for frames 0..n in
+    order renders the animation. ``motion`` is what the temporal denoisers reproject
+    with (``"features"`` or ``"first-hit"``, as the CLI's ``--motion``).
+
+    The device is the one the CLI picks (``DVR_DEVICE`` forces one by name); without a
+    Vulkan device this raises ``RuntimeError``.
+    """
+
+    def __init__(self, scene: Scene, size=(128, 128), spp=None, denoisers=("ours",), motion="features"):
+        if isinstance(scene, str):
+            scene = Scene.builtin(scene) if scene in _native.builtin_scene_names() else Scene.load(scene)
+        if isinstance(denoisers, str):
+            denoisers = [denoisers]
+        size = tuple(int(x) for x in size)
+        if len(size) != 2:
+            raise ValueError(f"size: expected (width, height), got {size!r}")
+        self.scene = scene
+        tf = scene.tf.to_dict() if getattr(scene, "tf", None) is not None else None
+        self._r = _native.Renderer(
+            scene._engine_dict(), size, list(denoisers), volume=scene.volume, tf=tf, spp=spp, motion=motion
+        )
+
+    def render(self, frame=None, reset=False, aux=False) -> dict:
+        """Renders animation frame ``frame`` (default: the next) and returns
+        ``{"noisy": img, "<denoiser>": img, ...}``, each ``(h, w, 3)`` float32 linear
+        radiance; with ``aux=True`` also ``"albedo"`` and ``"normal"`` (the guides
+        single-frame denoisers such as OIDN take). ``reset=True`` is a cut."""
+        return self._r.render(frame, reset, aux)
+
+    def reference(self, frame=None, spp=1024):
+        """A high-sample reference of ``frame`` (default: the last rendered), from its
+        own sample stream: what ``dvr reference`` writes for that frame."""
+        return self._r.reference(frame, spp)
+
+    def timings(self) -> dict:
+        """GPU milliseconds per pass of the last rendered frame."""
+        return self._r.timings()
+
+    @property
+    def frames(self) -> int:
+        return self._r.frames
+
+    @property
+    def denoisers(self) -> list:
+        return self._r.denoisers
+
+    @property
+    def device(self) -> str:
+        return self._r.device
+
+    @property
+    def spp(self) -> int:
+        return self._r.spp
+
+    @property
+    def size(self) -> tuple:
+        return self._r.size

@@ -1,0 +1,35 @@
+"""Shared fixtures: the repository's paths and the CLI binary the package is compared
+with (``DVR_BIN``, else the workspace's debug or release build)."""
+
+import os
+import pathlib
+import shutil
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="session")
+def root():
+    return ROOT
+
+
+@pytest.fixture(scope="session")
+def dvr_bin():
+    for candidate in (os.environ.get("DVR_BIN"), ROOT / "target/debug/dvr", ROOT / "target/release/dvr", shutil.which("dvr")):
+        if candidate and pathlib.Path(candidate).is_file():
+            return str(candidate)
+    pytest.fail("no dvr binary: build it (cargo build) or set DVR_BIN")
+
+
+@pytest.fixture(autouse=True)
+def no_validation_messages():
+    """With DVR_VALIDATION=1 (as tools/test.sh runs), any message from the Vulkan
+    validation layer fails the test that caused it."""
+    import dvr
+
+    before = dvr._native.validation_messages()
+    yield
+    after = dvr._native.validation_messages()
+    assert after == before, f"the Vulkan validation layer reported {after - before} message(s)"

@@ -1,0 +1,143 @@
+"""dvr.Renderer on the Vulkan device (lavapipe in CI): frames equal to the CLI's, scores
+equal to the eval's, convergence with samples, the GIL released, and clear errors."""
+
+import csv
+import os
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import OpenEXR
+import pytest
+
+import dvr
+
+SIZE = (24, 20)
+
+
+def read_exr(path):
+    with OpenEXR.File(str(path)) as f:
+        channels = f.channels()
+        if "RGB" in channels:
+            return np.asarray(channels["RGB"].pixels, dtype=np.float32)[..., :3]
+        return np.stack([np.asarray(channels[c].pixels, dtype=np.float32) for c in "RGB"], axis=-1)
+
+
+@pytest.fixture(scope="module")
+def phantom_frames():
+    r = dvr.Renderer(dvr.Scene.builtin("phantom/orbit"), size=SIZE, denoisers=["ours", "svgf"])
+    frames = [r.render() for _ in range(3)]
+    return r, frames
+
+
+def test_frames_are_finite_images_of_each_method(phantom_frames):
+    r, frames = phantom_frames
+    assert r.denoisers == ["ours", "svgf"] and r.frames >= 48 and r.size == SIZE
+    for out in frames:
+        assert set(out) == {"noisy", "ours", "svgf"}
+        for img in out.values():
+            assert img.shape == (SIZE[1], SIZE[0], 3) and img.dtype == np.float32
+            assert np.isfinite(img).all() and (img >= 0).all()
+    timings = r.timings()
+    assert timings and all(ms >= 0 for ms in timings.values())
+    assert any("path_trace" in p for p in timings)
+
+
+def test_frames_equal_the_clis(phantom_frames, dvr_bin, tmp_path):
+    _, frames = phantom_frames
+    out = tmp_path / "capture"
+    subprocess.run(
+        [dvr_bin, "capture", "--quiet", "--scene", "phantom/orbit", "--frames", "3",
+         "--size", f"{SIZE[0]}x{SIZE[1]}", "--denoiser", "none,ours,svgf", "--out", str(out)],
+        check=True,
+    )
+    for f in range(3):
+        for method, key in (("none", "noisy"), ("ours", "ours"), ("svgf", "svgf")):
+            cli = read_exr(out / method / f"{f:04d}.exr")
+            np.testing.assert_allclose(frames[f][key], cli, rtol=1e-3, atol=1e-5, err_msg=f"{method} frame {f}")
+
+
+def test_scores_equal_the_evals(dvr_bin, tmp_path):
+    out = tmp_path / "eval"
+    subprocess.run(
+        [dvr_bin, "eval", "--quiet", "--scene", "cloud/orbit", "--frames", "2", "--size", "16x16",
+         "--ref-spp", "8", "--denoiser", "none", "--out", str(out)],
+        check=True,
+    )
+    # The eval keeps the noisy input's EXRs (the other methods' frames as PNGs).
+    rows = list(csv.DictReader(open(out / "metrics.csv")))
+    assert len(rows) == 2
+    d = out / "cloud_orbit"
+    ref = [read_exr(d / "reference" / f"{f:04d}.exr") for f in range(2)]
+    for row in rows:
+        f = int(row["frame"])
+        test = read_exr(d / row["method"] / f"{f:04d}.exr")
+        assert dvr.metrics.psnr(ref[f], test) == pytest.approx(float(row["psnr"]), abs=1e-3)
+        assert dvr.metrics.ssim(ref[f], test) == pytest.approx(float(row["ssim"]), abs=1e-5)
+        assert dvr.metrics.flip(ref[f], test) == pytest.approx(float(row["flip"]), abs=1e-5)
+        if f == 1:
+            prev = read_exr(d / row["method"] / "0000.exr")
+            te = dvr.metrics.temporal_error(prev, test, ref[0], ref[1])
+            assert te == pytest.approx(float(row["temporal_error"]), abs=1e-5)
+
+
+def test_a_numpy_volume_renders_and_converges():
+    # A ball of density in a 32³ array: more samples, closer to the reference.
+    z, y, x = np.mgrid[-1:1:32j, -1:1:32j, -1:1:32j]
+    ball = (np.sqrt(x * x + y * y + z * z) < 0.7).astype(np.float32)
+    tf = dvr.TransferFunction.from_array([[0.0, 0.9, 0.8, 0.7, 0.0], [0.5, 0.9, 0.8, 0.7, 0.0], [1.0, 0.9, 0.8, 0.7, 0.05]])
+    scene = dvr.Scene(dvr.Volume(ball), tf=tf, frames=8, density_scale=80.0)
+    r = dvr.Renderer(scene, size=(16, 16), denoisers=["accum"], spp=1)
+    ref = r.reference(frame=0, spp=512)
+    assert np.isfinite(ref).all() and ref.max() > 0
+    errors = []
+    for f in range(8):
+        out = r.render(frame=0)  # a static view: accumulation converges
+        errors.append(float(np.mean((out["accum"] - ref) ** 2)))
+    assert errors[-1] < 0.35 * errors[0], errors
+    assert dvr.metrics.psnr(ref, out["accum"]) > dvr.metrics.psnr(ref, out["noisy"]) + 3.0
+
+
+def test_the_gil_is_released_while_the_gpu_works():
+    r = dvr.Renderer(dvr.Scene.builtin("cloud/orbit"), size=(48, 48), denoisers=["none"])
+    result = []
+    worker = threading.Thread(target=lambda: result.append(r.reference(frame=0, spp=512)))
+    ticks = 0
+    start = time.perf_counter()
+    worker.start()
+    while worker.is_alive():
+        ticks += 1
+        time.sleep(0.001)
+    worker.join()
+    assert result and result[0].shape == (48, 48, 3), "the reference failed in its thread"
+    elapsed = time.perf_counter() - start
+    # A held GIL would freeze this loop for the whole reference.
+    assert elapsed > 0.1, "the reference was too quick to tell"
+    assert ticks > 0.3 * elapsed / 0.0011, (ticks, elapsed)
+
+
+def test_bad_requests_raise_with_the_engines_messages():
+    scene = dvr.Scene.builtin("phantom/orbit")
+    with pytest.raises(ValueError, match="no-such"):
+        dvr.Renderer(scene, size=(8, 8), denoisers=["no-such"])
+    with pytest.raises(ValueError, match="size"):
+        dvr.Renderer(scene, size=(0, 8))
+    with pytest.raises(ValueError, match="spp"):
+        dvr.Renderer(scene, size=(8, 8), spp=1000)
+    with pytest.raises(ValueError, match="motion|first-hit"):
+        dvr.Renderer(scene, size=(8, 8), motion="sideways")
+    r = dvr.Renderer(scene, size=(8, 8), denoisers=["taa"])
+    with pytest.raises(ValueError, match="frame 999"):
+        r.render(frame=999)
+    with pytest.raises(ValueError, match="reference spp|at least 1"):
+        r.reference(spp=0)
+
+
+def test_a_missing_device_is_a_runtime_error():
+    code = "import dvr\ntry:\n    dvr.Renderer(dvr.Scene.builtin('phantom/orbit'), size=(8, 8))\nexcept RuntimeError as e:\n    print('RuntimeError:', e)\n"
+    env = dict(os.environ, DVR_DEVICE="no-such-gpu")
+    p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert "RuntimeError:" in p.stdout and "no-such-gpu" in p.stdout
