@@ -5,7 +5,8 @@
 #  2. the data: 7-frame 128x128 clips at 2 spp with 1024-spp references
 #     (~6 min per clip on this 2-core machine, so fewer clips), and the network
 #     fine-tuned on it (--init), validated on held-out 128x128 clips.
-# Needs target/release/dvr and a Python with tools/rae/requirements.txt. Everything runs
+# Needs a Python with tools/rae/requirements.txt and the dvr package (`pip install ./python`
+# into it: gen_data.py renders in process), and target/release/dvr. Everything runs
 # at nice 10 (the machine is shared). Training uses one thread: on a shared 2-core
 # machine, two OpenMP threads stall on each other (measured 5 s per iteration with 2
 # threads vs well under 1 s with 1).
