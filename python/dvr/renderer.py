@@ -18,11 +18,12 @@ class Renderer:
     order renders the animation. ``motion`` is what the temporal denoisers reproject
     with (``"features"`` or ``"first-hit"``, as the CLI's ``--motion``).
 
-    The device is the one the CLI picks (``DVR_DEVICE`` forces one by name); without a
-    Vulkan device this raises ``RuntimeError``.
+    ``device`` picks the Vulkan device by a substring of its name; by default it is the
+    one the CLI picks (a discrete GPU first; ``DVR_DEVICE`` forces one). Without a
+    Vulkan device, or with none of that name, this raises ``RuntimeError``.
     """
 
-    def __init__(self, scene: Scene, size=(128, 128), spp=None, denoisers=("ours",), motion="features"):
+    def __init__(self, scene: Scene, size=(128, 128), spp=None, denoisers=("ours",), motion="features", device=None):
         if isinstance(scene, str):
             scene = Scene.builtin(scene) if scene in _native.builtin_scene_names() else Scene.load(scene)
         if isinstance(denoisers, str):
@@ -33,7 +34,8 @@ class Renderer:
         self.scene = scene
         tf = scene.tf.to_dict() if getattr(scene, "tf", None) is not None else None
         self._r = _native.Renderer(
-            scene._engine_dict(), size, list(denoisers), volume=scene.volume, tf=tf, spp=spp, motion=motion
+            scene._engine_dict(), size, list(denoisers), volume=scene.volume, tf=tf, spp=spp, motion=motion,
+            device=device,
         )
 
     def render(self, frame=None, reset=False, aux=False) -> dict:

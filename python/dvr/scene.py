@@ -180,7 +180,7 @@ class Scene:
         elif isinstance(volume, str) and volume in ("phantom", "cloud", "mri"):
             source = {"builtin": volume}
         else:
-            source = {"path": str(volume)}
+            source = {"file": str(volume)}
         self.tf = tf if tf is not None else TransferFunction.preset("phantom-opaque")
         if isinstance(self.tf, str):
             self.tf = TransferFunction.preset(self.tf)

@@ -7,7 +7,7 @@ use crate::scene::{scene_from_dict, tf_from_dict};
 use crate::volume::Volume;
 use dvr_engine::error::EngineError;
 use dvr_engine::gpu::timestamps::PassTiming;
-use dvr_engine::gpu::GpuContext;
+use dvr_engine::gpu::{ContextOptions, GpuContext};
 use dvr_engine::graph::Extent;
 use dvr_engine::passes::aux_features::{ALBEDO, NORMAL};
 use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup};
@@ -63,9 +63,10 @@ struct Inner {
 impl Renderer {
     /// A renderer for `scene` (a scene dict, see `dvr.Scene`) at `size` = (width,
     /// height). `volume` replaces the scene's `[volume]` source (its density scale
-    /// stays), `tf` its `transfer.a`; `spp` overrides the scene's samples per frame.
+    /// stays), `tf` its `transfer.a`; `spp` overrides the scene's samples per frame;
+    /// `device` picks the Vulkan device by a substring of its name.
     #[new]
-    #[pyo3(signature = (scene, size, denoisers, volume = None, tf = None, spp = None, motion = "features"))]
+    #[pyo3(signature = (scene, size, denoisers, volume = None, tf = None, spp = None, motion = "features", device = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -76,6 +77,7 @@ impl Renderer {
         tf: Option<&Bound<'_, PyDict>>,
         spp: Option<u32>,
         motion: &str,
+        device: Option<String>,
     ) -> PyResult<Self> {
         let mut scene = scene_from_dict(scene, "scene")?;
         if let Some(tf) = tf {
@@ -122,7 +124,13 @@ impl Renderer {
                 // The trained RAE networks are per dataset; an array is none of them.
                 setup.config.dataset = None;
             }
-            let ctx = GpuContext::headless().map_err(runtime_error)?;
+            // `device` (a substring of the name) as `DVR_DEVICE` does; None: the same
+            // choice as the CLI's.
+            let options = ContextOptions {
+                device,
+                ..Default::default()
+            };
+            let ctx = GpuContext::new(options).map_err(runtime_error)?;
             let renderer = setup.renderer(ctx, &names).map_err(engine_error)?;
             Ok(OnThisThread((setup, renderer)))
         })?;

@@ -165,7 +165,7 @@ pub fn metrics_csv(results: &[SceneResult]) -> String {
                 } = x;
                 let _ = writeln!(
                     s,
-                    "{},{},{frame},{psnr:.4},{ssim:.6},{flip:.6},{},{gpu_ms:.4}",
+                    "{},{},{frame},{psnr:.6},{ssim:.6},{flip:.6},{},{gpu_ms:.4}",
                     field(scene),
                     field(method),
                     opt(*temporal_error, 6)

@@ -37,6 +37,12 @@ TFS = {
 }
 
 
+def r4(v):
+    """Values as the clips' scenes have always held them (4 decimals), so a clip is the
+    same whichever version of this tool made it."""
+    return [round(float(x), 4) for x in v]
+
+
 def scene_of(dataset, rng, frames, spp):
     """A random scene of `dataset` and what was drawn for it."""
     tf = TFS[dataset][rng.integers(len(TFS[dataset]))]
@@ -59,31 +65,33 @@ def scene_of(dataset, rng, frames, spp):
     kind = rng.choice(["point", "point", "area", "environment"])
     lights = []
     if kind == "point":
-        lights.append(dvr.PointLight(lpos, colour, rng.uniform(8, 40)))
+        lights.append(dvr.PointLight(r4(lpos), r4(colour), round(rng.uniform(8, 40), 2)))
     elif kind == "area":
         s = rng.uniform(0.2, 0.7)
-        lights.append(dvr.AreaLight(lpos, size=(s, s * rng.uniform(0.5, 1.5)), colour=colour,
-                                    intensity=rng.uniform(30, 150)))
+        lights.append(dvr.AreaLight(r4(lpos), size=(round(s, 3), round(s * rng.uniform(0.5, 1.5), 3)),
+                                    colour=r4(colour), intensity=round(rng.uniform(30, 150), 2)))
     if kind == "environment" or rng.random() < 0.7:
         env_i = rng.uniform(0.5, 1.5) if kind == "environment" else rng.uniform(0.1, 0.4)
         top = np.clip([0.55, 0.65, 0.8] + rng.uniform(-0.1, 0.1, 3), 0, 1)
-        lights.append(dvr.EnvironmentLight(top=top, bottom=(0.2, 0.18, 0.15), intensity=env_i))
+        lights.append(dvr.EnvironmentLight(top=r4(top), bottom=(0.2, 0.18, 0.15), intensity=round(env_i, 3)))
     render = {"spp": spp, "max_bounces": 4, "phase": str(rng.choice(["isotropic", "hg"])),
-              "hg_g": float(rng.uniform(-0.3, 0.6))}
+              "hg_g": round(float(rng.uniform(-0.3, 0.6)), 2)}
     scene = dvr.Scene(dataset, tf=dvr.TransferFunction.preset(tf), lights=lights, frames=frames,
-                      camera=dvr.Camera(cam, target, fov_y_degrees=fov), density_scale=density,
+                      camera=dvr.Camera(r4(cam), r4(target), fov_y_degrees=round(fov, 2)),
+                      density_scale=round(density, 2),
                       render=render, name=f"rae-{dataset}")
     if speed != 0.0:
-        scene.orbit(degrees_per_frame=float(speed))
+        scene.orbit(degrees_per_frame=round(float(speed), 1))
     return scene, dict(tf=tf, density=density, light=str(kind), speed=float(speed))
 
 
 def render_clip(scene, size, ref_spp):
-    """The clip's noisy frames (in order: the renderer's own animation) and its
-    references, each (frames, 3, H, W)."""
+    """The clip's references and noisy frames (in order: the renderer's own animation),
+    each (frames, 3, H, W). References first: a reference's sample stream starts after
+    the frames rendered before it, so these are the ones `dvr reference` writes."""
     r = dvr.Renderer(scene, size=size, denoisers=[])
-    noisy = np.stack([r.render(t)["noisy"] for t in range(scene.frames)])
     refs = np.stack([r.reference(t, spp=ref_spp) for t in range(scene.frames)])
+    noisy = np.stack([r.render(t)["noisy"] for t in range(scene.frames)])
     return np.moveaxis(noisy, -1, 1), np.moveaxis(refs, -1, 1)
 
 

@@ -140,6 +140,10 @@ impl Renderer {
         let ctx = ctx.into();
         check_spp(&ctx, settings.spp(), config.size)?;
         let features = PathTraceFeatures::new(settings.pipeline_key(), environment.is_some());
+        // What the caller can get wrong (a denoiser's name, what it needs) is checked
+        // before the graph exists: the graph's samplers and images are released only by
+        // `RenderGraph::destroy`, which an early return here would skip.
+        let denoisers = create_methods(&ctx, &config, features, denoisers)?;
         let mut graph = RenderGraph::new(&ctx)?;
         let passes = Passes {
             features: SurfaceFeatures::new(&ctx)?,
@@ -149,7 +153,6 @@ impl Renderer {
             present: None,
             aux: None,
         };
-        let denoisers = create_methods(&ctx, &config, features, denoisers)?;
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
