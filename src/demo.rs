@@ -33,7 +33,7 @@ pub struct DemoArgs {
     #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Comma-separated denoisers, all fed the same noisy frames.
-    #[arg(long, default_value = "none,taa,svgf,ours,rae", value_delimiter = ',')]
+    #[arg(long, default_value = "none,taa,svgf,ours,rae", value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
     pub denoiser: Vec<String>,
     /// Skip the videos (written by default when ffmpeg is on PATH).
     #[arg(long)]

@@ -96,7 +96,7 @@ enum Command {
         #[command(flatten)]
         scene: SceneArgs,
         /// Comma-separated denoisers (the noisy frames are rendered once and fed to all).
-        #[arg(long, default_value = "none,accum", value_delimiter = ',')]
+        #[arg(long, default_value = "none,accum", value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
         denoiser: Vec<String>,
         /// Output folder.
         #[arg(long, default_value = "out/capture")]
@@ -123,7 +123,7 @@ enum Command {
     Profile {
         #[command(flatten)]
         scene: SceneArgs,
-        #[arg(long, default_value = "none", value_delimiter = ',')]
+        #[arg(long, default_value = "none", value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
         denoiser: Vec<String>,
         /// Write the statistics (per pass: times, bytes, GB/s, % of the measured peak
         /// bandwidth) and the last 300 frames' raw timings as JSON.

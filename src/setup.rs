@@ -46,6 +46,19 @@ pub fn parse_spp(s: &str) -> Result<u32, String> {
 }
 
 /// Parses `--frames`: a whole number of at least 1.
+/// One `--denoiser` name, checked against the registry while the command line is
+/// parsed, so a wrong name is a usage error (exit 2) like any other bad argument, and
+/// nothing has been loaded yet. Empty items of a comma list pass (they are skipped).
+pub fn parse_denoiser(s: &str) -> Result<String, String> {
+    let name = s.trim();
+    if name.is_empty() {
+        return Ok(String::new());
+    }
+    registry::find(name)
+        .map(|info| info.name.to_string())
+        .map_err(|e| e.to_string())
+}
+
 pub fn parse_frames(s: &str) -> Result<u32, String> {
     match s.trim().parse::<u32>() {
         Ok(n) if n >= 1 => Ok(n),

@@ -47,7 +47,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 60, value_parser = crate::setup::parse_frames)]
     pub frames: u32,
     /// Denoisers to profile and evaluate (default: every one).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
     pub denoiser: Vec<String>,
     /// Scenes of the eval (`suite`, `stress` or a list).
     #[arg(long, default_value = "suite")]

@@ -339,11 +339,11 @@ pub(crate) mod tests {
         assert_eq!(lines.len(), 1 + 2 * 2 * 4);
         assert_eq!(
             lines[1],
-            "cloud/orbit,none,0,20.0000,0.500000,0.250000,,100.0000"
+            "cloud/orbit,none,0,20.000000,0.500000,0.250000,,100.0000"
         );
         assert_eq!(
             lines[2],
-            "cloud/orbit,none,1,20.0000,0.500000,0.250000,0.010000,100.0000"
+            "cloud/orbit,none,1,20.000000,0.500000,0.250000,0.010000,100.0000"
         );
         assert!(lines[9].starts_with("\"a,b\",none,0,"), "{}", lines[9]);
     }

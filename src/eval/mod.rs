@@ -77,7 +77,7 @@ pub struct EvalArgs {
     #[arg(long, default_value = "256x256", value_parser = crate::setup::parse_size)]
     pub size: (u32, u32),
     /// Comma-separated denoisers, all fed the same noisy frames.
-    #[arg(long, default_value = "none,accum,ours", value_delimiter = ',')]
+    #[arg(long, default_value = "none,accum,ours", value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
     pub denoiser: Vec<String>,
     /// Output folder (references in it are reused when their settings match).
     #[arg(long, default_value = "out/eval")]

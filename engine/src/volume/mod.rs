@@ -420,10 +420,10 @@ pub(crate) fn validate_spacing(
         field: field.to_string(),
         problem,
     };
-    if !spacing
-        .iter()
-        .all(|s| s.is_finite() && (MIN_SPACING_MM..=MAX_SPACING_MM).contains(s))
-    {
+    // The bounds are checked as the volume stores spacing, in f32: `1e-6` written in a
+    // file is 9.99999997e-7 once rounded, and must still count as the bound it names.
+    let in_range = |s: f64| (MIN_SPACING_MM as f32..=MAX_SPACING_MM as f32).contains(&(s as f32));
+    if !spacing.iter().all(|&s| s.is_finite() && in_range(s)) {
         return Err(bad(format!(
             "voxel spacing {spacing:?} must be finite and in [{MIN_SPACING_MM:e}, \
              {MAX_SPACING_MM:e}] mm"

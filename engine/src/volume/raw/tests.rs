@@ -3,6 +3,7 @@
 use super::*;
 use crate::volume::write;
 use crate::volume::VolumeData;
+use crate::volume::{MAX_SPACING_MM, MIN_SPACING_MM};
 
 #[test]
 fn round_trips_with_params_and_sidecars() {
@@ -130,4 +131,29 @@ fn malformed_sidecar_names_the_sidecar() {
     let err = Volume::load(&path, None).unwrap_err();
     assert!(matches!(err, VolumeError::MalformedHeader { .. }), "{err}");
     assert!(err.to_string().contains("v.raw.toml"), "{err}");
+}
+
+#[test]
+fn spacing_bounds_hold_after_rounding_to_f32() {
+    // The inclusive bounds, as written in a file: 1e-6 rounds to 9.99999997e-7 in f32.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("one.raw");
+    write::raw_u16(&path, &[7]);
+    for s in [MIN_SPACING_MM, MAX_SPACING_MM] {
+        let spacing = [s as f32; 3];
+        let params = RawParams {
+            dims: [1, 1, 1],
+            format: RawFormat::U16,
+            spacing,
+        };
+        let v = Volume::load(&path, Some(&params)).unwrap_or_else(|e| panic!("{s:e}: {e}"));
+        assert_eq!(v.spacing, spacing);
+    }
+    // Past them still fails.
+    let params = RawParams {
+        dims: [1, 1, 1],
+        format: RawFormat::U16,
+        spacing: [(MIN_SPACING_MM * 0.99) as f32; 3],
+    };
+    assert!(Volume::load(&path, Some(&params)).is_err());
 }
