@@ -106,7 +106,13 @@ pub fn capture(
 
 /// `dvr reference`: the same cache as `dvr eval`'s, in `out/reference/`, so a rerun with
 /// the same key reuses (or finishes) what is there.
-pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
+pub fn reference(
+    args: &SceneArgs,
+    spp: u32,
+    frame_range: Option<(u32, u32)>,
+    shard: Option<(u32, u32)>,
+    out: &Path,
+) -> Result<()> {
     // --spp above lavapipe's per-frame count most likely meant the reference's samples;
     // counts the command line refuses (past MAX_SPP) already point to --ref-spp there.
     if let Some(n) = args.render.spp.filter(|&n| n > MAX_SAMPLES_PER_DISPATCH) {
@@ -116,6 +122,7 @@ pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
         );
     }
     let setup = Setup::new(args)?;
+    let frames = crate::setup::select_frames(setup.frames, frame_range, shard)?;
     crate::setup::create_out_dir(out)?;
     let key = ReferenceKey::new(setup.scene(), args.size, spp, args.render.volume_size)?;
     let cache = ReferenceCache::new(out, key);
@@ -123,12 +130,13 @@ pub fn reference(args: &SceneArgs, spp: u32, out: &Path) -> Result<()> {
         progress: None,
         samples_per_frame: f64::from(spp) * f64::from(setup.width() * setup.height()),
     };
-    cache.fill(&setup, &mut report)?;
+    cache.fill_frames(&setup, &mut report, &frames)?;
     if let Some(p) = &mut report.progress {
         p.finish();
     }
     println!(
-        "wrote {} reference frames to {}",
+        "wrote {} of {} reference frames to {}",
+        frames.len(),
         setup.frames,
         cache.dir.display()
     );

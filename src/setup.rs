@@ -59,6 +59,51 @@ pub fn parse_denoiser(s: &str) -> Result<String, String> {
         .map_err(|e| e.to_string())
 }
 
+/// `--frame-range A..B`: frames A up to but not including B, A < B.
+pub fn parse_frame_range(s: &str) -> Result<(u32, u32), String> {
+    let bad = || {
+        format!("{s:?} is not a frame range (A..B: from frame A up to but not including B, A < B)")
+    };
+    let (a, b) = s.trim().split_once("..").ok_or_else(bad)?;
+    let (a, b) = (
+        a.trim().parse::<u32>().map_err(|_| bad())?,
+        b.trim().parse::<u32>().map_err(|_| bad())?,
+    );
+    if a >= b {
+        return Err(bad());
+    }
+    Ok((a, b))
+}
+
+/// `--shard I/N`: shard I (0-based) of N, N >= 1.
+pub fn parse_shard(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("{s:?} is not a shard (I/N: shard I of N, 0 <= I < N)");
+    let (i, n) = s.trim().split_once('/').ok_or_else(bad)?;
+    let (i, n) = (
+        i.trim().parse::<u32>().map_err(|_| bad())?,
+        n.trim().parse::<u32>().map_err(|_| bad())?,
+    );
+    if n == 0 || i >= n {
+        return Err(bad());
+    }
+    Ok((i, n))
+}
+
+/// The frames of a `frames`-frame animation that `--frame-range` and `--shard` select,
+/// in order; an error when the range lies past the animation or the shard is empty.
+pub fn select_frames(
+    frames: u32,
+    range: Option<(u32, u32)>,
+    shard: Option<(u32, u32)>,
+) -> Result<Vec<u32>> {
+    let (a, b) = range.unwrap_or((0, frames));
+    if b > frames {
+        bail!("--frame-range {a}..{b}: the scene has {frames} frame(s) (0..{frames})");
+    }
+    let (i, n) = shard.unwrap_or((0, 1));
+    Ok((a..b).skip(i as usize).step_by(n as usize).collect())
+}
+
 pub fn parse_frames(s: &str) -> Result<u32, String> {
     match s.trim().parse::<u32>() {
         Ok(n) if n >= 1 => Ok(n),

@@ -306,3 +306,93 @@ fn a_missing_device_is_reported_clearly() {
         .expect("run dvr");
     assert_error(&o, &["no-such-gpu-9000", "matches no Vulkan device"]);
 }
+
+/// Every file of `dir`, by name, with its bytes.
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .expect("reading the folder")
+        .map(|e| {
+            let p = e.expect("entry").path();
+            let name = p.file_name().expect("name").to_string_lossy().into_owned();
+            (name, std::fs::read(&p).expect("reading"))
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn sharded_references_write_the_bytes_of_one_run() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let (one, sharded) = (tmp.path().join("one"), tmp.path().join("sharded"));
+    let common = [
+        "reference",
+        "--scene",
+        "cloud/orbit",
+        "--frames",
+        "5",
+        "--size",
+        "12x10",
+        "--volume-size",
+        "16",
+        "--ref-spp",
+        "8",
+        "--out",
+    ];
+    let with = |out: &Path, extra: &[&str]| {
+        let mut args: Vec<String> = common.iter().map(|s| s.to_string()).collect();
+        args.push(out.to_str().expect("utf-8").to_string());
+        args.extend(extra.iter().map(|s| s.to_string()));
+        args
+    };
+    let run = |args: Vec<String>| dvr(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_ok(&run(with(&one, &[])));
+    // Three shards at once on one folder, as separate processes (a job array).
+    let children: Vec<_> = (0..3)
+        .map(|i| {
+            Command::new(env!("CARGO_BIN_EXE_dvr"))
+                .args(with(&sharded, &["--shard", &format!("{i}/3")]))
+                .env("DVR_VALIDATION", "1")
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .expect("starting a shard")
+        })
+        .collect();
+    for c in children {
+        assert_ok(&c.wait_with_output().expect("running a shard"));
+    }
+    let (a, b) = (
+        files(&one.join("reference")),
+        files(&sharded.join("reference")),
+    );
+    assert_eq!(a.len(), 11, "5 frames × EXR + PNG and the key");
+    assert!(a == b, "sharded files differ from one run's");
+
+    // A range selects its frames only; past the animation is an error naming it, a
+    // malformed shard a usage error.
+    let part = tmp.path().join("part");
+    assert_ok(&run(with(&part, &["--frame-range", "1..3"])));
+    let names: Vec<String> = files(&part.join("reference"))
+        .into_iter()
+        .map(|(n, _)| n)
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "0001.exr",
+            "0001.png",
+            "0002.exr",
+            "0002.png",
+            "reference.json"
+        ]
+    );
+    assert_error(
+        &run(with(&part, &["--frame-range", "2..9"])),
+        &["--frame-range 2..9", "5 frame(s)"],
+    );
+    for bad in ["3/3", "1/0", "x"] {
+        let o = run(with(&part, &["--shard", bad]));
+        assert_eq!(o.status.code(), Some(2), "--shard {bad}: {}", stderr(&o));
+    }
+}

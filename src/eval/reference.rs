@@ -353,8 +353,28 @@ impl ReferenceCache {
     /// unreadable frames, renders the rest with a renderer made by `setup` only when
     /// some frame is missing.
     pub fn fill(&self, setup: &Setup, report: &mut dyn FillReport) -> Result<()> {
-        let state = self.state();
-        let reused = self.key.frames as usize - state.missing.len();
+        let all: Vec<u32> = (0..self.key.frames).collect();
+        self.fill_frames(setup, report, &all)
+    }
+
+    /// [`ReferenceCache::fill`] for the frames `wanted` only (`dvr reference
+    /// --frame-range`/`--shard`). Each frame's image depends on nothing but the key and
+    /// its index (the renderer renders references only, from the reference stream), so
+    /// frames rendered by separate runs are the frames one run renders.
+    pub fn fill_frames(
+        &self,
+        setup: &Setup,
+        report: &mut dyn FillReport,
+        wanted: &[u32],
+    ) -> Result<()> {
+        let mut state = self.state();
+        state.missing.retain(|f| wanted.contains(f));
+        state.unreadable.retain(|(path, _)| {
+            wanted
+                .iter()
+                .any(|&f| *path == self.exr(f) || *path == self.png(f))
+        });
+        let reused = wanted.len() - state.missing.len();
         for (path, why) in &state.unreadable {
             report.note(None);
             log::warn!(
