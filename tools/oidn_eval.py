@@ -17,31 +17,19 @@ against the eval's references with the same metrics as `dvr eval`, writes
 
 Both denoise every frame independently (no temporal information).
 
-Metrics, exactly as `dvr eval` computes them (engine/src/metrics/):
-  * Tone map (engine/src/metrics/tonemap.rs), per channel c, exposure e = 1:
-        x = max(e * c, 0)                      (NaN -> 0)
-        y = min(x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), 1)   (ACES, Narkowicz 2015)
-        s = 12.92 y                  if y <= 0.0031308
-            1.055 y^(1/2.4) - 0.055  otherwise                       (sRGB OETF)
-  * PSNR: 10 log10(1 / MSE) over all pixels and the three channels, capped at 100 dB.
-  * SSIM: on luma Y' = 0.2126 R' + 0.7152 G' + 0.0722 B' of the tone-mapped values,
-    11x11 Gaussian window (sigma 1.5, normalised), K1 = 0.01, K2 = 0.03, L = 1, mean
-    over the valid region (windows fully inside the image).
-  * FLIP: LDR-FLIP of the tone-mapped images at 67.02 pixels per degree, via NVIDIA's
-    `flip-evaluator` (which dvr's own FLIP matches to ~1e-6); left empty if that
-    package is missing.
-  * temporal_error: mean |(cur - prev)_oidn - (cur - prev)_reference| over pixels and
-    channels, from frame 1 on.
+Metrics: `dvr.metrics` from the Python package (python/), i.e. the eval's own code
+(engine/src/metrics/): the same tone map, PSNR, SSIM, LDR-FLIP and temporal error, so
+the appended rows compare with the eval's to the last digit.
   * gpu_ms: left empty (OIDN runs on the CPU here); the CPU time is printed.
   * frames_to_recover (summary.csv): for scenes with a sudden change (the event frame is
     read from the eval's index.html), frames after the event until PSNR stays within
     1 dB of its mean over the 5 frames before; `never` if it does not recover.
 
-`--check` recomputes the `none` rows in Python first and reports the largest
-difference from metrics.csv, which verifies the two implementations agree.
+`--check` recomputes the `none` rows first and reports the largest difference from
+metrics.csv (zero up to the CSV's rounding).
 
-Usage (not part of the test suite; needs pip packages):
-    pip install pyoidn numpy OpenEXR pillow flip-evaluator
+Usage (not part of the test suite; needs the dvr package and pip packages):
+    pip install ./python pyoidn numpy OpenEXR pillow
     python3 tools/oidn_eval.py out/eval [--quality high] [--check]
 """
 
@@ -49,16 +37,19 @@ import argparse
 import csv
 import io
 import json
-import math
 import os
 import re
 import sys
 import time
 
 try:
+    import dvr
+except ImportError:
+    sys.exit("oidn_eval: the dvr Python package is missing: pip install ./python")
+try:
     import numpy as np
 except ImportError:
-    sys.exit("oidn_eval: numpy is missing: pip install pyoidn numpy OpenEXR pillow flip-evaluator")
+    sys.exit("oidn_eval: numpy is missing: pip install pyoidn numpy OpenEXR pillow")
 
 METHOD = "oidn"
 METHOD_AUX = "oidn-aux"
@@ -83,55 +74,6 @@ def dir_name(scene):
     return s or "scene"
 
 
-def tonemap(hdr, exposure=1.0):
-    x = np.nan_to_num(hdr.astype(np.float32) * np.float32(exposure), nan=0.0, posinf=np.inf)
-    x = np.maximum(x, 0.0)
-    with np.errstate(invalid="ignore", over="ignore"):
-        y = (x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)
-    y = np.where(np.isnan(y), 1.0, y)  # +inf input -> white, as in the Rust code
-    y = np.clip(y, 0.0, 1.0)
-    s = np.where(y <= 0.0031308, 12.92 * y, 1.055 * np.power(y, 1.0 / 2.4) - 0.055)
-    return np.where(y >= 1.0, 1.0, s).astype(np.float32)
-
-
-def psnr(a, b):
-    mse = np.mean((a.astype(np.float64) - b.astype(np.float64)) ** 2)
-    if mse == 0.0:
-        return PSNR_CAP
-    return min(10.0 * math.log10(1.0 / mse), PSNR_CAP)
-
-
-def ssim(a, b):
-    h, w = a.shape[:2]
-    radius = min(5, (min(w, h) - 1) // 2)
-    d = np.arange(-radius, radius + 1, dtype=np.float64)
-    g = np.exp(-d * d / (2.0 * 1.5 * 1.5))
-    g /= g.sum()
-    lw = np.array([0.2126, 0.7152, 0.0722])
-    x = a.astype(np.float64) @ lw
-    y = b.astype(np.float64) @ lw
-    taps = len(g)
-    ow, oh = w + 1 - taps, h + 1 - taps
-
-    def blur(img):
-        hor = sum(g[k] * img[:, k : k + ow] for k in range(taps))
-        return sum(g[k] * hor[k : k + oh, :] for k in range(taps))
-
-    mx, my = blur(x), blur(y)
-    vx = blur(x * x) - mx * mx
-    vy = blur(y * y) - my * my
-    cxy = blur(x * y) - mx * my
-    c1, c2 = 0.01**2, 0.03**2
-    m = ((2 * mx * my + c1) * (2 * cxy + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2))
-    return float(m.mean())
-
-
-def temporal_error(prev_test, cur_test, prev_ref, cur_ref):
-    dt = cur_test.astype(np.float64) - prev_test
-    dr = cur_ref.astype(np.float64) - prev_ref
-    return float(np.mean(np.abs(dt - dr)))
-
-
 def frames_to_recover(series, event, tol):
     if event <= 0 or event >= len(series):
         return None
@@ -143,26 +85,6 @@ def frames_to_recover(series, event, tol):
         return 0
     last = bad[-1]
     return last + 1 if last + 1 < len(ok) else None
-
-
-class Flip:
-    def __init__(self):
-        try:
-            import flip_evaluator
-
-            self.flip = flip_evaluator
-        except ImportError:
-            self.flip = None
-            print("oidn_eval: flip-evaluator is missing (pip install flip-evaluator): FLIP left empty")
-
-    def __call__(self, ref, test):
-        if self.flip is None:
-            return None
-        # flip-evaluator converts its inputs in place: hand it copies.
-        r = np.ascontiguousarray(ref, dtype=np.float32).copy()
-        t = np.ascontiguousarray(test, dtype=np.float32).copy()
-        _, mean, _ = self.flip.evaluate(r, t, "LDR")
-        return float(mean)
 
 
 def read_exr(path):
@@ -198,16 +120,24 @@ def fmt(v, digits):
     return "" if v is None else f"{v:.{digits}f}"
 
 
-def score_sequence(out, scene, frames, images, flip):
-    """Scores `images(frame) -> HDR array` against the references; returns rows."""
+def score_sequence(out, scene, frames, images):
+    """Scores `images(frame) -> HDR array` against the references with `dvr.metrics`
+    (the eval's own code, through the Python package); returns rows."""
     d = os.path.join(out, dir_name(scene))
     rows, prev = [], None
     for f in frames:
-        ref = tonemap(read_exr(os.path.join(d, "reference", f"{f:04d}.exr")))
-        test = tonemap(images(f))
-        te = temporal_error(prev[0], test, prev[1], ref) if prev is not None else None
+        ref = read_exr(os.path.join(d, "reference", f"{f:04d}.exr"))
+        test = np.ascontiguousarray(images(f), dtype=np.float32)
+        te = dvr.metrics.temporal_error(prev[0], test, prev[1], ref) if prev is not None else None
         rows.append(
-            {"frame": f, "psnr": psnr(ref, test), "ssim": ssim(ref, test), "flip": flip(ref, test), "temporal_error": te, "display": test}
+            {
+                "frame": f,
+                "psnr": dvr.metrics.psnr(ref, test),
+                "ssim": dvr.metrics.ssim(ref, test),
+                "flip": dvr.metrics.flip(ref, test),
+                "temporal_error": te,
+                "display": dvr.metrics.tonemap(test),
+            }
         )
         prev = (test, ref)
     return rows
@@ -239,13 +169,12 @@ def main():
         sys.exit(f"oidn_eval: {metrics_path} has no `none` rows (run dvr eval with --denoiser none,...)")
     frames = {s: sorted(int(r["frame"]) for r in rows if r["scene"] == s and r["method"] == "none") for s in scenes}
     events = event_frames(args.out)
-    flip = Flip()
 
     if args.check:
         worst = {"psnr": 0.0, "ssim": 0.0, "flip": 0.0, "temporal_error": 0.0}
         for s in scenes:
             d = os.path.join(args.out, dir_name(s))
-            got = score_sequence(args.out, s, frames[s], lambda f: read_exr(os.path.join(d, "none", f"{f:04d}.exr")), flip)
+            got = score_sequence(args.out, s, frames[s], lambda f: read_exr(os.path.join(d, "none", f"{f:04d}.exr")))
             want = {int(r["frame"]): r for r in rows if r["scene"] == s and r["method"] == "none"}
             for g in got:
                 w = want[g["frame"]]
@@ -279,11 +208,11 @@ def main():
                 cpu_ms[method].append(1e3 * (time.perf_counter() - t0))
                 return np.asarray(out, dtype=np.float32)
 
-            scored = score_sequence(args.out, s, frames[s], denoised, flip)
+            scored = score_sequence(args.out, s, frames[s], denoised)
             for r in scored:
                 write_png(os.path.join(d, method, f"{r['frame']:04d}.png"), r["display"])
                 new_rows.append(
-                    [s, method, str(r["frame"]), f"{r['psnr']:.4f}", f"{r['ssim']:.6f}", fmt(r["flip"], 6), fmt(r["temporal_error"], 6), ""]
+                    [s, method, str(r["frame"]), f"{r['psnr']:.6f}", f"{r['ssim']:.6f}", fmt(r["flip"], 6), fmt(r["temporal_error"], 6), ""]
                 )
             mean = lambda xs: sum(xs) / len(xs) if xs else None
             te = [r["temporal_error"] for r in scored if r["temporal_error"] is not None]
