@@ -54,6 +54,7 @@ pub fn capture(
         readback: true,
         reset: false,
         aux: false,
+        features: false,
     };
     let mut progress = Progress::new(f64::from(setup.frames));
     let mut rate = FrameRate::default();

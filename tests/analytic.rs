@@ -91,6 +91,7 @@ fn identical_seeds_give_identical_images() {
                 readback: true,
                 reset: false,
                 aux: false,
+                features: false,
             },
         )
         .expect("frame");

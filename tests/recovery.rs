@@ -55,6 +55,7 @@ fn recovery(scene_name: &str, method: &str) -> (usize, Option<usize>, Vec<f64>, 
         readback: true,
         reset: false,
         aux: false,
+        features: false,
     };
     for f in 0..FRAMES {
         if let Some(done) = r.frame(&setup.frame_inputs(f), &request).expect("frame") {

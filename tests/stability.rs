@@ -29,6 +29,7 @@ fn every_denoiser_stays_finite_and_bounded_on_every_built_in_animation() {
             readback: true,
             reset: false,
             aux: false,
+            features: false,
         };
         let mut results = Vec::new();
         for f in 0..8 {
@@ -84,6 +85,7 @@ fn ours_on_a_static_scene_beats_32_spp_after_64_frames() {
             readback: true,
             reset: false,
             aux: false,
+            features: false,
         };
         for _ in 0..64 {
             r.frame(&inputs, &request).expect("frame");

@@ -571,6 +571,7 @@ fn svgf_and_taa_stay_finite_and_bounded_for_50_frames() {
         readback: true,
         reset: false,
         aux: false,
+        features: false,
     };
     let mut results = Vec::new();
     for k in 0..60 {

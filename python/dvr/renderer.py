@@ -38,12 +38,18 @@ class Renderer:
             device=device,
         )
 
-    def render(self, frame=None, reset=False, aux=False) -> dict:
+    def render(self, frame=None, reset=False, aux=False, features=False) -> dict:
         """Renders animation frame ``frame`` (default: the next) and returns
         ``{"noisy": img, "<denoiser>": img, ...}``, each ``(h, w, 3)`` float32 linear
         radiance; with ``aux=True`` also ``"albedo"`` and ``"normal"`` (the guides
-        single-frame denoisers such as OIDN take). ``reset=True`` is a cut."""
-        return self._r.render(frame, reset, aux)
+        single-frame denoisers such as OIDN take); with ``features=True`` also
+        ``"features"``: ``{"position", "normal", "albedo"}``, each ``(h, w, 4)`` (the
+        opacity-threshold surface the temporal denoisers reproject with: world position
+        with w = 1 where the ray met that surface or, through semi-transparent medium,
+        at the expected first collision; normal with w = the distance along the ray and
+        TF albedo with w = 1, both on the threshold surface only). ``reset=True`` is a
+        cut."""
+        return self._r.render(frame, reset, aux, features)
 
     def reference(self, frame=None, spp=1024):
         """A high-sample reference of ``frame`` (default: the last rendered), from its

@@ -128,3 +128,17 @@ pub fn image_out<'py>(
         .expect("the renderer reads back width × height pixels");
     PyArray3::from_owned_array(py, array)
 }
+
+/// RGBA pixels from the renderer as an `(h, w, 4)` float32 array (the surface features,
+/// whose fourth channel carries a flag or a distance).
+pub fn image_out_rgba<'py>(
+    py: Python<'py>,
+    width: u32,
+    height: u32,
+    rgba: &[[f32; 4]],
+) -> Bound<'py, PyArray3<f32>> {
+    let flat: Vec<f32> = rgba.iter().flatten().copied().collect();
+    let array = numpy::ndarray::Array3::from_shape_vec((height as usize, width as usize, 4), flat)
+        .expect("the renderer reads back width × height pixels");
+    PyArray3::from_owned_array(py, array)
+}

@@ -2,7 +2,7 @@
 //! state lives here, so rendering frames 0..n in order is the animation `dvr eval`
 //! renders (same noisy input, same denoisers, same references).
 
-use crate::convert::{image_out, runtime_error, value_error};
+use crate::convert::{image_out, image_out_rgba, runtime_error, value_error};
 use crate::scene::{scene_from_dict, tf_from_dict};
 use crate::volume::Volume;
 use dvr_engine::error::EngineError;
@@ -11,7 +11,7 @@ use dvr_engine::gpu::{ContextOptions, GpuContext};
 use dvr_engine::graph::Extent;
 use dvr_engine::passes::aux_features::{ALBEDO, NORMAL};
 use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup};
-use dvr_engine::renderer::{FrameRequest, FrameResult, Renderer as EngineRenderer};
+use dvr_engine::renderer::{FrameRequest, FrameResult, Renderer as EngineRenderer, FEATURE_IMAGES};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -149,14 +149,17 @@ impl Renderer {
     /// Renders animation frame `frame` (default: the one after the last) and returns a
     /// dict of `(h, w, 3)` float32 linear images: `"noisy"` and one per denoiser, plus
     /// `"albedo"` and `"normal"` (the single-frame denoisers' guides) with `aux=True`.
-    /// `reset=True` restarts every history first (a cut).
-    #[pyo3(signature = (frame = None, reset = false, aux = false))]
+    /// `reset=True` restarts every history first (a cut). `features=True` adds
+    /// `"features"`: `{"position", "normal", "albedo"}`, each `(h, w, 4)` float32 (the
+    /// surface features the temporal denoisers reproject with; see `FEATURE_IMAGES`).
+    #[pyo3(signature = (frame = None, reset = false, aux = false, features = false))]
     fn render<'py>(
         &mut self,
         py: Python<'py>,
         frame: Option<u32>,
         reset: bool,
         aux: bool,
+        features: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let me = &mut self.inner;
         let f = frame.unwrap_or(me.0.next_frame);
@@ -171,6 +174,7 @@ impl Renderer {
             readback: true,
             reset,
             aux,
+            features,
         };
         let inputs = me.0.setup.frame_inputs(f);
         let results = py
@@ -190,7 +194,13 @@ impl Renderer {
         me.0.last_frame = Some(f);
         let (w, h) = (me.0.setup.config.size.width, me.0.setup.config.size.height);
         let out = PyDict::new(py);
+        let surface = PyDict::new(py);
         for (name, pixels) in &result.images {
+            if let Some(i) = FEATURE_IMAGES.iter().position(|n| n == name) {
+                let key = ["position", "normal", "albedo"][i];
+                surface.set_item(key, image_out_rgba(py, w, h, pixels))?;
+                continue;
+            }
             let key = match name.as_str() {
                 NOISY_METHOD => "noisy",
                 n if n == ALBEDO => "albedo",
@@ -198,6 +208,9 @@ impl Renderer {
                 n => n,
             };
             out.set_item(key, image_out(py, w, h, pixels))?;
+        }
+        if features {
+            out.set_item("features", surface)?;
         }
         me.0.last_timings = result.timings;
         Ok(out)

@@ -193,3 +193,24 @@ def test_a_missing_device_is_a_runtime_error():
     p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, p.stderr
     assert "RuntimeError:" in p.stdout and "no-such-gpu" in p.stdout
+
+
+def test_surface_features_come_back_with_a_frame():
+    r = dvr.Renderer(dvr.Scene.builtin("phantom/orbit"), size=(16, 16), denoisers=["taa"])
+    out = r.render(features=True, aux=True)
+    f = out["features"]
+    assert set(f) == {"position", "normal", "albedo"}
+    for img in f.values():
+        assert img.shape == (16, 16, 4) and np.isfinite(img).all()
+    met = f["position"][..., 3] > 0.5  # the threshold surface or visible medium
+    surface = f["albedo"][..., 3] > 0.5  # the threshold surface only
+    # The phantom fills the middle of the frame and not the corners.
+    assert met[8, 8] and not met[0, 0] and surface.any()
+    assert not (surface & ~met).any()
+    # Unit normals and a positive distance on the surface; albedo in [0, 1].
+    n = np.linalg.norm(f["normal"][surface][:, :3], axis=1)
+    assert np.allclose(n, 1.0, atol=1e-3) and (f["normal"][surface][:, 3] > 0).all()
+    assert (f["albedo"][surface][:, :3] >= 0).all() and (f["albedo"][surface][:, :3] <= 1).all()
+    # Positions lie inside the volume's box (longest side 1, centred on the origin).
+    assert (np.abs(f["position"][met][:, :3]) <= 0.5 + 1e-3).all()
+    assert "features" not in r.render()

@@ -397,6 +397,7 @@ pub fn evaluate_scene(
         readback: true,
         reset: false,
         aux: args.aux,
+        features: false,
     };
     let frame_units = f64::from(setup.settings.spp()) + methods.len() as f64;
     let status = |f: u32| {

@@ -116,6 +116,7 @@ impl Explorer {
             readback: readback_hdr,
             reset: false,
             aux: false,
+            features: false,
         };
         let result = renderer.frame_presented(&inputs, &request, Some(&target))?;
         if !gfx.swapchain.present(&gfx.ctx, &image)? {

@@ -66,7 +66,17 @@ pub struct FrameRequest {
     /// [`aux_features::ALBEDO`]: crate::passes::aux_features::ALBEDO
     /// [`aux_features::NORMAL`]: crate::passes::aux_features::NORMAL
     pub aux: bool,
+    /// Also read back the surface features (world position, normal with the distance
+    /// along the ray, TF albedo; [`FEATURE_IMAGES`]), rendering them if no denoiser
+    /// needs them (needs `readback`).
+    pub features: bool,
 }
+
+/// The names [`FrameRequest::features`] reads the surface features back as, each RGBA
+/// (surface_features.comp): position (w = 1 where the ray met the threshold surface or,
+/// through semi-transparent medium, at the expected first collision), normal (w =
+/// distance along the ray) and albedo (w = 1), both on the threshold surface only.
+pub const FEATURE_IMAGES: [&str; 3] = ["features.position", "features.normal", "features.albedo"];
 
 /// Results of a completed frame.
 #[derive(Clone, Debug, Default)]

@@ -10,7 +10,7 @@ pub mod scene_gpu;
 pub mod scene_setup;
 mod submit;
 
-pub use inputs::{CameraMatrices, FrameInputs, FrameRequest, FrameResult};
+pub use inputs::{CameraMatrices, FrameInputs, FrameRequest, FrameResult, FEATURE_IMAGES};
 pub use reference::{samples_per_dispatch, MAX_SAMPLES_PER_DISPATCH, PIXEL_SAMPLES_PER_DISPATCH};
 use submit::{add_readbacks, read_pixels, submit, Slot};
 
@@ -371,10 +371,11 @@ impl Renderer {
 
         // features → path trace → motion → each denoiser on the same noisy frame.
         let motion = self.config.motion_source;
-        let features = if self
-            .denoisers
-            .iter()
-            .any(|m| m.info.features.needed(motion))
+        let features = if request.features
+            || self
+                .denoisers
+                .iter()
+                .any(|m| m.info.features.needed(motion))
         {
             Some(passes.features.add(ctx, graph, &mut frame, &scene, size)?)
         } else {
@@ -442,6 +443,10 @@ impl Renderer {
             let (albedo, normal) = pass.add(ctx, graph, &mut frame, &scene, size)?;
             read.push((aux_features::ALBEDO.to_string(), albedo));
             read.push((aux_features::NORMAL.to_string(), normal));
+        }
+        if let (true, Some(f)) = (request.features, &features) {
+            let images = [f.position.cur, f.normal, f.albedo];
+            read.extend(FEATURE_IMAGES.iter().map(|n| n.to_string()).zip(images));
         }
         let readbacks = if request.readback {
             add_readbacks(ctx, graph, &mut frame, slot, &read, size)?
