@@ -75,7 +75,7 @@ impl Default for RenderArgs {
     fn default() -> Self {
         Self {
             spp: None,
-            volume_size: 128,
+            volume_size: dvr_engine::renderer::scene_setup::DEFAULT_VOLUME_SIZE,
             motion: dvr_engine::denoise::MotionSource::Features,
         }
     }

@@ -115,30 +115,22 @@ pub fn image_in(a: &PyReadonlyArray3<'_, f32>, name: &str) -> PyResult<Rgb32Imag
     Ok(Rgb32Image::new(w as u32, h as u32, data))
 }
 
-/// RGBA pixels from the renderer (row-major) as an `(h, w, 3)` float32 array.
+/// RGBA pixels from the renderer (row-major) as an `(h, w, channels)` float32 array:
+/// 3 for radiance, 4 for the surface features (whose fourth channel carries a flag or
+/// a distance).
 pub fn image_out<'py>(
     py: Python<'py>,
     width: u32,
     height: u32,
     rgba: &[[f32; 4]],
+    channels: usize,
 ) -> Bound<'py, PyArray3<f32>> {
     let (w, h) = (width as usize, height as usize);
-    let flat: Vec<f32> = rgba.iter().flat_map(|p| [p[0], p[1], p[2]]).collect();
-    let array = numpy::ndarray::Array3::from_shape_vec((h, w, 3), flat)
-        .expect("the renderer reads back width × height pixels");
-    PyArray3::from_owned_array(py, array)
-}
-
-/// RGBA pixels from the renderer as an `(h, w, 4)` float32 array (the surface features,
-/// whose fourth channel carries a flag or a distance).
-pub fn image_out_rgba<'py>(
-    py: Python<'py>,
-    width: u32,
-    height: u32,
-    rgba: &[[f32; 4]],
-) -> Bound<'py, PyArray3<f32>> {
-    let flat: Vec<f32> = rgba.iter().flatten().copied().collect();
-    let array = numpy::ndarray::Array3::from_shape_vec((height as usize, width as usize, 4), flat)
+    let flat: Vec<f32> = rgba
+        .iter()
+        .flat_map(|p| p[..channels].iter().copied())
+        .collect();
+    let array = numpy::ndarray::Array3::from_shape_vec((h, w, channels), flat)
         .expect("the renderer reads back width × height pixels");
     PyArray3::from_owned_array(py, array)
 }

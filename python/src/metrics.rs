@@ -103,5 +103,5 @@ pub fn tonemap<'py>(
     let img = image_in(&image, "image")?;
     let d = metrics::display(&img);
     let rgba: Vec<[f32; 4]> = d.data.iter().map(|p| [p[0], p[1], p[2], 1.0]).collect();
-    Ok(image_out(py, d.width, d.height, &rgba))
+    Ok(image_out(py, d.width, d.height, &rgba, 3))
 }

@@ -2,7 +2,7 @@
 //! state lives here, so rendering frames 0..n in order is the animation `dvr eval`
 //! renders (same noisy input, same denoisers, same references).
 
-use crate::convert::{image_out, image_out_rgba, runtime_error, value_error};
+use crate::convert::{image_out, runtime_error, value_error};
 use crate::scene::{scene_from_dict, tf_from_dict};
 use crate::volume::Volume;
 use dvr_engine::error::EngineError;
@@ -10,7 +10,7 @@ use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::gpu::{ContextOptions, GpuContext};
 use dvr_engine::graph::Extent;
 use dvr_engine::passes::aux_features::{ALBEDO, NORMAL};
-use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup};
+use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup, DEFAULT_VOLUME_SIZE};
 use dvr_engine::renderer::{FrameRequest, FrameResult, Renderer as EngineRenderer, FEATURE_IMAGES};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -104,7 +104,7 @@ impl Renderer {
             let volume = match given {
                 Some(v) => v.0,
                 None => {
-                    loaded = load_volume(&scene, 128).map_err(value_error)?;
+                    loaded = load_volume(&scene, DEFAULT_VOLUME_SIZE).map_err(value_error)?;
                     &loaded
                 }
             };
@@ -198,7 +198,7 @@ impl Renderer {
         for (name, pixels) in &result.images {
             if let Some(i) = FEATURE_IMAGES.iter().position(|n| n == name) {
                 let key = ["position", "normal", "albedo"][i];
-                surface.set_item(key, image_out_rgba(py, w, h, pixels))?;
+                surface.set_item(key, image_out(py, w, h, pixels, 4))?;
                 continue;
             }
             let key = match name.as_str() {
@@ -207,7 +207,7 @@ impl Renderer {
                 n if n == NORMAL => "normal",
                 n => n,
             };
-            out.set_item(key, image_out(py, w, h, pixels))?;
+            out.set_item(key, image_out(py, w, h, pixels, 3))?;
         }
         if features {
             out.set_item("features", surface)?;
@@ -239,7 +239,7 @@ impl Renderer {
             .detach(|| me.get().renderer.reference(&inputs, spp, spp))
             .map_err(engine_error)?;
         let (w, h) = (me.0.setup.config.size.width, me.0.setup.config.size.height);
-        Ok(image_out(py, w, h, &pixels))
+        Ok(image_out(py, w, h, &pixels, 3))
     }
 
     /// GPU milliseconds per pass of the last rendered frame (`{pass: ms}`).

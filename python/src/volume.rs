@@ -4,6 +4,7 @@
 //! `spacing` is given in the same axis order as the array's shape.
 
 use crate::convert::value_error;
+use dvr_engine::renderer::scene_setup::DEFAULT_VOLUME_SIZE;
 use dvr_engine::volume::{Volume as EngineVolume, VolumeData, Voxels};
 use numpy::{PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -98,7 +99,7 @@ impl Volume {
     /// A built-in dataset: `phantom` (CT-like head), `cloud` (a homogeneous medium),
     /// both `size`³, or `mri` (the bundled MNI152 T1; `size` is ignored).
     #[staticmethod]
-    #[pyo3(signature = (name, size = 128))]
+    #[pyo3(signature = (name, size = DEFAULT_VOLUME_SIZE))]
     fn builtin(py: Python<'_>, name: &str, size: u32) -> PyResult<Self> {
         let name = name.to_string();
         let inner = py

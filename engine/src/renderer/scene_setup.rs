@@ -136,6 +136,10 @@ pub fn inputs_for(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -
     }
 }
 
+/// Edge length of procedural volumes (phantom, cloud) when neither the scene nor the
+/// caller gives one: the CLI's `--volume-size` default and the Python package's.
+pub const DEFAULT_VOLUME_SIZE: u32 = 128;
+
 /// The scene's volume: a built-in dataset or a file.
 pub fn load_volume(scene: &Scene, volume_size: u32) -> Result<Volume, VolumeError> {
     match &scene.volume.source {
