@@ -48,13 +48,13 @@ class TransferFunction:
     @classmethod
     def preset(cls, name: str) -> "TransferFunction":
         """A shipped preset (see :meth:`presets`)."""
-        d = _native.tf_points(name)
+        d = _native.tf_preset(name)
         return cls(d["point"], d.get("name", name))
 
     @classmethod
     def load(cls, path) -> "TransferFunction":
         """A TF file (TOML, as in ``assets/transfer/``)."""
-        d = _native.tf_points(str(path) if "/" in str(path) or str(path).endswith(".toml") else "./" + str(path))
+        d = _native.tf_file(str(path))
         return cls(d["point"], d.get("name", str(path)))
 
     @classmethod

@@ -21,7 +21,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::scene_dict, m)?)?;
     m.add_function(wrap_pyfunction!(scene::builtin_scene_names, m)?)?;
     m.add_function(wrap_pyfunction!(scene::check_scene, m)?)?;
-    m.add_function(wrap_pyfunction!(scene::tf_points, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::tf_preset, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::tf_file, m)?)?;
     m.add_function(wrap_pyfunction!(scene::tf_preset_names, m)?)?;
     m.add_function(wrap_pyfunction!(scene::check_tf, m)?)?;
     m.add_function(wrap_pyfunction!(metrics::psnr, m)?)?;

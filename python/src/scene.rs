@@ -52,15 +52,17 @@ pub fn check_scene<'py>(
     toml_dict(py, &scene.to_toml().map_err(value_error)?)
 }
 
-/// A TF preset (by name) or TF file (a path) as its dict.
+/// A shipped TF preset, by name, as its dict.
 #[pyfunction]
-pub fn tf_points<'py>(py: Python<'py>, spec: &str) -> PyResult<Bound<'py, PyAny>> {
-    let tf = if dvr_engine::scene::transfer_ref::is_path(spec) {
-        TransferFunction::load(spec)
-    } else {
-        TransferFunction::preset(spec)
-    }
-    .map_err(value_error)?;
+pub fn tf_preset<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+    let tf = TransferFunction::preset(name).map_err(value_error)?;
+    toml_dict(py, &tf.to_toml())
+}
+
+/// A TF file as its dict.
+#[pyfunction]
+pub fn tf_file<'py>(py: Python<'py>, path: std::path::PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    let tf = TransferFunction::load(&path).map_err(value_error)?;
     toml_dict(py, &tf.to_toml())
 }
 

@@ -63,3 +63,12 @@ def test_transfer_functions():
         dvr.TransferFunction.from_array([[0.0, 1, 1, 1, 0.0], [1.0, 1, 1, 1, 2.0]])
     with pytest.raises(ValueError, match="no-such-tf"):
         dvr.TransferFunction.preset("no-such-tf")
+
+
+def test_transfer_function_files(root, tmp_path):
+    preset = dvr.TransferFunction.preset("mri-opaque")
+    loaded = dvr.TransferFunction.load(root / "assets/transfer/mri-opaque.toml")
+    assert loaded.points == preset.points
+    (tmp_path / "bad.toml").write_text('name = "x"\n[[point]]\ndensity = 0.5\nopacity = 2.0\ndiffuse = [1, 1, 1]\n')
+    with pytest.raises(ValueError, match="bad.toml"):
+        dvr.TransferFunction.load(tmp_path / "bad.toml")
