@@ -131,7 +131,7 @@ pub fn reference(
         progress: None,
         samples_per_frame: f64::from(spp) * f64::from(setup.width() * setup.height()),
     };
-    cache.fill_frames(&setup, &mut report, &frames)?;
+    let _claim = cache.fill_frames(&setup, &mut report, &frames)?;
     if let Some(p) = &mut report.progress {
         p.finish();
     }
@@ -187,23 +187,38 @@ pub fn profile(
     json: Option<&Path>,
     trace: Option<&Path>,
 ) -> Result<()> {
-    let (report, window) = run_profile(args, denoisers)?;
+    // An output that cannot be written is found before the run, not after it.
+    for p in json.into_iter().chain(trace) {
+        dvr_engine::files::output_target(p).with_context(|| format!("writing {}", p.display()))?;
+    }
+    let stop = profile::interrupt::Interrupt::install().context("installing signal handlers")?;
+    let (report, window) = run_profile(args, denoisers, Some(&stop))?;
     print!("{}", profile::table(&report));
     if let Some(p) = json {
         profile::write_json(p, &report)?;
     }
     if let Some(p) = trace {
-        profile::write_json(
-            p,
-            &profile::chrome_trace(window.frames(), window.first(), &report.frames_note),
-        )?;
+        let mut t = profile::chrome_trace(window.frames(), window.first(), &report.frames_note);
+        if let Some(why) = &report.interrupted {
+            t["metadata"]["interrupted"] = why.clone().into();
+        }
+        profile::write_json(p, &t)?;
     }
-    Ok(())
+    match stop.received() {
+        Some(signal) => Err(signal.into()),
+        None => Ok(()),
+    }
 }
 
 /// Renders the profile's frames: the report (streaming statistics of every frame, the
-/// measured peak bandwidth) and the window of raw frames for the trace.
-pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, profile::Window)> {
+/// measured peak bandwidth) and the window of raw frames for the trace. A signal seen
+/// by `stop` ends the run after the frame in flight; the report then covers the frames
+/// so far and says so.
+pub fn run_profile(
+    args: &SceneArgs,
+    denoisers: &[String],
+    stop: Option<&profile::interrupt::Interrupt>,
+) -> Result<(Profile, profile::Window)> {
     let denoisers = crate::setup::denoiser_list(denoisers)?;
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
@@ -221,7 +236,15 @@ pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, p
     let request = FrameRequest::default();
     let mut progress = Progress::new(f64::from(setup.frames));
     let mut rate = FrameRate::default();
+    let mut interrupted = None;
     for f in 0..setup.frames {
+        if let Some(signal) = stop.and_then(|s| s.received()) {
+            interrupted = Some(format!(
+                "{signal} after {f} of {} frames; the statistics cover those",
+                setup.frames
+            ));
+            break;
+        }
         if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
             keep(done.timings);
             rate.finished();
@@ -241,7 +264,9 @@ pub fn run_profile(args: &SceneArgs, denoisers: &[String]) -> Result<(Profile, p
         denoisers: renderer.denoiser_names(),
         shared_tiles: renderer.ctx().shared_tiles,
     };
-    Ok((Profile::new(run, &stats, &window, Some(peak)), window))
+    let mut report = Profile::new(run, &stats, &window, Some(peak));
+    report.interrupted = interrupted;
+    Ok((report, window))
 }
 
 /// `capture: frame 12/60 | 3.4 fps`.

@@ -173,6 +173,11 @@ fn main() {
     let validation_messages = dvr_engine::gpu::validation::message_count();
     if let Err(e) = result {
         progress::end_line();
+        // A profile stopped by a signal wrote what it had: exit as the signal would.
+        if let Some(signal) = e.downcast_ref::<profile::interrupt::Interrupted>() {
+            eprintln!("dvr: {signal}; the outputs hold the frames rendered so far");
+            std::process::exit(signal.exit_code());
+        }
         eprintln!("dvr: error: {}", error_chain(&e));
         std::process::exit(EXIT_ERROR);
     }

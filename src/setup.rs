@@ -48,15 +48,29 @@ pub fn parse_spp(s: &str) -> Result<u32, String> {
 /// Parses `--frames`: a whole number of at least 1.
 /// One `--denoiser` name, checked against the registry while the command line is
 /// parsed, so a wrong name is a usage error (exit 2) like any other bad argument, and
-/// nothing has been loaded yet. Empty items of a comma list pass (they are skipped).
+/// nothing has been loaded yet. An empty item of a comma list (`ours,,svgf`, a
+/// trailing comma) is a usage error too: it most likely lost a name.
 pub fn parse_denoiser(s: &str) -> Result<String, String> {
     let name = s.trim();
     if name.is_empty() {
-        return Ok(String::new());
+        return Err("an empty entry in the list (two commas in a row, or one at an end)".into());
     }
     registry::find(name)
         .map(|info| info.name.to_string())
         .map_err(|e| e.to_string())
+}
+
+/// The explorer's `--denoiser`: one name, or two for a split view (`A,B`), each checked
+/// as [`parse_denoiser`] checks one, so a wrong name is a usage error there too.
+pub fn parse_view_denoisers(s: &str) -> Result<String, String> {
+    let names = s
+        .split(',')
+        .map(parse_denoiser)
+        .collect::<Result<Vec<String>, String>>()?;
+    if names.len() > 2 {
+        return Err("one denoiser, or two for a split view (A,B)".into());
+    }
+    Ok(names.join(","))
 }
 
 /// `--frame-range A..B`: frames A up to but not including B, A < B.

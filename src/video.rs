@@ -255,6 +255,10 @@ struct Encoder {
 impl Encoder {
     fn start(path: &Path, size: (u32, u32), fps: u32) -> Result<Self> {
         let even = (size.0.next_multiple_of(2), size.1.next_multiple_of(2));
+        // The rename at the end puts a regular file at the target: only a new path, a
+        // regular file or a link to one may be replaced.
+        let path = &dvr_engine::files::output_target(path)
+            .with_context(|| format!("writing {}", path.display()))?;
         let partial = path.with_extension("partial.mp4");
         let mut child = Command::new(FFMPEG)
             .args(["-hide_banner", "-loglevel", "error", "-y"])

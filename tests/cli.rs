@@ -366,7 +366,11 @@ fn sharded_references_write_the_bytes_of_one_run() {
         files(&one.join("reference")),
         files(&sharded.join("reference")),
     );
-    assert_eq!(a.len(), 11, "5 frames × EXR + PNG and the key");
+    assert_eq!(
+        a.len(),
+        12,
+        "5 frames × EXR + PNG, the key and the folder's lock"
+    );
     assert!(a == b, "sharded files differ from one run's");
 
     // A range selects its frames only; past the animation is an error naming it, a
@@ -380,6 +384,7 @@ fn sharded_references_write_the_bytes_of_one_run() {
     assert_eq!(
         names,
         [
+            ".lock",
             "0001.exr",
             "0001.png",
             "0002.exr",
@@ -395,4 +400,146 @@ fn sharded_references_write_the_bytes_of_one_run() {
         let o = run(with(&part, &["--shard", bad]));
         assert_eq!(o.status.code(), Some(2), "--shard {bad}: {}", stderr(&o));
     }
+}
+
+/// `dvr reference` on a small scene into `out` with `spp` samples (more args after).
+fn reference_args(out: &Path, spp: u32, frames: u32) -> Vec<String> {
+    let mut args: Vec<String> = [
+        "reference",
+        "--scene",
+        "cloud/orbit",
+        "--size",
+        "12x10",
+        "--volume-size",
+        "16",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    args.extend(["--frames".into(), frames.to_string()]);
+    args.extend(["--ref-spp".into(), spp.to_string()]);
+    args.extend(["--out".into(), out.to_str().expect("utf-8").to_string()]);
+    args
+}
+
+fn spawn_dvr(args: &[String]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_dvr"))
+        .args(args)
+        .env("DVR_VALIDATION", "1")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("starting dvr")
+}
+
+/// The files of a reference folder without its lock and run records.
+fn frames_and_key(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    files(dir)
+        .into_iter()
+        .filter(|(n, _)| !n.starts_with('.'))
+        .collect()
+}
+
+/// Defect (reliability round 2): two runs with different settings on one `--out` mixed
+/// their frames under one key. Now a run claims the folder: while a live run with other
+/// settings holds it, a run is refused, naming the folder and the other run; equal
+/// settings share it; a dead run's claim is cleared.
+#[test]
+fn a_reference_folder_is_never_shared_by_runs_with_other_settings() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let out = tmp.path().join("c");
+    let run = |args: Vec<String>| dvr(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_ok(&run(reference_args(&out, 8, 3)));
+    let dir = out.join("reference");
+    let single = frames_and_key(&dir);
+    assert!(
+        files(&dir).iter().all(|(n, _)| !n.starts_with(".run-")),
+        "a finished run leaves no claim"
+    );
+
+    // A live run holding the folder with 8 spp, as a run file locked by this process.
+    let key: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("reference.json")).expect("key"))
+            .expect("key json");
+    let held = dir.join(".run-424242-0.json");
+    std::fs::write(
+        &held,
+        serde_json::json!({ "pid": 424242, "key": key }).to_string(),
+    )
+    .expect("run file");
+    let lock = std::fs::File::open(&held).expect("open");
+    lock.lock().expect("lock");
+    let refused = run(reference_args(&out, 4, 3));
+    assert_error(
+        &refused,
+        &[
+            dir.to_str().expect("utf-8"),
+            "in use by another dvr run (pid 424242",
+            "8 spp",
+            "4 spp",
+        ],
+    );
+    assert_eq!(
+        frames_and_key(&dir),
+        single,
+        "the refused run changed nothing"
+    );
+    // Equal settings share the folder.
+    assert_ok(&run(reference_args(&out, 8, 3)));
+    // The holder dies (its lock goes): its file is stale, removed by the next claim.
+    drop(lock);
+    assert_ok(&run(reference_args(&out, 4, 3)));
+    assert!(!held.exists(), "a dead run's claim is cleared");
+    let fresh = tmp.path().join("fresh");
+    assert_ok(&run(reference_args(&fresh, 4, 3)));
+    assert!(frames_and_key(&dir) == frames_and_key(&fresh.join("reference")));
+
+    // Two runs with different settings started together: whichever claims first
+    // renders, the other is refused (or runs after it); either way every frame in the
+    // folder is the one its key describes.
+    let both = tmp.path().join("both");
+    let children = [
+        spawn_dvr(&reference_args(&both, 16, 6)),
+        spawn_dvr(&reference_args(&both, 4, 6)),
+    ];
+    let outputs: Vec<Output> = children
+        .into_iter()
+        .map(|c| c.wait_with_output().expect("running dvr"))
+        .collect();
+    for o in &outputs {
+        assert!(
+            o.status.success() || stderr(o).contains("in use by another dvr run"),
+            "{}",
+            stderr(o)
+        );
+    }
+    let key: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(both.join("reference/reference.json")).expect("key"))
+            .expect("key json");
+    let spp = key["ref_spp"].as_u64().expect("ref_spp") as u32;
+    let alone = tmp.path().join(format!("alone{spp}"));
+    assert_ok(&run(reference_args(&alone, spp, 6)));
+    assert!(
+        frames_and_key(&both.join("reference")) == frames_and_key(&alone.join("reference")),
+        "the folder holds frames of another key than its own ({spp} spp)"
+    );
+
+    // Two identical runs at once: the bytes of one run.
+    let twins = tmp.path().join("twins");
+    let children = [
+        spawn_dvr(&reference_args(&twins, 4, 6)),
+        spawn_dvr(&reference_args(&twins, 4, 6)),
+    ];
+    for c in children {
+        assert_ok(&c.wait_with_output().expect("running dvr"));
+    }
+    let alone4 = if spp == 4 {
+        alone.clone()
+    } else {
+        tmp.path().join("alone4")
+    };
+    if spp != 4 {
+        assert_ok(&run(reference_args(&alone4, 4, 6)));
+    }
+    assert!(frames_and_key(&twins.join("reference")) == frames_and_key(&alone4.join("reference")));
 }

@@ -199,3 +199,243 @@ fn nonsense_scenes_fail_and_names_are_escaped() {
         "the name, escaped"
     );
 }
+
+/// A `dvr` child with piped output, for tests that signal or time it.
+fn spawn(args: &[&str], envs: &[(&str, &str)]) -> std::process::Child {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_dvr"));
+    c.args(args)
+        .env("DVR_VALIDATION", "1")
+        .env_remove("DVR_LOG")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped());
+    for (k, v) in envs {
+        c.env(k, v);
+    }
+    c.spawn().expect("starting dvr")
+}
+
+/// Waits at most `limit` for `child`; a child still running then is killed and the
+/// test fails (the defects these tests reproduce hung).
+fn wait_within(mut child: std::process::Child, limit: std::time::Duration) -> Output {
+    let start = std::time::Instant::now();
+    while child.try_wait().expect("waiting").is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let o = child.wait_with_output().expect("output");
+            panic!("dvr ran past {limit:?}; stderr:\n{}", stderr(&o));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child.wait_with_output().expect("output")
+}
+
+fn profile_args<'a>(json: &'a str, trace: &'a str, frames: &'a str) -> Vec<&'a str> {
+    vec![
+        "profile",
+        "--scene",
+        "cloud/orbit",
+        "--volume-size",
+        "16",
+        "--size",
+        "16x16",
+        "--frames",
+        frames,
+        "--denoiser",
+        "none",
+        "--json",
+        json,
+        "--trace",
+        trace,
+    ]
+}
+
+/// Reliability round 2, defect 1: `--trace /dev/full` replaced the device node with a
+/// regular file, `--json link.json` replaced the link, a FIFO was replaced. Now a
+/// link is written through and anything but a regular file or a new path is refused
+/// before the run, by name; nothing is replaced.
+#[test]
+fn outputs_write_through_links_and_refuse_devices_fifos_and_sockets() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let p = |n: &str| d.join(n).to_str().expect("utf-8").to_string();
+    std::fs::write(d.join("real.json"), "{}").expect("write");
+    std::os::unix::fs::symlink("real.json", d.join("link.json")).expect("symlink");
+    assert_status(&dvr(&profile_args(&p("link.json"), &p("t.json"), "3")), 0);
+    let written = std::fs::read_to_string(d.join("real.json")).expect("read");
+    assert!(
+        written.contains("frames_rendered"),
+        "written through: {written}"
+    );
+    assert!(std::fs::symlink_metadata(d.join("link.json"))
+        .expect("meta")
+        .file_type()
+        .is_symlink());
+
+    let ok = Command::new("mkfifo")
+        .arg(d.join("fifo"))
+        .status()
+        .expect("mkfifo");
+    assert!(ok.success());
+    let _socket = std::os::unix::net::UnixListener::bind(d.join("socket")).expect("bind");
+    let mut kinds = vec![("fifo", "named pipe"), ("socket", "socket")];
+    // A character device made here (root may: c 1 7 is /dev/full's numbers).
+    let made = Command::new("mknod")
+        .arg(d.join("full"))
+        .args(["c", "1", "7"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if made {
+        kinds.push(("full", "character device"));
+    }
+    for (name, what) in kinds {
+        let o = dvr(&profile_args(&p("j.json"), &p(name), "3"));
+        assert_status(&o, 1);
+        let err = stderr(&o);
+        assert!(
+            err.contains(&p(name)) && err.contains(what),
+            "{name}: {err}"
+        );
+        let t = std::fs::symlink_metadata(d.join(name))
+            .expect("still there")
+            .file_type();
+        assert!(!t.is_file(), "{name} was replaced by a regular file");
+        assert!(!d.join("j.json").exists(), "refused before the run");
+    }
+}
+
+/// Reliability round 2: Ctrl-C on a long `dvr profile` threw every measurement away.
+/// Now SIGINT or SIGTERM stops it after the frame in flight, the JSON and trace hold
+/// the statistics so far, marked as interrupted, and the exit status is the signal's.
+#[test]
+fn a_signalled_profile_writes_what_it_measured() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (signal, code) in [("INT", 130), ("TERM", 143)] {
+        let json = dir.path().join(format!("{signal}.json"));
+        let trace = dir.path().join(format!("{signal}-trace.json"));
+        let (j, t) = (
+            json.to_str().expect("utf-8"),
+            trace.to_str().expect("utf-8"),
+        );
+        let child = spawn(&profile_args(j, t, "1000000"), &[]);
+        std::thread::sleep(std::time::Duration::from_secs(5));
+        let sent = Command::new("kill")
+            .args([&format!("-{signal}"), &child.id().to_string()])
+            .status()
+            .expect("kill");
+        assert!(sent.success());
+        let o = wait_within(child, std::time::Duration::from_secs(60));
+        assert_status(&o, code);
+        assert!(
+            stderr(&o).contains(&format!("SIG{signal}")),
+            "{}",
+            stderr(&o)
+        );
+        let report: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).expect("json")).expect("parse");
+        let why = report["interrupted"]
+            .as_str()
+            .expect("marked as interrupted");
+        assert!(why.contains(&format!("SIG{signal}")), "{why}");
+        assert!(report["frames_rendered"].as_u64().expect("frames") > 0);
+        let trace: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&trace).expect("trace")).expect("parse");
+        assert!(trace["metadata"]["interrupted"].is_string());
+        assert!(!trace["traceEvents"].as_array().expect("events").is_empty());
+    }
+}
+
+/// Reliability round 2, defect 2: `DVR_FONT=/dev/zero` grew by 1 GB/s until killed; a
+/// text file given as the font passed without a word. Both are now warnings naming the
+/// file, and the usual fonts are used.
+#[test]
+fn a_font_that_is_not_one_is_a_warning_not_a_hang() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let text = dir.path().join("font.ttf");
+    std::fs::write(&text, "not a font\n").expect("write");
+    let out = dir.path().join("eval");
+    for (font, says) in [
+        ("/dev/zero", "character device"),
+        (
+            text.to_str().expect("utf-8"),
+            "not a TrueType or OpenType font",
+        ),
+    ] {
+        let child = spawn(
+            &[
+                "eval",
+                "--scene",
+                "cloud/orbit",
+                "--volume-size",
+                "16",
+                "--frames",
+                "2",
+                "--size",
+                "12x10",
+                "--ref-spp",
+                "4",
+                "--denoiser",
+                "none",
+                "--out",
+                out.to_str().expect("utf-8"),
+            ],
+            &[("DVR_FONT", font)],
+        );
+        let o = wait_within(child, std::time::Duration::from_secs(120));
+        assert_status(&o, 0);
+        let err = stderr(&o);
+        assert!(
+            err.contains(&format!("DVR_FONT={font}")) && err.contains(says),
+            "{font}: {err}"
+        );
+    }
+}
+
+/// Reliability round 2: `DVR_WRLS=kappa=nan` was refused only when the method was
+/// built, after the references; an empty `--denoiser` entry is a usage error (2).
+#[test]
+fn bad_overrides_fail_before_rendering_and_empty_entries_are_usage_errors() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("eval");
+    let args = [
+        "eval",
+        "--scene",
+        "cloud/orbit",
+        "--volume-size",
+        "16",
+        "--frames",
+        "2",
+        "--size",
+        "12x10",
+        "--ref-spp",
+        "4",
+        "--denoiser",
+        "none",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ];
+    for (var, value, says) in [
+        ("DVR_WRLS", "lambda=nan", "lambda must be in"),
+        ("DVR_OURS", "kappa=1e30", "kappa must be in"),
+        ("DVR_SVGF", "sigma_l=-1", "sigma_l must be in"),
+    ] {
+        let o = wait_within(
+            spawn(&args, &[(var, value)]),
+            std::time::Duration::from_secs(60),
+        );
+        assert_status(&o, 1);
+        assert!(stderr(&o).contains(says), "{var}={value}: {}", stderr(&o));
+        assert!(
+            !out.join("cloud_orbit/reference").exists(),
+            "refused before rendering"
+        );
+    }
+    for list in ["none,,ours", "none,", ","] {
+        let o = dvr(&["capture", "--denoiser", list, "--frames", "1"]);
+        assert_status(&o, 2);
+    }
+    // The explorer's split-view form is checked while parsing too (before a window).
+    for view in ["foo", "ours,foo", "ours,svgf,taa", "ours,"] {
+        let o = dvr(&["explore", "--denoiser", view, "--frames", "1"]);
+        assert_status(&o, 2);
+    }
+}

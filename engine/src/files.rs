@@ -1,8 +1,11 @@
 //! Files as the engine reads and writes them. Inputs are opened only when they are
-//! regular files, and text inputs only up to a size no real one reaches: a FIFO blocks
-//! its reader forever and `/dev/zero` never ends. Outputs are written under a temporary
-//! name in the same folder and renamed over the target, so a reader (or the next run of
-//! a cache) never sees half a file: a crash leaves the old file or none.
+//! regular files, and read only up to a size no real one reaches: a FIFO blocks its
+//! reader forever and `/dev/zero` never ends. Outputs go only to a regular file or a new
+//! path, written under a temporary name in the same folder and renamed over the target,
+//! so a reader (or the next run of a cache) never sees half a file: a crash leaves the
+//! old file or none. A symbolic link is written through (its target is replaced, the
+//! link stays); a device, FIFO, socket or folder is refused, since a rename would put a
+//! regular file in its place (`/dev/stdout` included: it links to a pipe or terminal).
 
 use std::fs::File;
 use std::io::{Read, Write};
@@ -58,18 +61,76 @@ pub fn open_regular(path: &Path) -> std::io::Result<(File, u64)> {
 
 /// Reads a UTF-8 text file of at most `limit` bytes (scene and TF files).
 pub fn read_text(path: &Path, limit: u64) -> std::io::Result<String> {
+    String::from_utf8(read_bounded(path, limit)?)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e.utf8_error()))
+}
+
+/// Reads a whole regular file of at most `limit` bytes (fonts, network weights, text),
+/// refusing a larger one before reading it.
+pub fn read_bounded(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
     let (file, len) = open_regular(path)?;
     if len > limit {
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
-            format!(
-                "is {len} bytes, more than the {limit} bytes a text file of this kind may have"
-            ),
+            format!("is {len} bytes, more than the {limit} bytes a file of this kind may have"),
         ));
     }
-    let mut text = String::new();
-    file.take(limit).read_to_string(&mut text)?;
-    Ok(text)
+    let mut bytes = Vec::with_capacity(len as usize);
+    // One byte past the limit: a file that grew since it was measured is not cut short
+    // silently.
+    file.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("grew past the {limit} bytes a file of this kind may have while it was read"),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// Symbolic links followed at most this deep when resolving an output (the kernel's own
+/// limit is 40).
+const MAX_LINK_DEPTH: usize = 40;
+
+/// The path an output for `path` is written to: `path` itself when it is new or a
+/// regular file; a symbolic link's final target (which may be new) when it is a link;
+/// an error saying what it is for anything else (folder, FIFO, device, socket).
+pub fn output_target(path: &Path) -> std::io::Result<PathBuf> {
+    let mut target = path.to_path_buf();
+    for _ in 0..MAX_LINK_DEPTH {
+        let meta = match std::fs::symlink_metadata(&target) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(target),
+            other => other?,
+        };
+        if meta.file_type().is_symlink() {
+            let link = std::fs::read_link(&target)?;
+            target = match target.parent() {
+                Some(dir) if link.is_relative() => dir.join(link),
+                _ => link,
+            };
+            continue;
+        }
+        return match not_a_regular_file(&target)? {
+            None => Ok(target),
+            Some(what) => {
+                let through = if target == path {
+                    String::new()
+                } else {
+                    format!(" (through the link to {})", target.display())
+                };
+                Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    format!(
+                        "is {what}{through}: outputs are written only to regular files or new paths"
+                    ),
+                ))
+            }
+        };
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!("is a chain of more than {MAX_LINK_DEPTH} symbolic links"),
+    ))
 }
 
 /// How far [`write_atomic`] goes to make a file survive a crash.
@@ -82,8 +143,10 @@ pub enum Durability {
     Synced,
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
+/// Writes `bytes` to `path` (through a symbolic link: to its target, see
+/// [`output_target`]) via a temporary file in the same folder and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8], durability: Durability) -> std::io::Result<()> {
+    let path = &output_target(path)?;
     let tmp = temporary_name(path);
     let result = (|| {
         let mut file = File::create(&tmp)?;
@@ -112,7 +175,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8], durability: Durability) -> std::i
 
 /// `.<name>.<pid>.<n>.tmp` beside `path`: hidden, unique per process and call, and
 /// never mistaken for an output (caches look for exact names).
-fn temporary_name(path: &Path) -> PathBuf {
+pub fn temporary_name(path: &Path) -> PathBuf {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     let name = path
@@ -155,5 +218,77 @@ mod tests {
         let err = read_text(&big, 100).unwrap_err();
         assert!(err.to_string().contains("200 bytes"), "{err}");
         assert_eq!(read_text(&big, 200).expect("fits").len(), 200);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn outputs_write_through_links_and_refuse_what_is_not_a_file() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let d = dir.path();
+        // A link to a regular file: the target is replaced, the link stays a link.
+        std::fs::write(d.join("real.json"), b"old").expect("write");
+        std::os::unix::fs::symlink("real.json", d.join("link.json")).expect("symlink");
+        write_atomic(&d.join("link.json"), b"new", Durability::Renamed).expect("through");
+        assert_eq!(std::fs::read(d.join("real.json")).expect("read"), b"new");
+        let meta = std::fs::symlink_metadata(d.join("link.json")).expect("meta");
+        assert!(meta.file_type().is_symlink());
+        // A dangling link (and a chain of two) creates its target.
+        std::fs::create_dir(d.join("sub")).expect("mkdir");
+        std::os::unix::fs::symlink("sub/made.txt", d.join("dangling")).expect("symlink");
+        std::os::unix::fs::symlink(d.join("dangling"), d.join("chain")).expect("symlink");
+        write_atomic(&d.join("chain"), b"x", Durability::Synced).expect("through");
+        assert_eq!(std::fs::read(d.join("sub/made.txt")).expect("read"), b"x");
+        // A FIFO, a socket, a folder and a link to a FIFO are refused, and left alone.
+        let fifo = d.join("fifo");
+        let ok = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .expect("mkfifo");
+        assert!(ok.success());
+        let socket = d.join("socket");
+        let _listener = std::os::unix::net::UnixListener::bind(&socket).expect("bind");
+        std::os::unix::fs::symlink(&fifo, d.join("to-fifo")).expect("symlink");
+        for (name, what) in [
+            ("fifo", "named pipe"),
+            ("socket", "socket"),
+            ("sub", "a folder"),
+            ("to-fifo", "through the link"),
+        ] {
+            let err = write_atomic(&d.join(name), b"y", Durability::Renamed).unwrap_err();
+            assert!(err.to_string().contains(what), "{name}: {err}");
+        }
+        let t = std::fs::symlink_metadata(&fifo).expect("meta").file_type();
+        assert!(std::os::unix::fs::FileTypeExt::is_fifo(&t));
+        // A character device made in the folder (root only may: mknod c 1 3 is
+        // /dev/null's numbers).
+        let dev = d.join("null");
+        let made = std::process::Command::new("mknod")
+            .arg(&dev)
+            .args(["c", "1", "3"])
+            .status()
+            .is_ok_and(|s| s.success());
+        if made {
+            let err = write_atomic(&dev, b"z", Durability::Renamed).unwrap_err();
+            assert!(err.to_string().contains("character device"), "{err}");
+            let t = std::fs::symlink_metadata(&dev).expect("meta").file_type();
+            assert!(std::os::unix::fs::FileTypeExt::is_char_device(&t));
+        }
+        // Nothing was left behind under a temporary name.
+        let leftovers: Vec<_> = std::fs::read_dir(d)
+            .expect("list")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".tmp"))
+            .collect();
+        assert!(leftovers.is_empty(), "{leftovers:?}");
+    }
+
+    #[test]
+    fn bounded_reads_refuse_large_files() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let p = dir.path().join("f.bin");
+        std::fs::write(&p, [7u8; 10]).expect("write");
+        assert_eq!(read_bounded(&p, 10).expect("fits").len(), 10);
+        let err = read_bounded(&p, 9).unwrap_err();
+        assert!(err.to_string().contains("10 bytes"), "{err}");
     }
 }

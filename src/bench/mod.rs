@@ -123,7 +123,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 ..Default::default()
             },
         };
-        let (report, _) = run_profile(&scene, &denoisers)?;
+        let (report, _) = run_profile(&scene, &denoisers, None)?;
         let stem = args.out.join(format!("profile_{}", size_name(size)));
         profile::write_json(&stem.with_extension("json"), &report)?;
         plots::pass_chart(&report, &stem)?;

@@ -100,7 +100,9 @@ pub struct EvalArgs {
 pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     let started = Instant::now();
     let methods = crate::setup::denoiser_list(&args.denoiser)?;
-    // Fail before hours of rendering, not after: the plots need a font, videos ffmpeg.
+    // Fail before hours of rendering, not after: the plots need a font, videos ffmpeg,
+    // and a parameter override must be in range.
+    dvr_engine::denoise::check_env_overrides()?;
     plots::init_font()?;
     if args.video.video {
         crate::video::require_ffmpeg()?;

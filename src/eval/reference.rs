@@ -8,6 +8,13 @@
 //! procedural generator), the environment map's texels, the path tracer's SPIR-V and
 //! the settings. Every file is written under a temporary name, flushed to disk and
 //! renamed, so an interrupted run never leaves a file that looks finished.
+//!
+//! Several processes may use one folder at once (shards of one reference, two evals
+//! with one `--out`) only when their keys are equal: a run first *claims* the folder
+//! ([`ReferenceCache::claim`]), which refuses it, naming the other run, while a live run
+//! with another key holds a claim there. So every frame in a folder is one its key
+//! describes, whatever runs in parallel; runs with equal keys render frames whose bytes
+//! are equal, written atomically, so which of them writes a frame does not matter.
 
 use crate::setup::Setup;
 use anyhow::{Context, Result};
@@ -144,6 +151,41 @@ impl ContentHash {
     }
 }
 
+/// A run's hold on a reference folder: `reference/.run-<pid>-<n>.json`, locked (an
+/// advisory `flock`) for as long as this value lives, holding the run's key. The lock,
+/// not the file, says the run is alive: a killed run's lock goes with its process and
+/// the next claimer removes its file.
+pub struct Claim {
+    run: Option<(std::fs::File, PathBuf)>,
+    /// What [`ReferenceCache::prepare`] threw away, for the log.
+    pub note: Option<String>,
+}
+
+impl Drop for Claim {
+    fn drop(&mut self) {
+        if let Some((_, path)) = self.run.take() {
+            let _ = std::fs::remove_file(path);
+        }
+    }
+}
+
+/// What a claim file holds.
+#[derive(Serialize, Deserialize)]
+struct RunRecord {
+    pid: u32,
+    key: ReferenceKey,
+}
+
+impl ReferenceKey {
+    /// The settings a user sets, for messages.
+    fn describe(&self) -> String {
+        format!(
+            "{}, {}x{}, {} frames, {} spp",
+            self.scene, self.width, self.height, self.frames, self.ref_spp
+        )
+    }
+}
+
 pub fn frame_name(f: u32) -> String {
     format!("{f:04}")
 }
@@ -273,10 +315,112 @@ impl ReferenceCache {
         self.state().missing
     }
 
+    /// Claims the folder for a run with this key (see the module's comment) and makes
+    /// it consistent with the key ([`ReferenceCache::prepare`]), both under the
+    /// folder's lock (`reference/.lock`), so no other claim runs between the check and
+    /// the clean-up. Fails, naming the other run, while a live run with another key
+    /// holds a claim. A folder that cannot be written (read-only) is claimed without a
+    /// lock: it can be read, and nothing can change it under this run.
+    pub fn claim(&self) -> Result<Claim> {
+        use std::fs::{File, OpenOptions, TryLockError};
+        std::fs::create_dir_all(&self.dir)
+            .with_context(|| format!("creating {}", self.dir.display()))?;
+        let lock_path = self.dir.join(".lock");
+        let lock = match OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&lock_path)
+        {
+            Ok(f) => f,
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::PermissionDenied | std::io::ErrorKind::ReadOnlyFilesystem
+                ) =>
+            {
+                return Ok(Claim {
+                    run: None,
+                    note: None,
+                })
+            }
+            Err(e) => return Err(e).with_context(|| format!("opening {}", lock_path.display())),
+        };
+        lock.lock()
+            .with_context(|| format!("locking {}", lock_path.display()))?;
+        for entry in std::fs::read_dir(&self.dir)
+            .with_context(|| format!("reading {}", self.dir.display()))?
+        {
+            let path = entry?.path();
+            let is_run = path
+                .file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with(".run-") && n.ends_with(".json"));
+            if !is_run {
+                continue;
+            }
+            let Ok(file) = File::open(&path) else {
+                continue; // removed since it was listed: its run ended
+            };
+            match file.try_lock_shared() {
+                // Nobody holds it: the run that wrote it is gone.
+                Ok(()) => {
+                    let _ = std::fs::remove_file(&path);
+                }
+                Err(TryLockError::WouldBlock) => {
+                    let record = dvr_engine::files::read_text(&path, 1 << 16)
+                        .ok()
+                        .and_then(|t| serde_json::from_str::<RunRecord>(&t).ok());
+                    match record {
+                        Some(r) if r.key == self.key => {}
+                        Some(r) => anyhow::bail!(
+                            "{} is in use by another dvr run (pid {}: {}) with other settings \
+                             than this one ({}); wait for it to finish or use another --out",
+                            self.dir.display(),
+                            r.pid,
+                            r.key.describe(),
+                            self.key.describe()
+                        ),
+                        None => anyhow::bail!(
+                            "{} is in use by another dvr run ({} is held but unreadable); \
+                             wait for it to finish or use another --out",
+                            self.dir.display(),
+                            path.display()
+                        ),
+                    }
+                }
+                Err(TryLockError::Error(e)) => {
+                    return Err(e).with_context(|| format!("checking {}", path.display()))
+                }
+            }
+        }
+        let note = self.prepare()?;
+        static CLAIMS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let n = CLAIMS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let path = self
+            .dir
+            .join(format!(".run-{}-{n}.json", std::process::id()));
+        let record = serde_json::to_string_pretty(&RunRecord {
+            pid: std::process::id(),
+            key: self.key.clone(),
+        })?;
+        let mut file =
+            File::create(&path).with_context(|| format!("creating {}", path.display()))?;
+        file.lock()
+            .with_context(|| format!("locking {}", path.display()))?;
+        std::io::Write::write_all(&mut file, record.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        // The folder's lock is released here (dropped); the run's own stays.
+        Ok(Claim {
+            run: Some((file, path)),
+            note,
+        })
+    }
+
     /// Makes the folder consistent with this key before rendering: a different (or
     /// unreadable) key removes the old frames and writes the new key. Returns a note for
-    /// the log when something was thrown away.
-    pub fn prepare(&self) -> Result<Option<String>> {
+    /// the log when something was thrown away. Called under a claim.
+    fn prepare(&self) -> Result<Option<String>> {
         std::fs::create_dir_all(&self.dir)
             .with_context(|| format!("creating {}", self.dir.display()))?;
         if self.key_matches() {
@@ -351,8 +495,9 @@ impl ReferenceCache {
 
     /// Brings the cache up to date: reuses what is there, warns about and re-renders
     /// unreadable frames, renders the rest with a renderer made by `setup` only when
-    /// some frame is missing.
-    pub fn fill(&self, setup: &Setup, report: &mut dyn FillReport) -> Result<()> {
+    /// some frame is missing. Returns the run's claim on the folder: keep it while the
+    /// frames are read.
+    pub fn fill(&self, setup: &Setup, report: &mut dyn FillReport) -> Result<Claim> {
         let all: Vec<u32> = (0..self.key.frames).collect();
         self.fill_frames(setup, report, &all)
     }
@@ -366,7 +511,8 @@ impl ReferenceCache {
         setup: &Setup,
         report: &mut dyn FillReport,
         wanted: &[u32],
-    ) -> Result<()> {
+    ) -> Result<Claim> {
+        let claim = self.claim()?;
         let mut state = self.state();
         state.missing.retain(|f| wanted.contains(f));
         state.unreadable.retain(|(path, _)| {
@@ -382,16 +528,17 @@ impl ReferenceCache {
                 path.display()
             );
         }
+        if let Some(changed) = &claim.note {
+            report.note(Some(changed));
+        }
         if state.missing.is_empty() {
             report.note(Some(&format!(
                 "reusing {reused} reference frame(s) in {}",
                 self.dir.display()
             )));
-            return Ok(());
+            return Ok(claim);
         }
-        if let Some(changed) = self.prepare()? {
-            report.note(Some(&changed));
-        } else if reused > 0 {
+        if reused > 0 {
             report.note(Some(&format!(
                 "reusing {reused} reference frame(s), rendering {}",
                 state.missing.len()
@@ -406,7 +553,8 @@ impl ReferenceCache {
             report.store(self, f, img)?;
             report.rendered(i + 1, state.missing.len());
         }
-        report.finished(&renderer)
+        report.finished(&renderer)?;
+        Ok(claim)
     }
 }
 

@@ -365,7 +365,9 @@ pub fn evaluate_scene(
 ) -> Result<SceneResult> {
     progress.show(&format!("{label} | loading"));
     let setup = Setup::new(&scene_args(args, &scene.spec))?;
-    timing.references.time(|| {
+    // Held until the scene's frames are scored: no run with other settings can change
+    // the references meanwhile.
+    let _claim = timing.references.time(|| {
         scene.references.fill(
             &setup,
             &mut ReferenceProgress {

@@ -77,7 +77,7 @@ pub struct ExploreArgs {
     #[arg(long, default_value = "512x512", value_parser = setup::parse_size)]
     pub size: (u32, u32),
     /// Denoiser shown; `A,B` starts in a split view of A (left) and B (right).
-    #[arg(long, default_value = "ours")]
+    #[arg(long, default_value = "ours", value_parser = setup::parse_view_denoisers)]
     pub denoiser: String,
     /// Exit after this many frames.
     #[arg(long)]
@@ -107,17 +107,8 @@ fn has_display() -> bool {
 }
 
 pub fn run(args: ExploreArgs) -> Result<()> {
-    let names: Vec<String> = args
-        .denoiser
-        .split(',')
-        .map(|s| s.trim().to_string())
-        .collect();
-    if names.is_empty() || names.len() > 2 {
-        bail!("--denoiser takes one denoiser or two for a split view (A,B)");
-    }
-    for n in &names {
-        registry::find(n)?;
-    }
+    // Checked names (setup::parse_view_denoisers): one, or two for a split view.
+    let names: Vec<String> = args.denoiser.split(',').map(str::to_string).collect();
     let script = match &args.script {
         Some(s) => Script::parse(s).context("--script")?,
         None => Script::default(),

@@ -45,8 +45,10 @@ impl Recorder {
             std::fs::create_dir_all(&d).with_context(|| format!("creating {}", d.display()))?;
         }
         let path = dir.join("state.jsonl");
-        let log =
-            std::fs::File::create(&path).with_context(|| format!("creating {}", path.display()))?;
+        let target = dvr_engine::files::output_target(&path)
+            .with_context(|| format!("creating {}", path.display()))?;
+        let log = std::fs::File::create(&target)
+            .with_context(|| format!("creating {}", path.display()))?;
         Ok(Self {
             dir: dir.to_path_buf(),
             frames: Vec::new(),

@@ -6,6 +6,7 @@
 //! raw per-frame timings in the JSON and the trace are those of the last
 //! [`WINDOW_FRAMES`] frames only ([`Window`]).
 
+pub mod interrupt;
 pub mod stats;
 
 use anyhow::Result;
@@ -67,6 +68,9 @@ pub struct Profile {
     pub warmup_frames: usize,
     /// Frames rendered (the statistics cover all of them after the warm-up).
     pub frames_rendered: usize,
+    /// Set when a signal stopped the run early: which, and after how many frames.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interrupted: Option<String>,
     /// The peak bandwidth each pass's `percent_of_peak` refers to.
     pub peak_bandwidth: Option<PeakBandwidth>,
     pub passes: Vec<PassStats>,
@@ -87,6 +91,7 @@ impl Profile {
             run,
             warmup_frames: WARMUP_FRAMES,
             frames_rendered: stats.frames_seen(),
+            interrupted: None,
             peak_bandwidth: peak,
             passes,
             total,
@@ -173,6 +178,9 @@ pub fn table(p: &Profile) -> String {
     }
     if p.frames_first > 0 {
         s.push_str(&format!("JSON and trace: {}\n", p.frames_note));
+    }
+    if let Some(why) = &p.interrupted {
+        s.push_str(&format!("INTERRUPTED: {why}\n"));
     }
     s
 }

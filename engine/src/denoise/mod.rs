@@ -35,6 +35,17 @@ pub type Overridable<P> = (&'static str, f32, f32, fn(&mut P, f32));
 /// environment variable `variable`) applied, for parameter studies with `dvr eval`. An
 /// unknown name lists the known ones; a value outside its range (or not finite) is an
 /// error naming the range.
+/// Checks the parameter overrides in the environment (`DVR_OURS`, `DVR_WRLS`,
+/// `DVR_SVGF`) as the denoisers will read them, so a command can refuse a bad value
+/// before it renders anything, not when the method is built after the references.
+pub fn check_env_overrides() -> Result<()> {
+    let var = |name| std::env::var(name).ok();
+    ours::OursParams::default().with_overrides(var("DVR_OURS").as_deref())?;
+    wrls_paper::WrlsParams::default().with_overrides(var("DVR_WRLS").as_deref())?;
+    svgf::SvgfParams::default().with_overrides(var("DVR_SVGF").as_deref())?;
+    Ok(())
+}
+
 pub fn with_overrides<P>(
     mut params: P,
     variable: &'static str,

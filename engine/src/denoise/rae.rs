@@ -195,7 +195,7 @@ impl RaeWeights {
     /// Reads a manifest and its weight file; every inconsistency (format, layer list,
     /// offsets, file size, non-finite weights) is an error naming the file.
     pub fn load(manifest_path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(manifest_path)
+        let text = crate::files::read_text(manifest_path, crate::files::MAX_TEXT_FILE_BYTES)
             .map_err(|e| weights_error(manifest_path, format!("cannot read: {e}")))?;
         let m: Manifest = serde_json::from_str(&text)
             .map_err(|e| weights_error(manifest_path, format!("not a RAE manifest: {e}")))?;
@@ -254,8 +254,9 @@ impl RaeWeights {
             .parent()
             .unwrap_or(Path::new("."))
             .join(&m.weights);
-        let bytes =
-            std::fs::read(&bin).map_err(|e| weights_error(&bin, format!("cannot read: {e}")))?;
+        // The manifest says how many floats to expect; a longer file is refused unread.
+        let bytes = crate::files::read_bounded(&bin, end * 4)
+            .map_err(|e| weights_error(&bin, format!("cannot read: {e}")))?;
         if bytes.len() as u64 != end * 4 {
             return Err(weights_error(
                 &bin,

@@ -88,6 +88,9 @@ pub struct Scene {
     pub animation: Animation,
 }
 
+/// Longest scene name, in bytes (see [`Scene::check`]).
+pub const MAX_NAME_BYTES: usize = 200;
+
 impl Scene {
     /// Reads and checks a scene file. Relative paths inside it are relative to its
     /// folder.
@@ -182,6 +185,17 @@ impl Scene {
     }
 
     pub(crate) fn check(&self, ctx: &Ctx) -> Result<(), SceneError> {
+        // The name becomes a folder name (at most 255 bytes) and a label on every
+        // progress line: a long one is refused here, before anything echoes it.
+        if self.name.len() > MAX_NAME_BYTES {
+            return Err(ctx.invalid(
+                "name",
+                format!(
+                    "{} bytes long; a scene name may have at most {MAX_NAME_BYTES}",
+                    self.name.len()
+                ),
+            ));
+        }
         self.volume.check(ctx)?;
         let tf_err = |field: &str| {
             let field = field.to_string();

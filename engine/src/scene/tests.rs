@@ -650,3 +650,16 @@ fn empty_file_paths_and_folders_are_named_for_what_they_are() {
         "{msg}"
     );
 }
+
+/// Reliability round 2: a 5,000-character name was refused only when the eval made its
+/// folder, after the progress line had echoed it.
+#[test]
+fn long_names_are_refused_when_the_scene_loads() {
+    let ok = format!("name = \"{}\"\n{MINIMAL}", "n".repeat(MAX_NAME_BYTES));
+    Scene::from_toml_str(&ok, "ok.toml").expect("a name of the longest length");
+    let msg = parse_err(&format!("name = \"{}\"\n{MINIMAL}", "n".repeat(5000)));
+    assert!(
+        msg.contains("name") && msg.contains("5000 bytes") && msg.len() < 300,
+        "{msg}"
+    );
+}

@@ -119,8 +119,9 @@ pub(crate) fn load_series(dir: &Path) -> Result<Volume, VolumeError> {
 fn has_preamble(p: &Path) -> bool {
     use std::io::Read;
     let mut head = [0u8; 132];
-    std::fs::File::open(p)
-        .and_then(|mut f| f.read_exact(&mut head))
+    // Regular files only: opening a FIFO that sits in the folder would block.
+    crate::files::open_regular(p)
+        .and_then(|(mut f, _)| f.read_exact(&mut head))
         .is_ok()
         && &head[128..] == b"DICM"
 }

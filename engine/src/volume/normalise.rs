@@ -14,7 +14,11 @@
 //!      type keep comparable values.
 //!    - float data: NaN/Inf is an error. If all values lie in `[0, 1]` the window is
 //!      `[0, 1]` (the values already are densities); otherwise it is `[min, max]`; a
-//!      constant outside `[0, 1]` uses `[min(0, c), max(1, c)]`.
+//!      constant outside `[0, 1]` uses `[min(0, c), max(1, c)]`. When a few outliers
+//!      set that range (the 0.1–99.9 percentile range of the rest spans less than
+//!      1/1000 of it, so the rest would map to one grey), the window is the range of
+//!      the values within ten such spans of that percentile range, the outliers are
+//!      clamped to 0 or 1, and a warning says how many they are.
 //! 3. Output type follows the stored width: 8-bit stays `U8`, 16-bit (signed or not)
 //!    becomes `U16` (rounded into `0..=65535`), float becomes `F32` clamped to `[0, 1]`.
 
@@ -55,9 +59,29 @@ pub(crate) fn normalise(
         check_finite(path, dims, v)?;
     }
     let data_range = physical_range(&stored.samples, slice_len, &stored.rescale);
-    let window = match stored.type_range {
-        Some(type_range) => integer_window(type_range, data_range, &stored.rescale, dims[2]),
-        None => float_window(data_range),
+    let window = match (&stored.type_range, &stored.samples) {
+        (Some(type_range), _) => integer_window(*type_range, data_range, &stored.rescale, dims[2]),
+        (None, Samples::F32(v)) => {
+            let min_max = float_window(data_range);
+            match outlier_window(v, slice_len, &stored.rescale, min_max) {
+                Some((window, clamped)) => {
+                    log::warn!(
+                        "{}: {clamped} of {voxels} voxels lie far outside the others' range \
+                         and would set the window [{:e}, {:e}], flattening the rest to one \
+                         value; the window is [{:e}, {:e}] and those voxels are clamped to \
+                         0 or 1",
+                        path.display(),
+                        min_max.0,
+                        min_max.1,
+                        window.0,
+                        window.1
+                    );
+                    window
+                }
+                None => min_max,
+            }
+        }
+        (None, _) => float_window(data_range),
     };
     let data = apply_window(stored, slice_len, window);
     Ok(Normalised {
@@ -161,6 +185,56 @@ pub(crate) fn float_window((lo, hi): (f64, f64)) -> (f64, f64) {
     } else {
         (lo.min(0.0), hi.max(1.0))
     }
+}
+
+/// Voxels sampled (evenly) to estimate the percentiles of [`outlier_window`].
+const PERCENTILE_SAMPLES: usize = 1 << 20;
+/// Share of the values below and above the percentile range of [`outlier_window`].
+const TAIL: f64 = 0.001;
+/// The percentile range may span this share of the min–max window before the window
+/// counts as set by outliers (the bulk would then use less than 1/1000 of `[0, 1]`).
+const DOMINATED: f64 = 1e-3;
+/// Values within this many percentile ranges of it are kept inside the window.
+const KEEP_SPANS: f64 = 10.0;
+
+/// A float volume's window when outliers set its min–max window (see the module's
+/// rule 2), with the number of voxels clamped; `None` when they do not.
+fn outlier_window(
+    v: &[f32],
+    slice_len: usize,
+    rescale: &Rescale,
+    (lo, hi): (f64, f64),
+) -> Option<((f64, f64), usize)> {
+    let physical = |i: usize| {
+        rescale
+            .for_slice(i / slice_len.max(1))
+            .apply(f64::from(v[i]))
+    };
+    let step = v.len().div_ceil(PERCENTILE_SAMPLES).max(1);
+    let mut sample: Vec<f64> = (0..v.len()).step_by(step).map(physical).collect();
+    if sample.len() < 2 || hi <= lo {
+        return None;
+    }
+    let at = |q: f64| ((sample.len() - 1) as f64 * q).round() as usize;
+    let (i_lo, i_hi) = (at(TAIL), at(1.0 - TAIL));
+    let q_lo = *sample.select_nth_unstable_by(i_lo, f64::total_cmp).1;
+    let q_hi = *sample.select_nth_unstable_by(i_hi, f64::total_cmp).1;
+    let span = q_hi - q_lo;
+    if span >= DOMINATED * (hi - lo) {
+        return None;
+    }
+    let (keep_lo, keep_hi) = (q_lo - KEEP_SPANS * span, q_hi + KEEP_SPANS * span);
+    let mut window = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut clamped = 0;
+    for i in 0..v.len() {
+        let p = physical(i);
+        if p < keep_lo || p > keep_hi {
+            clamped += 1;
+        } else {
+            window = (window.0.min(p), window.1.max(p));
+        }
+    }
+    (clamped > 0).then(|| (float_window(window), clamped))
 }
 
 /// Maps a physical value through the window to `[0, 1]`.

@@ -376,7 +376,8 @@ fn parse_spacing(
                 format!("{} entries for dimension {dimension}", v.len()),
             ));
         }
-        v
+        check_axes(path, axes, &v).map_err(|p| malformed("space directions", p))?;
+        v.iter().map(|d| d.as_ref().map(|d| norm(d))).collect()
     } else if let Some(sp) = fields.get("spacings") {
         let v: Vec<Option<f64>> = sp
             .split_whitespace()
@@ -409,8 +410,8 @@ fn parse_spacing(
     validate_spacing(path, field, spacing)
 }
 
-/// Parses `(1,0,0) (0,1.5,0) none ...` into vector lengths (`None` for `none`).
-fn parse_directions(s: &str) -> Option<Vec<Option<f64>>> {
+/// Parses `(1,0,0) (0,1.5,0) none ...` into vectors (`None` for `none`).
+fn parse_directions(s: &str) -> Option<Vec<Option<Vec<f64>>>> {
     let mut out = Vec::new();
     let mut rest = s.trim();
     while !rest.is_empty() {
@@ -426,11 +427,61 @@ fn parse_directions(s: &str) -> Option<Vec<Option<f64>>> {
             .map(|c| c.trim().parse::<f64>())
             .collect::<Result<_, _>>()
             .ok()?;
-        let len = comps.iter().map(|c| c * c).sum::<f64>().sqrt();
-        out.push(Some(len));
+        out.push(Some(comps));
         rest = r[close + 1..].trim_start();
     }
     Some(out)
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|c| c * c).sum::<f64>().sqrt()
+}
+
+/// |cos| of the angle between two spatial axes beyond which they are one direction:
+/// the grid has no extent along a third of its dimensions.
+const COLLINEAR_COS: f64 = 0.999;
+/// |cos| beyond which axes count as oblique (DICOM's orientation check uses the same).
+const OBLIQUE_COS: f64 = 0.01;
+
+/// The spatial axes' directions must span space: collinear (or zero) ones are an
+/// error. dvr renders the grid as rectangular, so oblique (sheared, e.g. a tilted
+/// gantry) axes are rendered without their shear: a warning says by how much.
+fn check_axes(path: &Path, axes: &[usize], dirs: &[Option<Vec<f64>>]) -> Result<(), String> {
+    let spatial: Vec<(usize, &Vec<f64>)> = axes
+        .iter()
+        .filter_map(|&a| dirs.get(a).and_then(|d| d.as_ref()).map(|d| (a, d)))
+        .collect();
+    for (i, &(a, da)) in spatial.iter().enumerate() {
+        if norm(da).is_nan() || norm(da) <= 0.0 {
+            return Err(format!("axis {a}'s direction {da:?} has no length"));
+        }
+        for &(b, db) in &spatial[i + 1..] {
+            if da.len() != db.len() {
+                return Err(format!(
+                    "axes {a} and {b} have vectors of {} and {} components",
+                    da.len(),
+                    db.len()
+                ));
+            }
+            let dot: f64 = da.iter().zip(db).map(|(x, y)| x * y).sum();
+            let cos = (dot / (norm(da) * norm(db))).abs();
+            if cos.is_nan() || cos >= COLLINEAR_COS {
+                return Err(format!(
+                    "axes {a} and {b} point the same way ({da:?}, {db:?}): the directions \
+                     must span three dimensions"
+                ));
+            }
+            if cos > OBLIQUE_COS {
+                log::warn!(
+                    "{}: space directions of axes {a} and {b} are {:.1}° from orthogonal \
+                     (a sheared grid); dvr renders the voxels on a rectangular grid",
+                    path.display(),
+                    90.0 - cos.acos().to_degrees()
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A detached data file name, relative to the header's folder unless absolute.

@@ -91,6 +91,34 @@ fn float_in_unit_range_is_kept_and_others_windowed() {
     assert_eq!(n.data, VolumeData::F32(vec![1.0, 1.0]));
 }
 
+/// Reliability round 2: two voxels at ±3.4e38 set the min–max window and flattened
+/// every other voxel to 0.5 without a word. Now they are clamped (and a warning counts
+/// them); the rest keep their spread.
+#[test]
+fn float_outliers_do_not_set_the_window() {
+    let mut v: Vec<f32> = (0..1000).map(|i| 10.0 + 80.0 * i as f32 / 999.0).collect();
+    v.push(3.4e38);
+    v.push(-3.4e38);
+    let n = run(
+        Samples::F32(v),
+        Rescale::Uniform(Affine::IDENTITY),
+        [1002, 1, 1],
+    );
+    assert_eq!(n.window, [10.0, 90.0]);
+    let VolumeData::F32(d) = n.data else {
+        panic!("float data stays float")
+    };
+    assert_eq!((d[0], d[999], d[1000], d[1001]), (0.0, 1.0, 1.0, 0.0));
+    assert!((d[500] - 0.5).abs() < 0.01);
+    // A wide but honest range is left alone.
+    let n = run(
+        Samples::F32(vec![-1000.0, 0.0, 3000.0, 1.0]),
+        Rescale::Uniform(Affine::IDENTITY),
+        [4, 1, 1],
+    );
+    assert_eq!(n.window, [-1000.0, 3000.0]);
+}
+
 #[test]
 fn nan_is_an_error_naming_the_first_voxel() {
     let stored = Stored::plain(Samples::F32(vec![

@@ -292,6 +292,45 @@ fn gzip_data_followed_by_other_bytes_loads_with_a_clear_note() {
 #[test]
 fn directions_parse() {
     let v = parse_directions("none (1,0,0) (0, 2 ,0) (0,0,-3)").expect("parse");
-    assert_eq!(v, vec![None, Some(1.0), Some(2.0), Some(3.0)]);
+    let lengths: Vec<Option<f64>> = v.iter().map(|d| d.as_deref().map(norm)).collect();
+    assert_eq!(lengths, vec![None, Some(1.0), Some(2.0), Some(3.0)]);
     assert!(parse_directions("(1,0").is_none());
+}
+
+/// Reliability round 2: collinear `space directions` were accepted (only their lengths
+/// were read), so a degenerate grid rendered as if it were rectangular.
+#[test]
+fn collinear_or_zero_directions_are_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (dirs, says) in [
+        ("(1,0,0) (2,0,0) (0,0,1)", "axes 0 and 1 point the same way"),
+        (
+            "(1,0,0) (0,1,0) (0,-2,0.001)",
+            "axes 1 and 2 point the same way",
+        ),
+        ("(0,0,0) (0,1,0) (0,0,1)", "axis 0's direction"),
+    ] {
+        let path = dir.path().join("v.nrrd");
+        let mut bytes = format!(
+            "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\
+             space: left-posterior-superior\nspace directions: {dirs}\n\n"
+        )
+        .into_bytes();
+        bytes.extend_from_slice(&[0u8; 8]);
+        write::bytes(&path, &bytes);
+        let e = Volume::load(&path, None).unwrap_err().to_string();
+        assert!(
+            e.contains("space directions") && e.contains(says),
+            "{dirs}: {e}"
+        );
+        assert!(e.contains("v.nrrd"), "{e}");
+    }
+    // Oblique but spanning (a 10° shear) loads, with a warning.
+    let path = dir.path().join("oblique.nrrd");
+    let mut bytes = b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\
+space directions: (1,0,0) (0,1,0) (0,0.17364818,0.98480775)\n\n"
+        .to_vec();
+    bytes.extend_from_slice(&[0u8; 8]);
+    write::bytes(&path, &bytes);
+    Volume::load(&path, None).expect("an oblique grid loads");
 }
