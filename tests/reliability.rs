@@ -229,6 +229,28 @@ fn wait_within(mut child: std::process::Child, limit: std::time::Duration) -> Ou
     child.wait_with_output().expect("output")
 }
 
+/// `dvr eval` of two 12×10 frames of cloud/orbit with 4-spp references into `out`.
+fn tiny_eval(out: &Path) -> Vec<&str> {
+    let mut args = vec![
+        "eval",
+        "--scene",
+        "cloud/orbit",
+        "--volume-size",
+        "16",
+        "--frames",
+        "2",
+        "--size",
+        "12x10",
+        "--ref-spp",
+        "4",
+        "--denoiser",
+        "none",
+        "--out",
+    ];
+    args.push(out.to_str().expect("utf-8"));
+    args
+}
+
 fn profile_args<'a>(json: &'a str, trace: &'a str, frames: &'a str) -> Vec<&'a str> {
     vec![
         "profile",
@@ -360,26 +382,7 @@ fn a_font_that_is_not_one_is_a_warning_not_a_hang() {
             "not a TrueType or OpenType font",
         ),
     ] {
-        let child = spawn(
-            &[
-                "eval",
-                "--scene",
-                "cloud/orbit",
-                "--volume-size",
-                "16",
-                "--frames",
-                "2",
-                "--size",
-                "12x10",
-                "--ref-spp",
-                "4",
-                "--denoiser",
-                "none",
-                "--out",
-                out.to_str().expect("utf-8"),
-            ],
-            &[("DVR_FONT", font)],
-        );
+        let child = spawn(&tiny_eval(&out), &[("DVR_FONT", font)]);
         let o = wait_within(child, std::time::Duration::from_secs(120));
         assert_status(&o, 0);
         let err = stderr(&o);
@@ -396,23 +399,7 @@ fn a_font_that_is_not_one_is_a_warning_not_a_hang() {
 fn bad_overrides_fail_before_rendering_and_empty_entries_are_usage_errors() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("eval");
-    let args = [
-        "eval",
-        "--scene",
-        "cloud/orbit",
-        "--volume-size",
-        "16",
-        "--frames",
-        "2",
-        "--size",
-        "12x10",
-        "--ref-spp",
-        "4",
-        "--denoiser",
-        "none",
-        "--out",
-        out.to_str().expect("utf-8"),
-    ];
+    let args = tiny_eval(&out);
     for (var, value, says) in [
         ("DVR_WRLS", "lambda=nan", "lambda must be in"),
         ("DVR_OURS", "kappa=1e30", "kappa must be in"),
