@@ -13,6 +13,10 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+// The normal guide costs six density fetches a step; SVGF's demodulation needs only the
+// albedo, so its pipeline leaves the normal out (written as zero with the opacity).
+layout(constant_id = 16) const bool GUIDE_NORMALS = true;
+
 layout(binding = 7, rgba32f) uniform writeonly image2D aux_albedo;  // rgb albedo, a opacity
 layout(binding = 8, rgba32f) uniform writeonly image2D aux_normal;  // xyz world normal, w opacity
 
@@ -54,15 +58,18 @@ void main() {
                 float step_len = base_step;
                 for (; t < cell_exit && alpha < OPAQUE; t += step_len) {
                     vec3 p = o + d * t;
-                    float a = 1.0 - exp(-extinction_at(p) * step_len);
+                    float density = density_at(p);
+                    vec4 tf = tf_albedo_opacity(density);
+                    float a = 1.0 - exp(-tf.a * frame.box_min.w * step_len);
                     if (a <= 0.0) continue;
                     float weight = (1.0 - alpha) * a;
-                    float density = density_at(p);
-                    vec3 g = density_gradient(p);
-                    vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
-                    if (dot(n, d) > 0.0) n = -n;
-                    albedo += weight * tf_albedo_opacity(density).rgb;
-                    normal += weight * n;
+                    if (GUIDE_NORMALS) {
+                        vec3 g = density_gradient(p);
+                        vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
+                        if (dot(n, d) > 0.0) n = -n;
+                        normal += weight * n;
+                    }
+                    albedo += weight * tf.rgb;
                     alpha += weight;
                 }
             } else {

@@ -12,7 +12,7 @@ layout(local_size_x = TILE, local_size_y = TILE) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D color_in;    // demodulated rgb, a variance
 layout(binding = 1, rgba32f) uniform readonly image2D geometry;
-layout(binding = 2, rgba32f) uniform readonly image2D feature_albedo;
+layout(binding = 2, rgba32f) uniform readonly image2D demod_albedo;  // see svgf_demod_factor
 layout(binding = 3, rgba32f) uniform writeonly image2D color_out;
 
 layout(push_constant) uniform SvgfAtrousPush {
@@ -99,7 +99,7 @@ void main() {
         variance = centre.a;
     }
     if (pc.modulate != 0u) {
-        color *= svgf_demod_factor(imageLoad(feature_albedo, p), pc.demod_eps);
+        color *= svgf_demod_factor(imageLoad(demod_albedo, p), pc.demod_eps);
         imageStore(color_out, p, vec4(color, 1.0));
     } else {
         imageStore(color_out, p, vec4(color, variance));

@@ -1,7 +1,7 @@
 #version 460
 // SVGF temporal accumulation (Schied et al. 2017, §4.1), with the shared reprojection in
-// place of the paper's (as the TVCG paper did): demodulate this frame's colour by the TF
-// albedo, blend it with the reprojected, bilinearly fetched colour history (the output of
+// place of the paper's (as the TVCG paper did): demodulate this frame's colour by the
+// composited guide albedo (svgf_demod_factor), blend it with the reprojected, bilinearly fetched colour history (the output of
 // last frame's first à-trous iteration) and blend the luminance moments with theirs.
 // Young pixels (history length n) blend with 1/n, so the first frames are plain means.
 // Also packs the edge-stopping features (normal, depth, depth gradient) for the spatial
@@ -24,6 +24,7 @@ layout(binding = 8, rgba32f) uniform writeonly image2D geometry;    // see svgf.
 // The surface features' position (w = 1 where the ray meets the medium), whatever the
 // motion source: the medium/background class must not follow a noisy first collision.
 layout(binding = 9, rgba32f) uniform readonly image2D feature_position;
+layout(binding = 10, rgba32f) uniform readonly image2D demod_albedo;  // see svgf_demod_factor
 
 layout(push_constant) uniform SvgfTemporalPush {
     vec4 camera;          // xyz camera position
@@ -77,7 +78,7 @@ void main() {
 
     vec3 c = imageLoad(noisy, p).rgb;
     if (!all_finite(c)) c = vec3(0.0);
-    vec3 d = c / svgf_demod_factor(albedo, pc.demod_eps);
+    vec3 d = c / svgf_demod_factor(imageLoad(demod_albedo, p), pc.demod_eps);
     float l = luminance(d);
     vec2 m = vec2(l, l * l);
 

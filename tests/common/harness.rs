@@ -137,6 +137,7 @@ impl Harness {
                 normal: normal_img,
                 albedo: albedo_img,
             }),
+            guides: None,
             first_hit,
             motion: motion_img,
             size: Extent {

@@ -162,6 +162,9 @@ pub struct DenoiseInputs {
     /// Deterministic surface features; rendered only when a denoiser of this frame
     /// reads them (its registry entry's [`DenoiserInfo::features`]).
     pub features: Option<FeatureImages>,
+    /// The guide albedo composited along each ray (aux_features.comp: rgb, a opacity);
+    /// rendered only when a denoiser of this frame reads it ([`DenoiserInfo::guides`]).
+    pub guides: Option<ImageHandle>,
     /// Closest first real collision per pixel, this frame's and last frame's.
     pub first_hit: History,
     /// Motion to the previous frame in pixels: xy from the first collision, zw from features.

@@ -224,6 +224,12 @@ impl DenoiserInfo {
         }
     }
 
+    /// Whether it reads the guide albedo composited along the ray
+    /// ([`DenoiseInputs::guides`](super::DenoiseInputs::guides)): SVGF demodulates by it.
+    pub fn guides(&self) -> bool {
+        matches!(self.kind, Kind::Svgf)
+    }
+
     /// Builds the denoiser.
     pub fn create(&self, ctx: &GpuContext, config: &DenoiserConfig) -> Result<Box<dyn Denoiser>> {
         let motion = config.motion;

@@ -218,6 +218,8 @@ impl Denoiser for Svgf {
         let noisy = input.noisy;
         let features = input.features(self.name())?;
         let (albedo, normal, position) = (features.albedo, features.normal, features.position.cur);
+        // Synthetic inputs without guides demodulate by the threshold surface's albedo.
+        let demod = input.guides.unwrap_or(albedo);
 
         let push = SvgfTemporalPush {
             camera: input.camera.extend(1.0),
@@ -236,6 +238,7 @@ impl Denoiser for Svgf {
                 .read("feature_albedo", albedo)
                 .read("feature_normal", normal)
                 .read("feature_position", position)
+                .read("demod_albedo", demod)
                 .sampled("color_prev", color.prev)
                 .sampled("moments_prev", moments.prev)
                 .write("integrated", ping)
@@ -292,7 +295,7 @@ impl Denoiser for Svgf {
             frame.add_compute(name, &self.atrous, apush, size, |b| {
                 b.read("color_in", src)
                     .read("geometry", geometry)
-                    .read("feature_albedo", albedo)
+                    .read("demod_albedo", demod)
                     .write("color_out", dst);
             });
             src = dst;

@@ -13,7 +13,8 @@
 //! 1. [`tonemap_srgb`] maps both the method's frame and the reference with the same
 //!    exposure to sRGB-encoded values in `[0,1]`. It is the one tone map of the project:
 //!    the PNGs written by `dvr eval` use it too, so what is measured is what is shown.
-//! 2. [`psnr`], [`ssim`], [`flip`] and [`temporal_error`] take those tone-mapped images.
+//! 2. [`psnr`], [`ssim`], [`flip`], [`temporal_error`] and [`outlier_fraction`] take
+//!    those tone-mapped images.
 //! 3. [`frames_to_recover`] post-processes a per-frame PSNR series around a sudden
 //!    scene change (light jump, transfer-function jump, ...).
 //!
@@ -21,6 +22,7 @@
 //! caller, not a measurement.
 
 mod flip;
+mod outliers;
 mod psnr;
 mod recovery;
 mod score;
@@ -29,6 +31,7 @@ mod temporal;
 mod tonemap;
 
 pub use flip::{flip, flip_colormap, FlipReference, FlipResult, DEFAULT_PPD};
+pub use outliers::outlier_fraction;
 pub use psnr::{psnr, PSNR_CAP};
 pub use recovery::{frames_to_recover, RECOVERY_BASELINE_FRAMES};
 pub use score::{display, score, FrameReference, Scores};

@@ -1,13 +1,14 @@
 //! The guide images of single-frame denoisers (shaders/glsl/aux_features.comp): per pixel
 //! the TF albedo and gradient normal composited along the ray with the weights of its
 //! first scattering event, the "albedo" and "normal" auxiliary images Intel Open Image
-//! Denoise takes. Rendered only when a frame asks for them (`dvr eval --aux`); no
-//! denoiser of dvr reads them.
+//! Denoise takes. Rendered when a frame asks for them (`dvr eval --aux`) and, albedo
+//! only (a pipeline without the normal's six extra fetches a step), when SVGF reads them
+//! to demodulate (`include/svgf.glsl`, `svgf_demod_factor`).
 
 use super::surface_features::STEP_VOXELS;
 use super::SceneBindings;
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc, Pipeline};
+use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::gpu_block;
 use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
 use ash::vk;
@@ -29,16 +30,21 @@ pub const NORMAL: &str = "aux.normal";
 
 pub struct AuxFeatures {
     pipeline: Pipeline<AuxFeaturesPush>,
+    /// The same pass without the normal guide (its image holds zero and the opacity).
+    albedo_only: Pipeline<AuxFeaturesPush>,
 }
 
 impl AuxFeatures {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         Ok(Self {
             pipeline: ctx.pipeline("aux_features", &[])?,
+            albedo_only: ctx
+                .pipeline("aux_features", &[("GUIDE_NORMALS", SpecValue::Bool(false))])?,
         })
     }
 
     /// Adds the pass; returns (albedo: rgb, a opacity; normal: xyz world, w opacity).
+    /// Without `normals` the normal image holds zero and the opacity.
     pub fn add(
         &self,
         ctx: &GpuContext,
@@ -46,6 +52,7 @@ impl AuxFeatures {
         frame: &mut Frame<'_>,
         scene: &SceneBindings,
         size: Extent,
+        normals: bool,
     ) -> Result<(ImageHandle, ImageHandle)> {
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
         let albedo = graph.image(ctx, ALBEDO, desc)?;
@@ -56,7 +63,12 @@ impl AuxFeatures {
             step_voxels: STEP_VOXELS,
             pad: 0.0,
         };
-        frame.add_compute("aux_features", &self.pipeline, push, size, |b| {
+        let pipeline = if normals {
+            &self.pipeline
+        } else {
+            &self.albedo_only
+        };
+        frame.add_compute("aux_features", pipeline, push, size, |b| {
             scene.bind_volume(b);
             b.write("aux_albedo", albedo).write("aux_normal", normal);
         });

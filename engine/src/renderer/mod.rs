@@ -352,7 +352,8 @@ impl Renderer {
         if present.is_some() && self.passes.present.is_none() {
             self.passes.present = Some(Present::new(&self.ctx)?);
         }
-        if request.aux && self.passes.aux.is_none() {
+        let guides = self.denoisers.iter().any(|m| m.info.guides());
+        if (request.aux || guides) && self.passes.aux.is_none() {
             self.passes.aux = Some(AuxFeatures::new(&self.ctx)?);
         }
         let reset = request.reset || std::mem::take(&mut self.pending_reset);
@@ -417,11 +418,30 @@ impl Renderer {
             }
             _ => None,
         };
+        // The guide images: the albedo for a denoiser that demodulates by it (the pass is
+        // then its own, in its GPU time), both read back for single-frame denoisers
+        // (`FrameRequest::aux`).
+        let aux = match &passes.aux {
+            Some(pass) if request.aux || guides => {
+                let reader = self.denoisers.iter().find(|m| m.info.guides());
+                Some(match reader {
+                    Some(m) => {
+                        let normals = request.aux;
+                        frame.add_owned(m.info.name, |f| {
+                            pass.add(ctx, graph, f, &scene, size, normals)
+                        })?
+                    }
+                    None => pass.add(ctx, graph, &mut frame, &scene, size, true)?,
+                })
+            }
+            _ => None,
+        };
         let input = DenoiseInputs {
             uniforms: scene.uniforms,
             noisy: noisy.radiance,
             moments: noisy.moments,
             features,
+            guides: aux.filter(|_| guides).map(|(albedo, _)| albedo),
             first_hit: noisy.first_hit,
             motion,
             size,
@@ -439,8 +459,7 @@ impl Renderer {
 
         // The guide images of single-frame denoisers, read back beside the methods.
         let mut read = outputs.clone();
-        if let (true, Some(pass)) = (request.aux, &passes.aux) {
-            let (albedo, normal) = pass.add(ctx, graph, &mut frame, &scene, size)?;
+        if let (true, Some((albedo, normal))) = (request.aux, aux) {
             read.push((aux_features::ALBEDO.to_string(), albedo));
             read.push((aux_features::NORMAL.to_string(), normal));
         }

@@ -10,11 +10,17 @@
 // The 1D B3-spline kernel [1/16, 1/4, 3/8, 1/4, 1/16], indexed by |offset|. [mirror]
 const float SVGF_B3[3] = float[](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
 
-// What colour is divided by before filtering and multiplied by after: the TF albedo of
-// the surface features plus `eps` (so a black albedo channel amplifies at most 1/eps),
-// or 1 where the features are invalid (background: nothing to demodulate by).
+// What colour is divided by before filtering and multiplied by after, from the
+// composited guide albedo (aux_features.comp: rgb the TF albedo weighted by where the
+// ray's first scattering event falls, a the share of the ray the volume stops): the
+// expected albedo of the first scattering vertex, plus 1 for the share that passes
+// through to the background (nothing to demodulate by there), plus `eps` (a black albedo
+// channel amplifies at most 1/eps). An opaque surface gives its albedo, as the paper's
+// primary-hit albedo; a faint layer or a thin vessel before a brighter medium gives the
+// mix its radiance comes from, so its pixel demodulates like its neighbours. The
+// threshold features' albedo (rgb, w 1 where valid else 0) reads the same way.
 vec3 svgf_demod_factor(vec4 albedo, float eps) {
-    return albedo.w > 0.0 ? albedo.rgb + eps : vec3(1.0);
+    return albedo.rgb + (1.0 - albedo.a) + eps;
 }
 
 // Edge-stopping features of one pixel, packed by svgf_temporal into one rgba32f texel:
