@@ -8,18 +8,19 @@
 //! faster than 4×4 strata resolve it; the README's gallery gives the numbers. It is not
 //! asserted here.)
 
-use std::collections::HashMap;
+mod common;
+
 use std::path::Path;
-use std::process::Command;
 
 const FIRST_CHECKED_FRAME: u32 = 5;
 const MARGIN_DB: f64 = 0.5;
 
-/// Per (method, frame) PSNR of one scene's eval.
-fn per_frame_psnr(scene: &str, out: &Path) -> HashMap<(String, u32), f64> {
-    let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
-        .args([
-            "eval",
+fn assert_no_lag(scene: &str) {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("lag")
+        .join(scene.replace('/', "_"));
+    let psnr = common::eval::run_eval(
+        &[
             "--scene",
             scene,
             "--frames",
@@ -30,35 +31,9 @@ fn per_frame_psnr(scene: &str, out: &Path) -> HashMap<(String, u32), f64> {
             "64",
             "--denoiser",
             "taa,svgf,ours",
-            "--out",
-        ])
-        .arg(out)
-        .output()
-        .expect("running dvr");
-    assert!(
-        o.status.success(),
-        "dvr eval {scene} failed ({:?}):\n{}",
-        o.status.code(),
-        String::from_utf8_lossy(&o.stderr)
+        ],
+        &out,
     );
-    let csv = std::fs::read_to_string(out.join("metrics.csv")).expect("metrics.csv");
-    let mut psnr = HashMap::new();
-    for line in csv.lines().skip(1) {
-        let f: Vec<&str> = line.split(',').collect();
-        let frame: u32 = f[2].parse().expect("frame");
-        psnr.insert((f[1].to_string(), frame), f[3].parse().expect("psnr"));
-    }
-    psnr
-}
-
-fn assert_no_lag(scene: &str) {
-    let out = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("lag")
-        .join(scene.replace('/', "_"));
-    if out.exists() {
-        std::fs::remove_dir_all(&out).expect("clearing the old output");
-    }
-    let psnr = per_frame_psnr(scene, &out);
     let at = |m: &str, f: u32| psnr[&(m.to_string(), f)];
     let mut worst = (f64::INFINITY, 0);
     for f in FIRST_CHECKED_FRAME..48 {

@@ -16,9 +16,10 @@
 //!   paper nor Falcor's SVGF clamps fireflies, so no method here does); svgf 1.15%,
 //!   ours 0.50%; the noisy input 5.0%.
 
+mod common;
+
 use dvr_engine::metrics::{outlier_fraction, Rgb32Image};
 use std::path::Path;
-use std::process::Command;
 
 const K: f32 = 4.0;
 const FLOOR: f32 = 0.1;
@@ -40,19 +41,20 @@ fn png(path: &Path) -> Rgb32Image {
 fn no_method_leaves_isolated_outliers() {
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("outliers");
     let methods: Vec<&str> = dvr_engine::denoise::registry::names().collect();
-    let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
-        .args(["eval", "--scene", "phantom/orbit,mri/point-light"])
-        .args(["--frames", &FRAMES.to_string(), "--size", "64x64"])
-        .args(["--ref-spp", "1024", "--denoiser", &methods.join(",")])
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .expect("running dvr");
-    assert!(
-        o.status.success(),
-        "dvr eval failed ({:?}):\n{}",
-        o.status.code(),
-        String::from_utf8_lossy(&o.stderr)
+    common::eval::run_eval(
+        &[
+            "--scene",
+            "phantom/orbit,mri/point-light",
+            "--frames",
+            &FRAMES.to_string(),
+            "--size",
+            "64x64",
+            "--ref-spp",
+            "1024",
+            "--denoiser",
+            &methods.join(","),
+        ],
+        &out,
     );
     let mut failures = Vec::new();
     let mut table = String::new();

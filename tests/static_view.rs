@@ -7,8 +7,9 @@
 //! (The scene is judged, not tuned on: this checks a property every estimator that only
 //! averages more samples has.)
 
+mod common;
+
 use std::path::Path;
-use std::process::Command;
 
 const FRAMES: u32 = 64;
 const MARGIN_DB: f64 = 0.5;
@@ -18,39 +19,28 @@ fn ours_never_gets_worse_on_a_static_view() {
     let scene =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/static/mri-faint-static.toml");
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("static_view");
-    if out.exists() {
-        std::fs::remove_dir_all(&out).expect("clearing the old output");
-    }
-    let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
-        .args(["eval", "--scene"])
-        .arg(&scene)
-        .args([
+    let scene = scene.to_str().expect("utf-8 path");
+    let by_frame = common::eval::run_eval(
+        &[
+            "--scene",
+            scene,
             "--size",
             "32x32",
             "--ref-spp",
             "256",
             "--denoiser",
             "ours",
-            "--out",
-        ])
-        .arg(&out)
-        .output()
-        .expect("running dvr");
-    assert!(
-        o.status.success(),
-        "dvr eval failed ({:?}):\n{}",
-        o.status.code(),
-        String::from_utf8_lossy(&o.stderr)
+        ],
+        &out,
     );
-    let csv = std::fs::read_to_string(out.join("metrics.csv")).expect("metrics.csv");
-    let mut psnr = vec![f64::NAN; FRAMES as usize];
-    for line in csv.lines().skip(1) {
-        let f: Vec<&str> = line.split(',').collect();
-        if f[1] == "ours" {
-            let frame: usize = f[2].parse().expect("frame");
-            psnr[frame] = f[3].parse().expect("psnr");
-        }
-    }
+    let psnr: Vec<f64> = (0..FRAMES)
+        .map(|f| {
+            by_frame
+                .get(&("ours".to_string(), f))
+                .copied()
+                .unwrap_or(f64::NAN)
+        })
+        .collect();
     assert!(psnr.iter().all(|p| p.is_finite()), "{psnr:?}");
     let mean = |r: std::ops::Range<usize>| psnr[r.clone()].iter().sum::<f64>() / r.len() as f64;
     let (early, late) = (mean(8..32), mean(32..64));

@@ -348,17 +348,7 @@ impl ReferenceCache {
         };
         lock.lock()
             .with_context(|| format!("locking {}", lock_path.display()))?;
-        for entry in std::fs::read_dir(&self.dir)
-            .with_context(|| format!("reading {}", self.dir.display()))?
-        {
-            let path = entry?.path();
-            let is_run = path
-                .file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with(".run-") && n.ends_with(".json"));
-            if !is_run {
-                continue;
-            }
+        for path in self.files_named(|n| n.starts_with(".run-") && n.ends_with(".json"))? {
             let Ok(file) = File::open(&path) else {
                 continue; // removed since it was listed: its run ended
             };
@@ -417,6 +407,20 @@ impl ReferenceCache {
         })
     }
 
+    /// The entries of the folder whose file name `keep` accepts.
+    fn files_named(&self, keep: impl Fn(&str) -> bool) -> Result<Vec<PathBuf>> {
+        let mut paths = Vec::new();
+        for entry in std::fs::read_dir(&self.dir)
+            .with_context(|| format!("reading {}", self.dir.display()))?
+        {
+            let path = entry?.path();
+            if path.file_name().and_then(|n| n.to_str()).is_some_and(&keep) {
+                paths.push(path);
+            }
+        }
+        Ok(paths)
+    }
+
     /// Makes the folder consistent with this key before rendering: a different (or
     /// unreadable) key removes the old frames and writes the new key. Returns a note for
     /// the log when something was thrown away. Called under a claim.
@@ -435,19 +439,16 @@ impl ReferenceCache {
         } else {
             self.stored_key().map(|old| self.change_note(&old))
         };
-        for entry in std::fs::read_dir(&self.dir)
-            .with_context(|| format!("reading {}", self.dir.display()))?
-        {
-            let path = entry?.path();
-            let is_frame = path
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .is_some_and(|s| s.len() == 4 && s.bytes().all(|b| b.is_ascii_digit()));
-            let ext = path.extension().and_then(|e| e.to_str());
-            if is_frame && matches!(ext, Some("exr" | "png")) {
-                std::fs::remove_file(&path)
-                    .with_context(|| format!("removing stale {}", path.display()))?;
-            }
+        let is_frame = |n: &str| {
+            n.split_once('.').is_some_and(|(stem, ext)| {
+                stem.len() == 4
+                    && stem.bytes().all(|b| b.is_ascii_digit())
+                    && matches!(ext, "exr" | "png")
+            })
+        };
+        for path in self.files_named(is_frame)? {
+            std::fs::remove_file(&path)
+                .with_context(|| format!("removing stale {}", path.display()))?;
         }
         let json = serde_json::to_string_pretty(&self.key)?;
         dvr_engine::files::write_atomic(&self.key_path(), json.as_bytes(), Durability::Synced)

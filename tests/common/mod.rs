@@ -3,6 +3,8 @@
 //! known optics, and the validation check every GPU test ends with.
 #![allow(dead_code)]
 
+pub mod eval;
+
 use dvr_engine::gpu::{validation, GpuContext};
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_gpu::{BrickRanges, LutUpload, VolumeFormat, VolumeUpload};
