@@ -5,6 +5,7 @@ use crate::eval::reference::{FillReport, ReferenceCache, ReferenceKey};
 use crate::profile::{self, Profile};
 use crate::progress::{FrameRate, Progress};
 use crate::setup::Setup;
+use crate::shard::{FolderReport, RunReport, ShardArgs};
 use crate::video::{self, Track, VideoArgs};
 use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
@@ -111,7 +112,7 @@ pub fn reference(
     args: &SceneArgs,
     spp: u32,
     frame_range: Option<(u32, u32)>,
-    shard: Option<(u32, u32)>,
+    shard: &ShardArgs,
     out: &Path,
 ) -> Result<()> {
     // --spp above lavapipe's per-frame count most likely meant the reference's samples;
@@ -123,25 +124,42 @@ pub fn reference(
         );
     }
     let setup = Setup::new(args)?;
-    let frames = crate::setup::select_frames(setup.frames, frame_range, shard)?;
-    crate::setup::create_out_dir(out)?;
+    let frames = crate::setup::select_frames(setup.frames, frame_range, shard.shard)?;
     let key = ReferenceKey::new(setup.scene(), args.size, spp, args.render.volume_size)?;
     let cache = ReferenceCache::new(out, key);
-    let mut report = ReferenceReport {
+    if shard.verify {
+        return crate::shard::verdict(
+            &format!("reference frames in {}", cache.dir.display()),
+            frames.len(),
+            &cache.problems(&frames),
+        );
+    }
+    crate::setup::create_out_dir(out)?;
+    let mut progress = ReferenceReport {
         progress: None,
         samples_per_frame: f64::from(spp) * f64::from(setup.width() * setup.height()),
     };
-    let _claim = cache.fill_frames(&setup, &mut report, &frames)?;
-    if let Some(p) = &mut report.progress {
+    let filled = cache.fill_frames(&setup, &mut progress, &frames)?;
+    if let Some(p) = &mut progress.progress {
         p.finish();
     }
     println!(
-        "wrote {} of {} reference frames to {}",
+        "wrote {} of {} reference frames to {} ({} rendered, {} already there)",
         frames.len(),
         setup.frames,
-        cache.dir.display()
+        cache.dir.display(),
+        filled.rendered.len(),
+        filled.reused.len()
     );
-    Ok(())
+    let mut report = RunReport::new(shard);
+    report.references.push(FolderReport {
+        scene: setup.name.clone(),
+        folder: cache.dir.clone(),
+        selected: frames,
+        rendered: filled.rendered,
+        reused: filled.reused,
+    });
+    report.write(shard.report.as_deref())
 }
 
 /// `dvr reference`'s progress: frames and Msamples/s on the progress line (redrawn on a

@@ -136,6 +136,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         },
         aux: false,
         note: Some(note),
+        farm: Default::default(),
     })?;
     Ok(())
 }

@@ -15,6 +15,7 @@ mod output;
 mod profile;
 mod progress;
 mod setup;
+mod shard;
 mod video;
 
 use anyhow::Result;
@@ -115,11 +116,8 @@ enum Command {
         /// Only the frames from A up to but not including B (`A..B`, 0-based).
         #[arg(long = "frame-range", value_parser = crate::setup::parse_frame_range)]
         frame_range: Option<(u32, u32)>,
-        /// Only shard I of N (`I/N`, 0-based): every N-th selected frame from the I-th,
-        /// so N runs with I = 0..N-1 on one folder render each frame once and leave the
-        /// same files as one run (`$SLURM_ARRAY_TASK_ID/N`, `$JOB_COMPLETION_INDEX/N`).
-        #[arg(long, value_parser = crate::setup::parse_shard)]
-        shard: Option<(u32, u32)>,
+        #[command(flatten)]
+        shard: shard::ShardArgs,
         #[arg(long, default_value = "out/reference")]
         out: PathBuf,
     },
@@ -219,7 +217,7 @@ fn run(cli: Cli) -> Result<()> {
             frame_range,
             shard,
             out,
-        } => capture::reference(&scene, ref_spp, frame_range, shard, &out),
+        } => capture::reference(&scene, ref_spp, frame_range, &shard, &out),
         Command::Eval(args) => eval::eval(&args).map(|_| ()),
         Command::Profile {
             scene,

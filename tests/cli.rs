@@ -321,27 +321,28 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     out
 }
 
+/// The references the shard tests split: 5 frames of a small scene.
+const SHARDED_REFERENCE: [&str; 11] = [
+    "reference",
+    "--scene",
+    "cloud/orbit",
+    "--frames",
+    "5",
+    "--size",
+    "12x10",
+    "--volume-size",
+    "16",
+    "--ref-spp",
+    "8",
+];
+
 #[test]
 fn sharded_references_write_the_bytes_of_one_run() {
     let tmp = tempfile::tempdir().expect("tempdir");
     let (one, sharded) = (tmp.path().join("one"), tmp.path().join("sharded"));
-    let common = [
-        "reference",
-        "--scene",
-        "cloud/orbit",
-        "--frames",
-        "5",
-        "--size",
-        "12x10",
-        "--volume-size",
-        "16",
-        "--ref-spp",
-        "8",
-        "--out",
-    ];
     let with = |out: &Path, extra: &[&str]| {
-        let mut args: Vec<String> = common.iter().map(|s| s.to_string()).collect();
-        args.push(out.to_str().expect("utf-8").to_string());
+        let mut args: Vec<String> = SHARDED_REFERENCE.iter().map(|s| s.to_string()).collect();
+        args.extend(["--out".into(), out.to_str().expect("utf-8").to_string()]);
         args.extend(extra.iter().map(|s| s.to_string()));
         args
     };
@@ -400,6 +401,168 @@ fn sharded_references_write_the_bytes_of_one_run() {
         let o = run(with(&part, &["--shard", bad]));
         assert_eq!(o.status.code(), Some(2), "--shard {bad}: {}", stderr(&o));
     }
+}
+
+/// Runs `dvr` with `common`, `--out out` and `extra`.
+fn dvr_with(common: &[&str], out: &Path, extra: &[&str]) -> Output {
+    let mut args = common.to_vec();
+    args.extend(["--out", out.to_str().expect("utf-8")]);
+    args.extend_from_slice(extra);
+    dvr(&args)
+}
+
+#[test]
+fn verify_names_missing_and_corrupt_reference_frames_and_a_rerun_refills_them() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let (one, sharded) = (tmp.path().join("one"), tmp.path().join("sharded"));
+    let common = SHARDED_REFERENCE;
+    let verify = |out: &Path| dvr_with(&common, out, &["--verify"]);
+    assert_error(
+        &verify(&one),
+        &["5 frame(s) missing", "no reference rendered yet"],
+    );
+    assert!(!one.exists(), "--verify renders and creates nothing");
+    assert_ok(&dvr_with(&common, &one, &[]));
+    assert_ok(&verify(&one));
+    // Three shards one after another, as a job array on one machine, each saying
+    // which frames it rendered.
+    for i in 0..3 {
+        let report = tmp.path().join(format!("shard{i}.json"));
+        let shard = format!("{i}/3");
+        let r = report.to_str().expect("utf-8");
+        assert_ok(&dvr_with(
+            &common,
+            &sharded,
+            &["--shard", &shard, "--report", r],
+        ));
+        let json = std::fs::read_to_string(&report).expect("the report");
+        let expect: Vec<u32> = (i..5).step_by(3).collect();
+        let rendered = format!("\"rendered\": {}", serde_json_list(&expect));
+        assert!(
+            json.replace([' ', '\n'], "")
+                .contains(&rendered.replace(' ', "")),
+            "shard {i} rendered {expect:?}: {json}"
+        );
+    }
+    assert!(files(&one.join("reference")) == files(&sharded.join("reference")));
+    // A frame gone and one cut short: both named, and only they are rendered again.
+    let dir = sharded.join("reference");
+    std::fs::remove_file(dir.join("0003.png")).expect("removing");
+    std::fs::write(dir.join("0001.exr"), b"v/1\x01").expect("cutting");
+    let o = verify(&sharded);
+    assert_error(
+        &o,
+        &[
+            "0003.png: missing",
+            "0001.exr: does not read back",
+            "2 problem(s)",
+        ],
+    );
+    assert!(
+        !stderr(&o).contains("0002"),
+        "only the broken frames: {}",
+        stderr(&o)
+    );
+    let o = dvr_with(&common, &sharded, &[]);
+    assert_ok(&o);
+    let said = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(said.contains("2 rendered, 3 already there"), "{said}");
+    assert_ok(&verify(&sharded));
+    assert!(files(&one.join("reference")) == files(&sharded.join("reference")));
+    // Other settings: every frame is named as missing.
+    let mut fewer = common;
+    fewer[4] = "4";
+    let o = dvr_with(&fewer, &sharded, &["--verify"]);
+    assert_error(&o, &["4 frame(s) missing", "other settings"]);
+}
+
+/// `[a, b]` as JSON writes it.
+fn serde_json_list(v: &[u32]) -> String {
+    let items: Vec<String> = v.iter().map(u32::to_string).collect();
+    format!("[{}]", items.join(","))
+}
+
+/// Each line of a CSV without its last `drop` columns (the measured GPU times).
+fn csv_without_times(path: &Path, drop: usize) -> Vec<String> {
+    std::fs::read_to_string(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .lines()
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            cells[..cells.len() - drop].join(",")
+        })
+        .collect()
+}
+
+#[test]
+fn a_sharded_eval_merges_into_the_reports_of_one_run() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let (one, sharded) = (tmp.path().join("one"), tmp.path().join("sharded"));
+    let common = [
+        "eval",
+        "--scene",
+        "cloud/orbit,phantom/tf-sweep,cloud/point-light",
+        "--frames",
+        "4",
+        "--size",
+        "16x12",
+        "--volume-size",
+        "16",
+        "--ref-spp",
+        "8",
+        "--denoiser",
+        "none,ours,svgf",
+    ];
+    assert_ok(&dvr_with(&common, &one, &[]));
+    assert_ok(&dvr_with(&common, &one, &["--verify"]));
+    // References in 5 shards (a unit per frame: 12 over 3 scenes), then the scenes in
+    // 2, then the merge.
+    for i in 0..5 {
+        let shard = format!("{i}/5");
+        assert_ok(&dvr_with(
+            &common,
+            &sharded,
+            &["--references-only", "--shard", &shard],
+        ));
+    }
+    assert_ok(&dvr_with(
+        &common,
+        &sharded,
+        &["--references-only", "--verify"],
+    ));
+    assert_error(
+        &dvr_with(&common, &sharded, &["--verify"]),
+        &["result.json: missing", "3 problem(s)"],
+    );
+    assert_ok(&dvr_with(&common, &sharded, &["--shard", "1/2"]));
+    assert!(
+        !sharded.join("metrics.csv").exists(),
+        "a shard leaves the reports to --merge"
+    );
+    let o = dvr_with(&common, &sharded, &["--merge"]);
+    assert_error(&o, &["2 of 3 scene(s)", "cloud_orbit/result.json: missing"]);
+    assert_ok(&dvr_with(&common, &sharded, &["--shard", "0/2"]));
+    assert_ok(&dvr_with(&common, &sharded, &["--merge"]));
+    for scene in ["cloud_orbit", "phantom_tf-sweep", "cloud_point-light"] {
+        for folder in ["reference", "none", "ours", "svgf"] {
+            assert!(
+                files(&one.join(scene).join(folder)) == files(&sharded.join(scene).join(folder)),
+                "{scene}/{folder} differs from one run's"
+            );
+        }
+    }
+    // The scores are one run's to the last digit; GPU times are measured anew.
+    for (csv, times) in [("metrics.csv", 1), ("summary.csv", 2), ("baseline.csv", 2)] {
+        assert_eq!(
+            csv_without_times(&one.join(csv), times),
+            csv_without_times(&sharded.join(csv), times),
+            "{csv}"
+        );
+    }
+    assert!(sharded.join("index.html").is_file());
+    // A result made under other settings is not merged.
+    let o = dvr_with(&common, &sharded, &["--merge", "--spp", "1"]);
+    assert_error(&o, &["made under other settings", "spp"]);
 }
 
 /// `dvr reference` on a small scene into `out` with `spp` samples (more args after).

@@ -183,6 +183,7 @@ fn run_eval<'a>(args: &'a BenchArgs, denoisers: &[String]) -> Result<EvalRecord<
         },
         aux: false,
         note: None,
+        farm: Default::default(),
     };
     eprintln!(
         "bench: eval {} into {}",

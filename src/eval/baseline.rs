@@ -21,11 +21,13 @@ pub const MAX_SPP: u32 = 256;
 /// references' (which would otherwise share its first n samples and flatter it).
 const SEED_OFFSET: u32 = 0x5eed_0b11;
 
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct BaselinePoint {
     pub frame: u32,
     pub spp: u32,
+    #[serde(with = "super::record::float")]
     pub gpu_ms: f64,
+    #[serde(with = "super::record::float")]
     pub psnr: f64,
 }
 

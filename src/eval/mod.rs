@@ -20,20 +20,24 @@
 //! DIR/<scene>/reference/NNNN.{exr,png}      + reference.json (the cache key)
 //! DIR/<scene>/<method>/NNNN.png, flip_NNNN.png   (+ NNNN.exr for `none`, the noisy input)
 //! DIR/<scene>/timings.json        per-frame, per-pass GPU timings
+//! DIR/<scene>/result.json         the scene's scores and settings, for `--merge`
 //! DIR/<scene>/aux/NNNN_{albedo,normal}.exr  with --aux: guide images for OIDN
 //! ```
 //!
 //! One file per responsibility: [`scenes`] (which scenes, folder names, the event frame),
-//! [`reference`] (the cache), [`run`] (the frame loop), [`score`] (metrics of one frame),
+//! [`reference`] (the cache), [`run`] (the frame loop), [`record`] (each scene's
+//! `result.json`), [`farm`] (shards, `--references-only`, `--verify`, `--merge`), [`score`] (metrics of one frame),
 //! [`baseline`], [`csv`], [`plots`], [`html`]; progress lines come from
 //! [`crate::progress`].
 
 mod baseline;
 mod csv;
+mod farm;
 mod html;
 mod images;
 mod overlap;
 pub mod plots;
+mod record;
 pub(crate) mod reference;
 pub mod run;
 mod scenes;
@@ -94,6 +98,8 @@ pub struct EvalArgs {
     /// A paragraph shown at the top of the results page (what was run, and why).
     #[arg(long)]
     pub note: Option<String>,
+    #[command(flatten)]
+    pub farm: farm::FarmArgs,
 }
 
 /// Runs the eval; returns where its time went.
@@ -103,23 +109,58 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     // Fail before hours of rendering, not after: the plots need a font, videos ffmpeg,
     // and a parameter override must be in range.
     dvr_engine::denoise::check_env_overrides()?;
+    let names = scenes::select(&args.scene)?;
+    let plan = run::Plan::new(args, &names, &methods)?;
+    let timing = timing::Timing::shared();
+    let farm = &args.farm;
+    if farm.references_only {
+        farm::references(args, &plan, &timing)?;
+        return Ok(timing.outcome(started.elapsed()));
+    }
+    if farm.shard.verify {
+        farm::verify(args, &plan, &methods)?;
+        return Ok(timing.outcome(started.elapsed()));
+    }
     plots::init_font()?;
+    if farm.merge {
+        let (results, seconds) = farm::results(args, &plan, &methods)?;
+        let device = results.last().map(|r| r.device.clone()).unwrap_or_default();
+        write_reports(args, &methods, &results, &device, seconds)?;
+        print_summary(args, &methods, &results, seconds);
+        return Ok(timing.outcome(started.elapsed()));
+    }
     if args.video.video {
         crate::video::require_ffmpeg()?;
     }
-    let names = scenes::select(&args.scene)?;
     crate::setup::create_out_dir(&args.out)?;
-    let plan = run::Plan::new(args, &names, &methods)?;
-    let mut progress = crate::progress::Progress::new(plan.total_units());
-    let timing = timing::Timing::shared();
+    let take = |i: usize| farm.shard.takes(i);
+    let mut progress = crate::progress::Progress::new(plan.total_units(take));
+    let mut report = crate::shard::RunReport::new(&farm.shard);
     let mut results = Vec::new();
     let mut device = String::new();
-    for (i, scene) in plan.scenes.iter().enumerate() {
+    for (i, scene) in plan.scenes.iter().enumerate().filter(|(i, _)| take(*i)) {
+        let scene_started = Instant::now();
         let label = format!("[{}/{}] {}", i + 1, plan.scenes.len(), scene.name);
-        let r = run::evaluate_scene(args, &methods, scene, &label, &mut progress, &timing)
-            .with_context(|| format!("evaluating {}", scene.name))?;
+        let r = run::evaluate_scene(
+            args,
+            &methods,
+            scene,
+            &label,
+            &mut progress,
+            &timing,
+            &mut report,
+        )
+        .with_context(|| format!("evaluating {}", scene.name))?;
         device.clone_from(&r.device);
         timing.reports.time(|| -> Result<()> {
+            record::save(
+                &scene.dir,
+                &farm::result_key(args, &methods, scene),
+                scene_started.elapsed().as_secs_f64(),
+                &r,
+            )?;
+            report.scenes.push(r.name.clone());
+            report.write(farm.shard.report.as_deref())?;
             plots::scene_plots(&args.out, &r)?;
             if args.video.video {
                 progress.newline();
@@ -129,23 +170,47 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
             }
             results.push(r);
             // Everything is rewritten after each scene, so an interrupted eval leaves a
-            // consistent report of the scenes it finished.
-            write_reports(args, &methods, &results, &device, started)
+            // consistent report of the scenes it finished. A shard leaves the reports
+            // to `--merge`.
+            if farm.shard.shard.is_none() {
+                write_reports(
+                    args,
+                    &methods,
+                    &results,
+                    &device,
+                    started.elapsed().as_secs_f64(),
+                )?;
+            }
+            Ok(())
         })?;
     }
     progress.finish();
-    let overall = csv::overall_summary(&results, &methods);
-    print!("{}", csv::summary_table(&results, &overall));
-    println!(
-        "eval: {} scene(s) × {} method(s) in {:.1} s; open {}",
-        results.len(),
-        methods.len(),
-        started.elapsed().as_secs_f64(),
-        args.out.join("index.html").display()
-    );
+    report.write(farm.shard.report.as_deref())?;
+    if let Some(shard) = farm.shard.label() {
+        println!(
+            "eval: shard {shard} evaluated {} of {} scene(s) into {}; when every shard has \
+             finished, `dvr eval --merge` with the same options writes the reports",
+            results.len(),
+            plan.scenes.len(),
+            args.out.display()
+        );
+    } else {
+        print_summary(args, &methods, &results, started.elapsed().as_secs_f64());
+    }
     let wall = started.elapsed();
     eprintln!("{}", timing.summary(wall));
     Ok(timing.outcome(wall))
+}
+
+fn print_summary(args: &EvalArgs, methods: &[String], results: &[run::SceneResult], seconds: f64) {
+    let overall = csv::overall_summary(results, methods);
+    print!("{}", csv::summary_table(results, &overall));
+    println!(
+        "eval: {} scene(s) × {} method(s) in {seconds:.1} s; open {}",
+        results.len(),
+        methods.len(),
+        args.out.join("index.html").display()
+    );
 }
 
 fn write_reports(
@@ -153,7 +218,7 @@ fn write_reports(
     methods: &[String],
     results: &[run::SceneResult],
     device: &str,
-    started: Instant,
+    seconds: f64,
 ) -> Result<()> {
     let out = &args.out;
     csv::write_metrics(&out.join("metrics.csv"), results)?;
@@ -167,7 +232,7 @@ fn write_reports(
             args,
             methods,
             device,
-            seconds: started.elapsed().as_secs_f64(),
+            seconds,
         },
         results,
         &overall,

@@ -113,6 +113,16 @@ fn renderer_hash() -> String {
     h.finish()
 }
 
+/// Hash of every shader dvr runs: results of another build are not mixed with these.
+pub fn shaders_hash() -> String {
+    let mut h = ContentHash::new();
+    for (name, spirv) in dvr_engine::shaders::SHADERS {
+        h.write(name.as_bytes());
+        h.write(spirv);
+    }
+    h.finish()
+}
+
 /// FNV-1a (64-bit) over 8-byte words, each chunk's length mixed in: a stable hash (the
 /// key files outlive compiler versions, unlike `std`'s hasher) that reads a gigabyte
 /// volume in well under a second. A cache key, not a signature.
@@ -214,6 +224,10 @@ impl ReferenceCache {
         }
     }
 
+    pub fn key(&self) -> &ReferenceKey {
+        &self.key
+    }
+
     fn key_path(&self) -> PathBuf {
         self.dir.join("reference.json")
     }
@@ -313,6 +327,52 @@ impl ReferenceCache {
     /// Frames still to render (see [`ReferenceCache::state`]).
     pub fn missing(&self) -> Vec<u32> {
         self.state().missing
+    }
+
+    /// What keeps the frames `wanted` from being reused, one line each, naming the
+    /// file (`--verify`); empty when every one is present under this key and reads
+    /// back. Renders and changes nothing.
+    pub fn problems(&self, wanted: &[u32]) -> Vec<String> {
+        if !self.key_matches() {
+            let why = match self.stored_key() {
+                Some(old) => format!(
+                    "rendered under other settings ({}, now {})",
+                    old.describe(),
+                    self.key.describe()
+                ),
+                None if self.key_path().exists() => {
+                    format!("{} is unreadable", self.key_path().display())
+                }
+                None => "no reference rendered yet".into(),
+            };
+            return vec![format!(
+                "{}: {} frame(s) missing: {why}",
+                self.dir.display(),
+                wanted.len()
+            )];
+        }
+        let state = self.state();
+        let mut lines: Vec<String> = state
+            .unreadable
+            .iter()
+            .filter(|(path, _)| wanted.iter().any(|&f| self.frame_of(path) == Some(f)))
+            .map(|(path, why)| format!("{}: does not read back ({why})", path.display()))
+            .collect();
+        for f in state.missing.iter().filter(|f| wanted.contains(f)) {
+            let unreadable = |p: &PathBuf| state.unreadable.iter().any(|(u, _)| u == p);
+            for path in [self.exr(*f), self.png(*f)] {
+                if !path.exists() && !unreadable(&path) {
+                    lines.push(format!("{}: missing", path.display()));
+                }
+            }
+        }
+        lines.sort();
+        lines
+    }
+
+    /// The frame a cached file holds, from its name.
+    fn frame_of(&self, path: &Path) -> Option<u32> {
+        path.file_stem()?.to_str()?.parse().ok()
     }
 
     /// Claims the folder for a run with this key (see the module's comment) and makes
@@ -496,9 +556,9 @@ impl ReferenceCache {
 
     /// Brings the cache up to date: reuses what is there, warns about and re-renders
     /// unreadable frames, renders the rest with a renderer made by `setup` only when
-    /// some frame is missing. Returns the run's claim on the folder: keep it while the
-    /// frames are read.
-    pub fn fill(&self, setup: &Setup, report: &mut dyn FillReport) -> Result<Claim> {
+    /// some frame is missing. Returns the run's claim on the folder (keep it while the
+    /// frames are read) and what it rendered.
+    pub fn fill(&self, setup: &Setup, report: &mut dyn FillReport) -> Result<Filled> {
         let all: Vec<u32> = (0..self.key.frames).collect();
         self.fill_frames(setup, report, &all)
     }
@@ -512,7 +572,7 @@ impl ReferenceCache {
         setup: &Setup,
         report: &mut dyn FillReport,
         wanted: &[u32],
-    ) -> Result<Claim> {
+    ) -> Result<Filled> {
         let claim = self.claim()?;
         let mut state = self.state();
         state.missing.retain(|f| wanted.contains(f));
@@ -537,7 +597,11 @@ impl ReferenceCache {
                 "reusing {reused} reference frame(s) in {}",
                 self.dir.display()
             )));
-            return Ok(claim);
+            return Ok(Filled {
+                claim,
+                rendered: Vec::new(),
+                reused: wanted.to_vec(),
+            });
         }
         if reused > 0 {
             report.note(Some(&format!(
@@ -555,8 +619,24 @@ impl ReferenceCache {
             report.rendered(i + 1, state.missing.len());
         }
         report.finished(&renderer)?;
-        Ok(claim)
+        Ok(Filled {
+            claim,
+            reused: wanted
+                .iter()
+                .copied()
+                .filter(|f| !state.missing.contains(f))
+                .collect(),
+            rendered: state.missing,
+        })
     }
+}
+
+/// What [`ReferenceCache::fill_frames`] did: the claim to keep while the frames are
+/// read, and which of the wanted frames it rendered and which it found done.
+pub struct Filled {
+    pub claim: Claim,
+    pub rendered: Vec<u32>,
+    pub reused: Vec<u32>,
 }
 
 /// How [`ReferenceCache::fill`] tells the user what it does, and how it writes frames.

@@ -5,11 +5,13 @@
 use super::baseline::{self, BaselinePoint};
 use super::images::{write_display_png, write_flip_png};
 use super::overlap::Overlap;
+use super::record::float;
 use super::reference::{frame_name, FillReport, ReferenceCache, ReferenceKey};
 use super::timing::Timing;
 use super::{scenes, EvalArgs, GPU_WARMUP_FRAMES};
 use crate::progress::Progress;
 use crate::setup::Setup;
+use crate::shard::{FolderReport, RunReport};
 use crate::SceneArgs;
 use anyhow::{Context, Result};
 use dvr_engine::gpu::timestamps::{PassOwner, PassTiming};
@@ -19,6 +21,7 @@ use dvr_engine::metrics::{self as score, score, FrameReference};
 use dvr_engine::passes::aux_features;
 use dvr_engine::renderer::{FrameRequest, FrameResult};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -81,11 +84,13 @@ impl Plan {
         })
     }
 
-    /// Work units of the whole eval (see [`Progress`]).
-    pub fn total_units(&self) -> f64 {
+    /// Work units of the scenes `take` accepts (by index; see [`Progress`]).
+    pub fn total_units(&self, take: impl Fn(usize) -> bool) -> f64 {
         self.scenes
             .iter()
-            .map(|s| {
+            .enumerate()
+            .filter(|(i, _)| take(*i))
+            .map(|(_, s)| {
                 s.references.missing().len() as f64 * f64::from(self.ref_spp)
                     + f64::from(s.frames) * (f64::from(s.spp) + self.methods as f64)
                     + baseline::units(s.frames, self.ref_spp)
@@ -95,19 +100,26 @@ impl Plan {
 }
 
 /// Per-frame scores of one method.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MetricRow {
     pub scene: String,
     pub method: String,
     pub frame: u32,
+    #[serde(with = "float")]
     pub psnr: f64,
+    #[serde(with = "float")]
     pub ssim: f64,
+    #[serde(with = "float")]
     pub flip: f64,
+    #[serde(with = "float::option")]
     pub temporal_error: Option<f64>,
+    #[serde(with = "float")]
     pub gpu_ms: f64,
 }
 
-/// Everything the reports need about one evaluated scene.
+/// Everything the reports need about one evaluated scene (kept in
+/// `<scene>/result.json`, see [`super::record`]).
+#[derive(Clone, Serialize, Deserialize)]
 pub struct SceneResult {
     pub name: String,
     /// Folder name inside the eval folder.
@@ -119,6 +131,7 @@ pub struct SceneResult {
     pub event_frame: Option<u32>,
     pub rows: Vec<MetricRow>,
     pub baseline: Vec<BaselinePoint>,
+    #[serde(with = "float")]
     pub path_trace_ms_per_spp: f64,
     pub device: String,
 }
@@ -299,7 +312,7 @@ impl FrameState<'_> {
     }
 }
 
-fn scene_args(args: &EvalArgs, name: &str) -> SceneArgs {
+pub(super) fn scene_args(args: &EvalArgs, name: &str) -> SceneArgs {
     SceneArgs {
         scene: name.to_string(),
         frames: args.frames,
@@ -311,12 +324,12 @@ fn scene_args(args: &EvalArgs, name: &str) -> SceneArgs {
 /// The eval's view of filling a scene's reference cache: notes under the progress
 /// line, reference frames counted as progress, each frame written on the pool while the
 /// GPU renders the next, and the renderer's GPU time counted.
-struct ReferenceProgress<'a> {
-    progress: &'a mut Progress,
-    label: &'a str,
-    ref_spp: u32,
-    timing: &'a Arc<Timing>,
-    writes: Option<Overlap<()>>,
+pub(super) struct ReferenceProgress<'a> {
+    pub progress: &'a mut Progress,
+    pub label: &'a str,
+    pub ref_spp: u32,
+    pub timing: &'a Arc<Timing>,
+    pub writes: Option<Overlap<()>>,
 }
 
 impl FillReport for ReferenceProgress<'_> {
@@ -362,12 +375,11 @@ pub fn evaluate_scene(
     label: &str,
     progress: &mut Progress,
     timing: &Arc<Timing>,
+    report: &mut RunReport,
 ) -> Result<SceneResult> {
     progress.show(&format!("{label} | loading"));
     let setup = Setup::new(&scene_args(args, &scene.spec))?;
-    // Held until the scene's frames are scored: no run with other settings can change
-    // the references meanwhile.
-    let _claim = timing.references.time(|| {
+    let filled = timing.references.time(|| {
         scene.references.fill(
             &setup,
             &mut ReferenceProgress {
@@ -379,6 +391,16 @@ pub fn evaluate_scene(
             },
         )
     })?;
+    report.references.push(FolderReport {
+        scene: scene.name.clone(),
+        folder: scene.references.dir.clone(),
+        selected: (0..scene.frames).collect(),
+        rendered: filled.rendered,
+        reused: filled.reused,
+    });
+    // Held until the scene's frames are scored: no run with other settings can change
+    // the references meanwhile.
+    let _claim = filled.claim;
 
     let names: Vec<&str> = methods.iter().map(String::as_str).collect();
     let mut renderer = setup.renderer(&names)?;

@@ -35,6 +35,10 @@ pub type Overridable<P> = (&'static str, f32, f32, fn(&mut P, f32));
 /// environment variable `variable`) applied, for parameter studies with `dvr eval`. An
 /// unknown name lists the known ones; a value outside its range (or not finite) is an
 /// error naming the range.
+/// The environment variables that override denoiser parameters (`ours`, the paper's
+/// family, svgf): what a method computes depends on them.
+pub const OVERRIDE_VARIABLES: [&str; 3] = ["DVR_OURS", "DVR_WRLS", "DVR_SVGF"];
+
 /// Checks the parameter overrides in the environment (`DVR_OURS`, `DVR_WRLS`,
 /// `DVR_SVGF`) as the denoisers will read them, so a command can refuse a bad value
 /// before it renders anything, not when the method is built after the references.
