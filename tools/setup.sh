@@ -4,7 +4,9 @@
 # archives that build.rs links), Xvfb for window tests, a TrueType font for the plots of
 # `dvr eval` (fonts-dejavu-core), Chromium, in which a test opens the eval's results
 # page headless, ffmpeg, which encodes the videos of `--video` and the main job, and
-# Python 3 with venv, for the Python package (`python/`) and its tests.
+# Python 3 with venv, for the Python package (`python/`) and its tests, and iproute2 and
+# util-linux (`ip`, `unshare`), in which the Ray runner's test keeps its cluster on a
+# loopback-only network namespace.
 # Idempotent: it installs only what is missing, so the README's commands can call it
 # every time.
 set -euo pipefail
@@ -13,7 +15,7 @@ packages=(
   mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers vulkan-tools
   libshaderc-dev glslang-dev glslang-tools spirv-tools
   pkg-config cmake
-  python3 python3-venv python3-pip
+  python3 python3-venv python3-pip iproute2 util-linux
   fonts-dejavu-core chromium ffmpeg
   xvfb libx11-xcb1 libxcursor1 libxi6 libxrandr2 libxkbcommon-x11-0
 )
