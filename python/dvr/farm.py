@@ -14,7 +14,8 @@ driver checks the folder (``--verify``) or writes the eval's reports (``--merge`
 
 ``eval`` runs in two rounds: the references (a unit per frame of each scene), then the
 methods (a unit per scene: temporal denoisers run a scene's frames in order), then the
-merge. Everything after ``--`` is passed to ``dvr`` as it is.
+merge; with ``--references-only`` among dvr's options, the references alone and the
+check. Everything after ``--`` is passed to ``dvr`` as it is.
 """
 
 from __future__ import annotations
@@ -182,6 +183,10 @@ def main(argv: Optional[List[str]] = None) -> int:
         summary: Dict[str, Any] = {"command": a.command, "shards": a.shards}
         if a.command == "reference":
             base = ["reference"] + rest
+            summary["references"] = run_shards(dvr, base, a.shards, "references", a.gpus_per_shard, a.retries)
+            _dvr_local(dvr, base + ["--verify"])
+        elif "--references-only" in rest:
+            base = ["eval"] + rest
             summary["references"] = run_shards(dvr, base, a.shards, "references", a.gpus_per_shard, a.retries)
             _dvr_local(dvr, base + ["--verify"])
         else:
