@@ -44,5 +44,7 @@ __all__ = [
 
 def load_volume(path) -> Volume:
     """Load a volume file as the CLI does: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr),
-    DICOM (a folder or a .dcm file) or raw data with a ``<file>.json``/``.toml`` sidecar."""
+    DICOM (a folder or a .dcm file), OME-Zarr (an image folder: its finest level that
+    fits one texture; or one level's folder inside it) or raw data with a
+    ``<file>.json``/``.toml`` sidecar."""
     return Volume.load(str(path))

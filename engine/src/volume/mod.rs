@@ -15,6 +15,7 @@
 //! | NRRD | `.nrrd` (attached) and `.nhdr` (detached); raw/gzip; uint8/uint16/int16/float | `nrrd.rs` |
 //! | NIfTI-1 | `.nii`, `.nii.gz`; uint8/int16/uint16/float32; `scl_slope/inter` | `nifti.rs` |
 //! | DICOM | a folder of slices (uncompressed little endian, 8/16 bit) | `dicom.rs` |
+//! | OME-Zarr | an image group (0.4 on Zarr v2, 0.5 on Zarr v3; the finest level that fits) or one level's array; uint8/uint16/int16/float32; blosc, gzip, zstd | `zarr.rs` |
 //! | built-in | `phantom` (CT-like head, thin vessels), `cloud` (homogeneous), `mri` (MNI152) | `builtin.rs` |
 //!
 //! Loaders keep the file's index order (no reorientation to RAS/LPS): the renderer
@@ -57,6 +58,7 @@ mod raw;
 mod samples;
 #[cfg(test)]
 mod write;
+mod zarr;
 
 use std::path::Path;
 
@@ -187,12 +189,16 @@ impl Volume {
     /// Loads a volume from a file or a DICOM folder.
     ///
     /// With `raw` given the file is read as raw voxels whatever its extension. Otherwise
-    /// the loader is chosen by: a folder -> DICOM series; `.nrrd`/`.nhdr` -> NRRD;
+    /// the loader is chosen by: a folder with Zarr metadata -> OME-Zarr (the image, or
+    /// one level's array); another folder -> DICOM series; `.nrrd`/`.nhdr` -> NRRD;
     /// `.nii`/`.nii.gz` -> NIfTI-1; `.dcm` -> a one-slice DICOM series; any file with a
     /// sidecar `<file>.json`/`<file>.toml` -> raw.
     pub fn load(path: &Path, raw: Option<&RawParams>) -> Result<Volume, VolumeError> {
         if let Some(params) = raw {
             return raw::load(path, params);
+        }
+        if zarr::is_zarr(path) {
+            return zarr::load(path);
         }
         if path.is_dir() {
             return dicom::load_series(path);
@@ -220,7 +226,8 @@ impl Volume {
             Err(VolumeError::Unsupported {
                 path: path.to_path_buf(),
                 reason: "unknown volume format; expected .nrrd, .nhdr, .nii, .nii.gz, .dcm, \
-                         a DICOM folder, or raw data with a <file>.json/.toml sidecar"
+                         a DICOM folder, an OME-Zarr folder, or raw data with a \
+                         <file>.json/.toml sidecar"
                     .into(),
             })
         }
