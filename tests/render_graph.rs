@@ -162,6 +162,24 @@ fn a_volume_too_large_for_the_device_is_refused_before_allocation() {
         .expect_err("dimension limit")
         .to_string();
     assert!(err.contains("dimension"), "message: {err}");
+    // Defect: a renderer made for such a volume failed only after its graph held
+    // buffers, so the error came after the allocator's "leak detected" reports and the
+    // device was torn down with objects alive. Now it fails before allocating anything.
+    let s = settings(16, 1);
+    let err = match dvr_engine::renderer::Renderer::new(
+        ctx,
+        s.settings,
+        s.config,
+        &huge,
+        None,
+        &["ours"],
+        LUT as u32,
+    ) {
+        Ok(_) => panic!("a renderer for 256 GiB of volume"),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("huge"), "message: {err}");
+    assert_validation_clean();
 }
 
 #[test]

@@ -143,6 +143,9 @@ impl Renderer {
         // What the caller can get wrong (a denoiser's name, what it needs) is checked
         // before the graph exists: the graph's samplers and images are released only by
         // `RenderGraph::destroy`, which an early return here would skip.
+        // So is a volume the device cannot hold (a 1024³ 16-bit one on lavapipe): found
+        // here, the error is not preceded by the allocator's reports of leaked buffers.
+        scene_gpu::check_volume_fits(&ctx, volume)?;
         let denoisers = create_methods(&ctx, &config, features, denoisers)?;
         let mut graph = RenderGraph::new(&ctx)?;
         let passes = Passes {
