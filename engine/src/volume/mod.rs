@@ -15,6 +15,7 @@
 //! | NRRD | `.nrrd` (attached) and `.nhdr` (detached); raw/gzip; uint8/uint16/int16/float | `nrrd.rs` |
 //! | NIfTI-1 | `.nii`, `.nii.gz`; uint8/int16/uint16/float32; `scl_slope/inter` | `nifti.rs` |
 //! | DICOM | a folder of slices (uncompressed little endian, 8/16 bit) | `dicom.rs` |
+//! | OME-TIFF | `.ome.tif(f)` z-stacks (channel 0, time 0; spacing from the OME-XML), plain `.tif` page stacks; uint8/uint16/int16/float32 | `ome_tiff.rs` |
 //! | OME-Zarr | an image group (0.4 on Zarr v2, 0.5 on Zarr v3; the finest level that fits) or one level's array; uint8/uint16/int16/float32; blosc, gzip, zstd | `zarr.rs` |
 //! | built-in | `phantom` (CT-like head, thin vessels), `cloud` (homogeneous), `mri` (MNI152) | `builtin.rs` |
 //!
@@ -52,6 +53,7 @@ mod majorant;
 mod nifti;
 mod normalise;
 mod nrrd;
+mod ome_tiff;
 mod phantom;
 mod procedural;
 mod raw;
@@ -191,7 +193,7 @@ impl Volume {
     /// With `raw` given the file is read as raw voxels whatever its extension. Otherwise
     /// the loader is chosen by: a folder with Zarr metadata -> OME-Zarr (the image, or
     /// one level's array); another folder -> DICOM series; `.nrrd`/`.nhdr` -> NRRD;
-    /// `.nii`/`.nii.gz` -> NIfTI-1; `.dcm` -> a one-slice DICOM series; any file with a
+    /// `.nii`/`.nii.gz` -> NIfTI-1; `.tif`/`.tiff` -> OME-TIFF or a page stack; `.dcm` -> a one-slice DICOM series; any file with a
     /// sidecar `<file>.json`/`<file>.toml` -> raw.
     pub fn load(path: &Path, raw: Option<&RawParams>) -> Result<Volume, VolumeError> {
         if let Some(params) = raw {
@@ -211,6 +213,8 @@ impl Volume {
             nrrd::load(path)
         } else if lower.ends_with(".nii") || lower.ends_with(".nii.gz") {
             nifti::load(path)
+        } else if lower.ends_with(".tif") || lower.ends_with(".tiff") {
+            ome_tiff::load(path)
         } else if lower.ends_with(".dcm") {
             dicom::load_files(path, vec![path.to_path_buf()])
         } else if let Some(params) = raw::read_sidecar(path)? {
@@ -225,9 +229,9 @@ impl Volume {
         } else {
             Err(VolumeError::Unsupported {
                 path: path.to_path_buf(),
-                reason: "unknown volume format; expected .nrrd, .nhdr, .nii, .nii.gz, .dcm, \
-                         a DICOM folder, an OME-Zarr folder, or raw data with a \
-                         <file>.json/.toml sidecar"
+                reason: "unknown volume format; expected .nrrd, .nhdr, .nii, .nii.gz, \
+                         .ome.tif/.tif, .dcm, a DICOM folder, an OME-Zarr folder, or raw \
+                         data with a <file>.json/.toml sidecar"
                     .into(),
             })
         }
