@@ -6,6 +6,8 @@
 //! Outputs stay in `target/tmp/eval/` for inspection (the page test leaves a
 //! screenshot there).
 
+mod common;
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -52,19 +54,8 @@ fn out_dir(name: &str) -> PathBuf {
 /// Runs the tiny eval into `out`; fails the test if dvr fails (a validation message
 /// with DVR_VALIDATION=1 makes it exit with status 3).
 fn eval(out: &Path, frames: u32, ref_spp: u32) -> Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_dvr"))
-        .args(tiny_args(frames, ref_spp))
-        .arg("--out")
-        .arg(out)
-        .output()
-        .expect("running dvr");
-    assert!(
-        o.status.success(),
-        "dvr eval failed ({}):\n{}",
-        o.status,
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
+    let args = tiny_args(frames, ref_spp);
+    common::eval::dvr_ok(&args.iter().map(String::as_str).collect::<Vec<_>>(), out)
 }
 
 fn stderr(o: &Output) -> String {

@@ -66,6 +66,8 @@ pub fn references(args: &EvalArgs, plan: &Plan, timing: &Arc<Timing>) -> Result<
         .scenes
         .iter()
         .zip(&units)
+        // A scene with none of this shard's frames is not read back at all.
+        .filter(|(_, frames)| !frames.is_empty())
         .map(|(s, frames)| {
             let m = s.references.missing();
             frames.iter().filter(|f| m.contains(f)).count()
