@@ -19,13 +19,16 @@
 // Predict: x⁻ = g ∘ x, P⁻ = ḡ² P + Q. Update: K = P⁻ / (P⁻ + R), x = x⁻ + K (y − x⁻),
 // P = (1 − K) P⁻. With nothing changing Q = 0 and K = 1/n: the running mean, which only
 // improves.
-// Outliers and jumps from the normalised innovation ν² = |y − x⁻|² / 3 / (P⁻ + R): beyond
-// outlier_z standard deviations a sample counts only as far as outlier_z (a Huber weight:
-// R is raised by ν² / outlier_z²); a second such innovation in a row is a jump, and its
-// square is added to P⁻ so the filter follows it.
+// Outliers from the normalised innovation ν² = |y − x⁻|² / 3 / (P⁻ + R): beyond outlier_z
+// standard deviations a sample counts only as far as outlier_z (a Huber weight: R is
+// raised by ν² / outlier_z²). Jumps from the pooled lag test: a residual the neighbourhood
+// shares beyond outlier_z standard errors of its mean is a moved level, and its square is
+// added to P⁻ so the filter follows it. A firefly, however often it repeats in one pixel,
+// is clipped (heavy-tailed noise puts bright paths in a pixel in successive frames); a
+// change of the scene moves a region.
 //
-// State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (rg32f:
-// x the measurement noise R, y frames in a row with a far innovation).
+// State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (r32f:
+// the measurement noise R).
 // Outputs: the estimate with its variance for the à-trous filter (variance_atrous.comp), and
 // the a-posteriori residual with its variance for the pooled lag test (ours_lag.comp).
 #include "common.glsl"
@@ -38,7 +41,7 @@ layout(binding = 1, rgba32f) uniform readonly image2D noisy;
 layout(binding = 2) uniform sampler2D model_prev;
 layout(binding = 3) uniform sampler2D noise_prev;
 layout(binding = 4, rgba32f) uniform writeonly image2D model_cur;
-layout(binding = 5, rg32f) uniform writeonly image2D noise_cur;
+layout(binding = 5, r32f) uniform writeonly image2D noise_cur;
 layout(binding = 6, rgba32f) uniform writeonly image2D prediction;  // rgb, a variance
 layout(binding = 7, rgba32f) uniform writeonly image2D residual;    // rgb, a variance (< 0: none)
 layout(binding = 8) uniform sampler2D lag_prev;                      // rgb mean, a variance
@@ -110,7 +113,7 @@ void main() {
     Reprojection r = reproject(p, size, pc.history_valid != 0u, pc.camera.xyz, pc.tolerance);
 
     vec3 x;
-    float P, R, streak = 0.0;
+    float P, R;
     vec4 res = vec4(0.0, 0.0, 0.0, -1.0);  // no residual (a new filter has no history to lag)
     vec4 m = r.valid ? history_fetch(model_prev, r) : vec4(0.0);
     bool fresh = !r.valid || !all_finite(m.rgb) || !(m.a >= 0.0) || isinf(m.a);
@@ -119,19 +122,19 @@ void main() {
         R = fresh_noise(p, size);
         P = R;
     } else {
-        vec2 st = history_fetch(noise_prev, r).xy;
+        float noise = history_fetch(noise_prev, r).x;
         // Predict: the measured change scales the estimate, its variance and the noise.
         SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum);
         float g = dot(sc.ratio, vec3(1.0 / 3.0));
         x = m.rgb * sc.ratio;
         P = m.a * g * g;
-        R = max(st.x * g * g, TINY);
-        streak = st.y;
+        R = max(noise * g * g, TINY);
         float level = luminance(max(x, vec3(0.0)));
         float Q = pc.change_q * sc.change * level;
         Q *= Q;
         if (length(r.motion) > STILL_PX) Q += pc.motion_q * R;
         vec3 shift = vec3(0.0);
+        bool jump = false;
         if (pc.lag_valid != 0u) {
             // A residual the neighbourhood shares, beyond lag_z standard errors, is a
             // measurement of what this frame's prediction missed, whose prior variance
@@ -146,24 +149,24 @@ void main() {
             if (z2 > pc.lag_z * pc.lag_z) shift = B / (B + max(lag.a, TINY)) * lag.rgb;
             x += shift;
             Q += dot(shift, shift) / 3.0;
+            // A shared residual beyond outlier_z standard errors is a jump, announced or
+            // not (below).
+            jump = z2 > pc.outlier_z * pc.outlier_z;
         }
         float P_prior = P + Q;
 
         // Update, with the innovation's outliers clipped and jumps followed.
         vec3 e = y - x;
         float e2 = dot(e, e) / 3.0;
+        // At a jump the level moved by about the innovation: its square joins the
+        // prediction's variance and the update follows this frame's samples.
+        if (jump) P_prior += e2;
         float nu2 = e2 / max(P_prior + R, TINY);
         float z2 = pc.outlier_z * pc.outlier_z;
         bool far = nu2 > z2;
-        streak = far ? streak + 1.0 : 0.0;
-        float R_eff = R;
+        // A spike counts as far as outlier_z deviations (a Huber weight).
+        float R_eff = far ? R * nu2 / z2 : R;
         P = P_prior;
-        if (far && streak >= 2.0) {
-            P += e2;  // a jump: the level moved by about the innovation
-            streak = 0.0;
-        } else if (far) {
-            R_eff = R * nu2 / z2;  // a spike counts as far as outlier_z deviations
-        }
         float K = P / (P + R_eff);
         x += K * e;
         P = (1.0 - K) * P;
@@ -176,7 +179,7 @@ void main() {
         float clip = far ? sqrt(z2 / nu2) : 1.0;
         res = vec4((1.0 - K) * clip * e, (1.0 - K) * (1.0 - K) * (P_prior + R_eff));
         vec4 prev = history_fetch(residual_prev, r);
-        if (pc.lag_valid != 0u && prev.a > 0.0 && all_finite(prev.rgb)) {
+        if (pc.lag_valid != 0u && !jump && prev.a > 0.0 && all_finite(prev.rgb)) {
             vec3 carried = prev.rgb * sc.ratio - shift;
             res.rgb = mix(carried, res.rgb, LAG_BLEND);
         }
@@ -188,7 +191,7 @@ void main() {
         P = R;
     }
     imageStore(model_cur, p, vec4(x, P));
-    imageStore(noise_cur, p, vec4(R, streak, 0.0, 0.0));
+    imageStore(noise_cur, p, vec4(R, 0.0, 0.0, 0.0));
     imageStore(prediction, p, vec4(max(x, vec3(0.0)), P));
     imageStore(residual, p, res);
 }

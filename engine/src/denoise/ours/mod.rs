@@ -58,8 +58,8 @@ pub struct OursParams {
     /// Pooled residual, in standard errors of its mean, below which it is noise; beyond,
     /// the positive-part shrinkage of it is taken as a shift of the state.
     pub lag_z: f32,
-    /// Innovation, in standard deviations, beyond which a sample is clipped (and, twice
-    /// in a row, taken as a jump).
+    /// Innovation, in standard deviations, beyond which a sample is clipped; and pooled
+    /// residual, in standard errors of its mean, beyond which the level jumped.
     pub outlier_z: f32,
     /// Standard errors by which a neighbour's estimate may differ from the pixel's and
     /// still be blended (the à-trous range term).

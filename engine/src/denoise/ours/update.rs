@@ -1,7 +1,7 @@
 //! `<name>.update` (ours_update.comp): the Kalman filter's predict (the estimate
 //! reprojected, scaled by the measured change, shifted by a significant pooled lag) and
 //! update with this frame's noisy colour. State: `model` (rgb estimate, a its variance)
-//! and `noise` (the measurement noise, frames in a row with a far innovation).
+//! and `noise` (the measurement noise R).
 
 use super::gradient::Gradients;
 use super::lag::LagImages;
@@ -48,9 +48,9 @@ impl Ours {
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
         let n = &self.name;
         let model = graph.history(ctx, &format!("{n}.model"), desc)?;
-        // Two channels are all the noise state needs.
+        // One channel is all the noise state needs.
         let noise_desc = ImageDesc {
-            format: vk::Format::R32G32_SFLOAT,
+            format: vk::Format::R32_SFLOAT,
             ..desc
         };
         let noise = graph.history(ctx, &format!("{n}.noise"), noise_desc)?;
