@@ -80,7 +80,7 @@ impl Default for OursParams {
             lag_z: 1.5,
             outlier_z: 6.0,
             kappa: 2.5,
-            keep: 0.05,
+            keep: 0.02,
         }
     }
 }
