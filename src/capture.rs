@@ -281,6 +281,7 @@ pub fn run_profile(
         spp: setup.settings.spp(),
         denoisers: renderer.denoiser_names(),
         shared_tiles: renderer.ctx().shared_tiles,
+        volume: renderer.volume_residency().to_string(),
     };
     let mut report = Profile::new(run, &stats, &window, Some(peak));
     report.interrupted = interrupted;

@@ -70,6 +70,11 @@ pub struct RenderArgs {
     /// depend on it.
     #[arg(long, default_value_t = RenderArgs::default().motion)]
     pub motion: dvr_engine::denoise::MotionSource,
+    /// Bytes the volume may take on the device, e.g. `512M`, `2G` (default: the scene's
+    /// `[render] gpu_memory`, else half the device-local heap). A volume past it is paged
+    /// through a brick pool of the bricks the TF makes visible.
+    #[arg(long, value_parser = setup::parse_gpu_memory)]
+    pub gpu_memory: Option<u64>,
 }
 
 impl Default for RenderArgs {
@@ -78,6 +83,7 @@ impl Default for RenderArgs {
             spp: None,
             volume_size: dvr_engine::renderer::scene_setup::DEFAULT_VOLUME_SIZE,
             motion: dvr_engine::denoise::MotionSource::Features,
+            gpu_memory: None,
         }
     }
 }

@@ -130,12 +130,13 @@ fn new_images_start_at_zero() {
 }
 
 #[test]
-fn a_volume_too_large_for_the_device_is_refused_before_allocation() {
+fn a_volume_past_the_device_limits_is_paged_and_a_mis_sized_one_refused_before_allocation() {
+    use dvr_engine::renderer::brick_pool::VolumePath;
     use dvr_engine::renderer::scene_gpu::{
         check_volume_fits, BrickRanges, VolumeFormat, VolumeUpload,
     };
     let ctx = context();
-    // Only the header matters: the limits are checked before the bytes.
+    // A header whose bytes are missing: refused, naming the volume, before anything else.
     let huge = VolumeUpload {
         name: "huge".into(),
         dims: [4096, 4096, 4096],
@@ -149,33 +150,38 @@ fn a_volume_too_large_for_the_device_is_refused_before_allocation() {
             max: vec![1.0],
         },
     };
-    let err = check_volume_fits(&ctx, &huge)
-        .expect_err("256 GiB cannot fit")
+    let err = check_volume_fits(&ctx, &huge, None)
+        .expect_err("no bytes for 128 GiB")
         .to_string();
     assert!(
-        err.contains("huge") && err.contains(&ctx.info.name),
+        err.contains("huge") && err.contains("0 bytes"),
         "message: {err}"
     );
+    // Taller than the 3D image limit: paged through the brick pool, not refused.
     let mut too_tall = huge.clone();
     too_tall.dims = [8, 8, ctx.info.max_image_dimension_3d + 1];
-    let err = check_volume_fits(&ctx, &too_tall)
-        .expect_err("dimension limit")
-        .to_string();
-    assert!(err.contains("dimension"), "message: {err}");
-    // Defect: a renderer made for such a volume failed only after its graph held
-    // buffers, so the error came after the allocator's "leak detected" reports and the
-    // device was torn down with objects alive. Now it fails before allocating anything.
+    too_tall.bytes = vec![0; 8 * 8 * too_tall.dims[2] as usize * 2];
+    match check_volume_fits(&ctx, &too_tall, None).expect("pooled") {
+        VolumePath::Pool(p) => assert!(p
+            .pool_extent()
+            .iter()
+            .all(|&e| e <= ctx.info.max_image_dimension_3d)),
+        VolumePath::Dense => panic!("past the 3D image limit"),
+    }
+    // Defect: a renderer made for a volume it could not hold failed only after its graph
+    // held buffers, so the error came after the allocator's "leak detected" reports and
+    // the device was torn down with objects alive. Now it fails before allocating anything.
     let s = settings(16, 1);
     let err = match dvr_engine::renderer::Renderer::new(
         ctx,
         s.settings,
         s.config,
-        &huge,
+        std::sync::Arc::new(huge),
         None,
         &["ours"],
         LUT as u32,
     ) {
-        Ok(_) => panic!("a renderer for 256 GiB of volume"),
+        Ok(_) => panic!("a renderer for a volume without its bytes"),
         Err(e) => e.to_string(),
     };
     assert!(err.contains("huge"), "message: {err}");

@@ -344,6 +344,7 @@ mod tests {
             spp: 2,
             denoisers: vec!["ours".into(), "svgf".into()],
             shared_tiles: true,
+            volume: "dense volume".into(),
         };
         let peak = PeakBandwidth {
             gb_per_s: 4.0,

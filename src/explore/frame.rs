@@ -94,6 +94,7 @@ impl Explorer {
         };
         let finished = renderer.resize(view)?;
         self.ui.stats.render_size = (vw, vh);
+        self.ui.stats.volume = renderer.volume_residency().to_string();
         let Some(image) = gfx.swapchain.acquire()? else {
             gfx.recreate_swapchain(size)?;
             return Ok(());

@@ -45,6 +45,8 @@ pub struct Stats {
     pub device: String,
     pub render_size: (u32, u32),
     pub present_mode: String,
+    /// How the volume is held on the device: "dense volume" or the brick pool's residency.
+    pub volume: String,
     /// Per-pass GPU times of the last completed frame.
     pub timings: Vec<PassTiming>,
     /// (CPU frame interval, GPU span) in ms, oldest first.
@@ -197,6 +199,7 @@ fn panel(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model, requests: &m
         ))
         .small(),
     );
+    ui.label(RichText::new(&state.stats.volume).small());
     egui::CollapsingHeader::new("Transfer function")
         .default_open(true)
         .show(ui, |ui| {

@@ -113,6 +113,9 @@ pub struct RunInfo {
     pub denoisers: Vec<String>,
     /// The à-trous levels read their window through shared memory (GpuContext::shared_tiles).
     pub shared_tiles: bool,
+    /// How the volume reached the device: "dense volume", or the brick pool's residency
+    /// at the end of the run.
+    pub volume: String,
 }
 
 fn window_note(window: &Window, rendered: usize) -> String {
@@ -131,7 +134,7 @@ fn window_note(window: &Window, rendered: usize) -> String {
 pub fn table(p: &Profile) -> String {
     let r = &p.run;
     let mut s = format!(
-        "{} | {} | {}x{} | {} spp | denoisers: {} | à-trous windows: {}\n",
+        "{} | {} | {}x{} | {} spp | denoisers: {} | à-trous windows: {} | {}\n",
         r.device,
         r.scene,
         r.width,
@@ -142,7 +145,8 @@ pub fn table(p: &Profile) -> String {
             "shared-memory tiles"
         } else {
             "direct loads"
-        }
+        },
+        r.volume
     );
     match &p.peak_bandwidth {
         Some(b) => s.push_str(&format!(
@@ -279,6 +283,7 @@ mod tests {
             spp: 1,
             denoisers: vec!["none".into()],
             shared_tiles: false,
+            volume: "dense volume".into(),
         };
         let peak = PeakBandwidth {
             gb_per_s: 8.0,

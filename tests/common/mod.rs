@@ -119,7 +119,7 @@ pub fn renderer_with(
         ctx,
         s.settings,
         s.config,
-        v,
+        std::sync::Arc::new(v.clone()),
         environment,
         denoisers,
         LUT as u32,

@@ -224,19 +224,30 @@ impl<'a> PassContext<'a> {
 
     /// Copies a declared buffer (TransferSrc) into a declared image (TransferDst).
     pub fn copy_buffer_to_image(&mut self, src: BufferHandle, dst: ImageHandle) -> Result<()> {
-        let buffer = self.buffer(src)?;
-        let image = self.image(dst)?;
         let desc = self.graph.image_desc(dst);
         let region = vk::BufferImageCopy::default()
             .image_subresource(color_layers())
             .image_extent(extent(desc.extent));
+        self.copy_buffer_to_image_regions(src, dst, &[region])
+    }
+
+    /// Copies regions of a declared buffer (TransferSrc) into regions of a declared
+    /// image (TransferDst): the brick pool's uploads.
+    pub fn copy_buffer_to_image_regions(
+        &mut self,
+        src: BufferHandle,
+        dst: ImageHandle,
+        regions: &[vk::BufferImageCopy],
+    ) -> Result<()> {
+        let buffer = self.buffer(src)?;
+        let image = self.image(dst)?;
         unsafe {
             self.ctx.device.cmd_copy_buffer_to_image(
                 self.cmd,
                 buffer,
                 image,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[region],
+                regions,
             )
         };
         Ok(())

@@ -24,10 +24,12 @@ pub struct SceneBindings {
     pub tf_emissive: ImageHandle,
     pub majorant: ImageHandle,
     pub environment: ImageHandle,
+    pub brick_pool: ImageHandle,
+    pub brick_table: ImageHandle,
 }
 
 impl SceneBindings {
-    /// Binds the frame block, volume, LUTs and majorant grid to the variables
+    /// Binds the frame block, volume, LUTs, majorant grid and brick pool to the variables
     /// include/frame.glsl and include/volume.glsl declare.
     pub fn bind_volume(&self, b: &mut Bindings) {
         b.uniform("frame", self.uniforms)
@@ -35,6 +37,8 @@ impl SceneBindings {
             .sampled("tf_diffuse_opacity", self.tf_diffuse_opacity)
             .sampled("tf_specular_roughness", self.tf_specular_roughness)
             .sampled("tf_emissive", self.tf_emissive)
-            .sampled_nearest("majorant_grid", self.majorant);
+            .sampled_nearest("majorant_grid", self.majorant)
+            .sampled("brick_pool", self.brick_pool)
+            .sampled_nearest("brick_table", self.brick_table);
     }
 }

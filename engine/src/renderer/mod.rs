@@ -3,6 +3,7 @@
 //! render graph, submitted once. Frames alternate between two slots so recording frame N overlaps the GPU's work
 //! on frame N−1; timestamps and readbacks of a slot are collected when it comes round.
 
+pub mod brick_pool;
 mod inputs;
 pub mod present;
 mod reference;
@@ -31,6 +32,7 @@ use crate::passes::SceneBindings;
 use crate::scene::RenderSettings;
 use crate::shaders::frame::{FrameBlock, FrameParams, SampleStream, MAX_LIGHTS};
 use ash::vk;
+use brick_pool::{Residency, VolumePath};
 use glam::Vec3;
 use gpu_allocator::MemoryLocation;
 pub use present::{Overlay, PresentTarget, Screenshot};
@@ -52,6 +54,10 @@ pub struct RendererConfig {
     /// The built-in dataset the volume is, if it is one (`rae` runs the network trained
     /// on it).
     pub dataset: Option<&'static str>,
+    /// Bytes the volume may take on the device (`--gpu-memory`, `[render] gpu_memory`);
+    /// `None`: half the largest device-local heap. Past it the volume is paged through
+    /// the brick pool.
+    pub gpu_memory: Option<u64>,
 }
 
 impl Default for RendererConfig {
@@ -64,6 +70,48 @@ impl Default for RendererConfig {
             density_scale: 100.0,
             motion_source: denoise::MotionSource::FirstHit,
             dataset: None,
+            gpu_memory: None,
+        }
+    }
+}
+
+/// How a renderer holds its volume (see [`brick_pool`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum VolumeResidency {
+    /// One dense 3D texture.
+    Dense,
+    /// A brick pool: of the bricks the current TF can make visible, `resident` have a
+    /// slot, `pending` wait for their upload, and the rest (past the pool's slots) show at
+    /// the coarse level.
+    Pool {
+        layout: brick_pool::PoolLayout,
+        visible: usize,
+        resident: usize,
+        pending: usize,
+    },
+}
+
+impl std::fmt::Display for VolumeResidency {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            VolumeResidency::Dense => write!(f, "dense volume"),
+            VolumeResidency::Pool {
+                layout,
+                visible,
+                resident,
+                ..
+            } => {
+                write!(
+                    f,
+                    "brick pool: {resident} of {visible} visible bricks resident ({} slots of {}³), coarse level {} ({}×{}×{})",
+                    layout.slot_count(),
+                    brick_pool::BRICK,
+                    layout.level,
+                    layout.coarse_dims[0],
+                    layout.coarse_dims[1],
+                    layout.coarse_dims[2]
+                )
+            }
         }
     }
 }
@@ -108,10 +156,21 @@ pub struct Renderer {
     denoisers: Vec<Method>,
     scene: SceneImages,
     bricks: scene_gpu::BrickRanges,
+    /// The volume as loaded: the brick pool reads its bricks from it.
+    volume: Arc<VolumeUpload>,
+    volume_path: VolumePath,
+    /// Which brick is in which pool slot (the pool path only).
+    residency: Option<Residency>,
+    /// The brick table changed since it was last uploaded.
+    table_dirty: bool,
+    /// The current TF makes more bricks visible than the pool has slots.
+    over_budget: bool,
     volume_dims: [u32; 3],
     world_size: [f32; 3],
     lut_size: u32,
     current_lut: Option<LutUpload>,
+    /// The largest extinction under `current_lut`.
+    majorant_max: f32,
     last_inputs: Option<FrameInputs>,
     slots: Vec<Slot>,
     pool: vk::CommandPool,
@@ -132,7 +191,7 @@ impl Renderer {
         ctx: impl Into<Arc<GpuContext>>,
         settings: RenderSettings,
         config: RendererConfig,
-        volume: &VolumeUpload,
+        volume: Arc<VolumeUpload>,
         environment: Option<&EnvironmentUpload>,
         denoisers: &[&str],
         lut_size: u32,
@@ -143,9 +202,9 @@ impl Renderer {
         // What the caller can get wrong (a denoiser's name, what it needs) is checked
         // before the graph exists: the graph's samplers and images are released only by
         // `RenderGraph::destroy`, which an early return here would skip.
-        // So is a volume the device cannot hold (a 1024³ 16-bit one on lavapipe): found
-        // here, the error is not preceded by the allocator's reports of leaked buffers.
-        scene_gpu::check_volume_fits(&ctx, volume)?;
+        // So is a volume not even a brick pool can hold in the budget: found here, the
+        // error is not preceded by the allocator's reports of leaked buffers.
+        let volume_path = scene_gpu::check_volume_fits(&ctx, &volume, config.gpu_memory)?;
         let denoisers = create_methods(&ctx, &config, features, denoisers)?;
         let mut graph = RenderGraph::new(&ctx)?;
         let passes = Passes {
@@ -194,7 +253,15 @@ impl Renderer {
 
         // Upload the volume and environment once, through the graph.
         let mut setup = Frame::new();
-        let scene = scene_gpu::create(&ctx, &mut graph, &mut setup, volume, environment, lut_size)?;
+        let scene = scene_gpu::create(
+            &ctx,
+            &mut graph,
+            &mut setup,
+            &volume,
+            &volume_path,
+            environment,
+            lut_size,
+        )?;
         ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, setup))?;
 
         Ok(Self {
@@ -209,8 +276,20 @@ impl Renderer {
             bricks: volume.bricks.clone(),
             volume_dims: volume.dims,
             world_size: volume.world_size,
+            residency: match &volume_path {
+                VolumePath::Dense => None,
+                VolumePath::Pool(layout) => Some(Residency::new(
+                    layout.clone(),
+                    brick_pool::pool_ranges(&volume.bricks),
+                )),
+            },
+            volume_path,
+            volume,
+            table_dirty: false,
+            over_budget: false,
             lut_size,
             current_lut: None,
+            majorant_max: 0.0,
             last_inputs: None,
             slots,
             pool,
@@ -317,6 +396,10 @@ impl Renderer {
             majorant_max,
             volume_dims: self.volume_dims,
             brick: self.bricks.brick,
+            pool_brick: match self.volume_path {
+                VolumePath::Dense => 0,
+                VolumePath::Pool(_) => brick_pool::BRICK,
+            },
             lights: &inputs.lights,
             stream,
             max_bounces: s.max_bounces(),
@@ -367,7 +450,7 @@ impl Renderer {
         let mut frame = Frame::new();
 
         // Scene state: the TF (only when it changed) and this frame's uniforms.
-        let majorant_max = self.upload_transfer_function(&mut frame, slot, &inputs.lut)?;
+        let majorant_max = self.upload_transfer_function(&mut frame, slot, &inputs.lut, true)?;
         let block = self.frame_block(inputs, majorant_max, SampleStream::Frame(self.frame_index));
         let scene = self.write_uniforms(slot, &block)?;
         let (ctx, graph, passes, size) =
@@ -494,12 +577,16 @@ impl Renderer {
     }
 
     /// Adds uploads of the TF LUTs and the majorant grid when the TF differs from the one
-    /// on the device; returns the largest extinction (the global majorant).
+    /// on the device, and on the pool path the bricks it makes visible and the brick
+    /// table; returns the largest extinction (the global majorant). `stream`: a frame
+    /// uploads at most [`brick_pool::STREAM_PER_FRAME`] bricks after the first frame; a
+    /// reference (`false`) waits for them all.
     fn upload_transfer_function(
         &mut self,
         frame: &mut Frame,
         slot: usize,
         lut: &LutUpload,
+        stream: bool,
     ) -> Result<f32> {
         if lut.diffuse_opacity.len() != self.lut_size as usize {
             return Err(EngineError::Resource {
@@ -511,10 +598,12 @@ impl Renderer {
                 ),
             });
         }
-        let opacity: Vec<f32> = lut.diffuse_opacity.iter().map(|c| c[3]).collect();
-        let majorants = scene_gpu::majorants(&self.bricks, &opacity, self.config.density_scale);
-        let majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
+        let first = self.current_lut.is_none();
         if self.current_lut.as_ref() != Some(lut) {
+            let opacity: Vec<f32> = lut.diffuse_opacity.iter().map(|c| c[3]).collect();
+            let scale = self.config.density_scale;
+            let majorants = scene_gpu::majorants(&self.bricks, &opacity, scale);
+            self.majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
             let (ctx, graph) = (&self.ctx, &mut self.graph);
             let [a, b, c] = self.scene.tf;
             for (name, image, bytes) in [
@@ -537,9 +626,101 @@ impl Renderer {
             ] {
                 scene_gpu::add_frame_upload(ctx, graph, frame, name, slot, image, bytes)?;
             }
+            if let Some(r) = &mut self.residency {
+                r.set_transfer_function(&scene_gpu::majorants(r.ranges(), &opacity, scale));
+                self.table_dirty = true;
+                let slots = r.layout.slot_count();
+                // Said once each time the TF goes past the pool (not on every edit while
+                // it stays there); the HUD and profile header show the count throughout.
+                let over = r.visible_count > slots;
+                if over && !std::mem::replace(&mut self.over_budget, over) {
+                    log::warn!(
+                        "{} of the {} bricks this TF makes visible show at the coarse level (1/{} resolution): the budget holds {slots} (raise --gpu-memory)",
+                        r.visible_count - slots,
+                        r.visible_count,
+                        1 << r.layout.level
+                    );
+                }
+                self.over_budget = over;
+            }
             self.current_lut = Some(lut.clone());
         }
-        Ok(majorant_max)
+        self.upload_bricks(frame, slot, first || !stream)?;
+        if first && self.residency.is_some() {
+            log::info!("{}", self.volume_residency());
+        }
+        Ok(self.majorant_max)
+    }
+
+    /// On the pool path: uploads pending bricks into their slots (at most one frame's
+    /// worth into `frame`; with `all`, the rest first through set-up submissions) and
+    /// the brick table after them, in the same frame, so no frame reads a slot the
+    /// table does not describe.
+    fn upload_bricks(&mut self, frame: &mut Frame, slot: usize, all: bool) -> Result<()> {
+        /// Bricks per set-up submission when a whole TF's bricks load at once.
+        const SETUP_CHUNK: usize = 512;
+        let Some(r) = &mut self.residency else {
+            return Ok(());
+        };
+        let (ctx, graph, volume) = (&self.ctx, &mut self.graph, &self.volume);
+        let size = brick_pool::brick_bytes(volume.format) as u64;
+        while all && r.pending() > brick_pool::STREAM_PER_FRAME {
+            let uploads = r.take_uploads(SETUP_CHUNK);
+            let staging = graph.buffer(
+                ctx,
+                "brick_pool.staging.setup",
+                SETUP_CHUNK as u64 * size,
+                MemoryLocation::CpuToGpu,
+            )?;
+            let mut setup = Frame::new();
+            let pool = self.scene.pool;
+            scene_gpu::add_brick_uploads(
+                graph, &mut setup, staging, pool, volume, &r.layout, &uploads,
+            )?;
+            ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, setup))?;
+            self.table_dirty = true;
+        }
+        let uploads = r.take_uploads(brick_pool::STREAM_PER_FRAME);
+        if !uploads.is_empty() {
+            let staging = graph.buffer(
+                ctx,
+                &format!("brick_pool.staging.{slot}"),
+                brick_pool::STREAM_PER_FRAME as u64 * size,
+                MemoryLocation::CpuToGpu,
+            )?;
+            let pool = self.scene.pool;
+            scene_gpu::add_brick_uploads(graph, frame, staging, pool, volume, &r.layout, &uploads)?;
+            self.table_dirty = true;
+        }
+        if std::mem::take(&mut self.table_dirty) {
+            let table = r.table();
+            let image = self.scene.brick_table;
+            let bytes = bytemuck::cast_slice(&table);
+            scene_gpu::add_frame_upload(
+                ctx,
+                graph,
+                frame,
+                "upload_brick_table",
+                slot,
+                image,
+                bytes,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// How the volume reaches the device, and on the pool path how many of the bricks the
+    /// current TF makes visible have a slot.
+    pub fn volume_residency(&self) -> VolumeResidency {
+        match &self.residency {
+            None => VolumeResidency::Dense,
+            Some(r) => VolumeResidency::Pool {
+                layout: r.layout.clone(),
+                visible: r.visible_count,
+                resident: r.resident_visible(),
+                pending: r.pending(),
+            },
+        }
     }
 
     /// Writes `uniforms` into slot `slot`'s uniform buffer; returns the scene bindings.
@@ -556,6 +737,8 @@ impl Renderer {
             tf_emissive: self.scene.tf[2],
             majorant: self.scene.majorant,
             environment: self.scene.environment,
+            brick_pool: self.scene.pool,
+            brick_table: self.scene.brick_table,
         })
     }
 

@@ -2,11 +2,13 @@
 //! as 1D LUTs, the majorant grid and the environment map. Uploads go through the render
 //! graph as transfer passes, like everything else.
 
+use super::brick_pool::{self, Limits, PoolLayout, VolumePath, STORED};
 use crate::error::{EngineError, Result};
 use crate::gpu::{GpuContext, ImageDesc};
-use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
+use std::borrow::Cow;
 
 /// Texel format of an uploaded volume.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -120,6 +122,8 @@ pub struct SceneImages {
     pub tf: [ImageHandle; 3],
     pub majorant: ImageHandle,
     pub environment: ImageHandle,
+    pub pool: ImageHandle,
+    pub brick_table: ImageHandle,
 }
 
 /// Adds a pass that copies `bytes` into `image` through a staging buffer of its own
@@ -180,41 +184,27 @@ fn add_upload_via(
     Ok(())
 }
 
-/// Checks a volume against the device's limits before anything is allocated: each
-/// dimension within the 3D image limit, the texture within one allocation, and the
-/// texture plus its staging copy within the device-local heap (lavapipe: a 1024³ 8-bit
-/// volume fits its 2 GiB, a 1024³ 16-bit one does not).
-pub fn check_volume_fits(ctx: &GpuContext, v: &VolumeUpload) -> Result<()> {
+/// The memory budget a renderer assumes without `--gpu-memory`: half the largest
+/// device-local heap, so a dense texture and its upload copy fit together (lavapipe: a
+/// 1024³ 8-bit volume is dense, a 1024³ 16-bit one is pooled).
+pub fn default_budget(ctx: &GpuContext) -> u64 {
+    match ctx.info.device_local_heap {
+        0 => ctx.info.max_memory_allocation_size,
+        heap => heap / 2,
+    }
+}
+
+/// Decides, before anything is allocated, how `v` reaches the device within `budget`
+/// bytes (`None`: [`default_budget`]): one dense texture where it fits the budget and the
+/// device's limits, else a brick pool; an error names the volume and the device where
+/// not even a pool fits, or where the bytes do not match the header.
+pub fn check_volume_fits(
+    ctx: &GpuContext,
+    v: &VolumeUpload,
+    budget: Option<u64>,
+) -> Result<VolumePath> {
     let texels: u64 = v.dims.iter().map(|&d| d as u64).product();
     let needed = texels * v.format.bytes() as u64;
-    if let Some(&d) = v
-        .dims
-        .iter()
-        .find(|&&d| d > ctx.info.max_image_dimension_3d)
-    {
-        return Err(EngineError::TooLarge {
-            what: format!("volume {:?}: dimension {d}", v.name),
-            needed: d as u64,
-            limit: ctx.info.max_image_dimension_3d as u64,
-            device: ctx.info.name.clone(),
-        });
-    }
-    let heap = if ctx.info.device_local_heap > 0 {
-        ctx.info.device_local_heap
-    } else {
-        u64::MAX
-    };
-    if needed > ctx.info.max_memory_allocation_size || needed.saturating_mul(2) > heap {
-        return Err(EngineError::TooLarge {
-            what: format!(
-                "volume {:?} ({:?} voxels, {:?}; the texture and its upload copy)",
-                v.name, v.dims, v.format
-            ),
-            needed: needed.saturating_mul(2),
-            limit: heap.min(ctx.info.max_memory_allocation_size.saturating_mul(2)),
-            device: ctx.info.name.clone(),
-        });
-    }
     if needed != v.bytes.len() as u64 {
         return Err(EngineError::Resource {
             resource: v.name.clone(),
@@ -226,25 +216,71 @@ pub fn check_volume_fits(ctx: &GpuContext, v: &VolumeUpload) -> Result<()> {
             ),
         });
     }
-    Ok(())
+    let limits = Limits {
+        budget: budget.unwrap_or_else(|| default_budget(ctx)),
+        max_image_dimension_3d: ctx.info.max_image_dimension_3d,
+        max_allocation: ctx.info.max_memory_allocation_size,
+        heap: match ctx.info.device_local_heap {
+            0 => u64::MAX,
+            heap => heap,
+        },
+    };
+    brick_pool::plan(v.dims, v.format, &limits).map_err(|why| EngineError::TooLarge {
+        what: format!(
+            "volume {:?} ({:?} voxels, {:?}): {why}",
+            v.name, v.dims, v.format
+        ),
+        needed,
+        limit: limits.budget,
+        device: ctx.info.name.clone(),
+    })
 }
 
-/// Creates the scene images and adds their uploads to `frame`.
+/// Creates the scene images and adds their uploads to `frame`: the volume (dense, or the
+/// coarse copy beneath a brick pool), the pool and its brick table (1×1×1 stand-ins on
+/// the dense path, whose shaders never read them), the LUTs, majorant grid and
+/// environment map.
 pub fn create<'f>(
     ctx: &GpuContext,
     graph: &mut RenderGraph,
     frame: &mut Frame<'f>,
     volume: &VolumeUpload,
+    path: &VolumePath,
     environment: Option<&EnvironmentUpload>,
     lut_size: u32,
 ) -> Result<SceneImages> {
-    check_volume_fits(ctx, volume)?;
-    let vol = graph.image(
-        ctx,
-        "scene.volume",
-        ImageDesc::d3(volume.dims, volume.format.vk()),
-    )?;
-    add_upload(ctx, graph, frame, "upload_volume", vol, &volume.bytes)?;
+    let format = volume.format.vk();
+    // Dense: the volume itself, and 1×1×1 pool and table no shader reads. Pooled: the
+    // coarse copy, the pool (slots are written as the TF makes their bricks visible, and
+    // read only through the table, which starts with no slot) and the table.
+    let (volume_dims, volume_bytes, pool_extent, grid, no_slot) = match path {
+        VolumePath::Dense => (
+            volume.dims,
+            Cow::Borrowed(&volume.bytes[..]),
+            [1; 3],
+            [1; 3],
+            0.0,
+        ),
+        VolumePath::Pool(layout) => (
+            layout.coarse_dims,
+            Cow::Owned(brick_pool::coarse_copy(
+                volume,
+                layout.level,
+                layout.coarse_dims,
+            )),
+            layout.pool_extent(),
+            layout.grid,
+            -1.0,
+        ),
+    };
+    let vol = graph.image(ctx, "scene.volume", ImageDesc::d3(volume_dims, format))?;
+    add_upload(ctx, graph, frame, "upload_volume", vol, &volume_bytes)?;
+    let pool = graph.image(ctx, "scene.brick_pool", ImageDesc::d3(pool_extent, format))?;
+    let table_desc = ImageDesc::d3(grid, vk::Format::R32G32_SFLOAT);
+    let table = graph.image(ctx, "scene.brick_table", table_desc)?;
+    let entries = vec![[-1f32, no_slot]; table_desc.texel_count() as usize];
+    let entries = bytemuck::cast_slice(&entries);
+    add_upload(ctx, graph, frame, "upload_brick_table", table, entries)?;
     let lut_desc = ImageDesc::d1(lut_size, vk::Format::R32G32B32A32_SFLOAT);
     let tf = [
         graph.image(ctx, "scene.tf_diffuse_opacity", lut_desc)?,
@@ -276,13 +312,68 @@ pub fn create<'f>(
         bytemuck::cast_slice(rgba),
     )?;
     // Later frames' shaders sample what this frame uploads.
-    frame.add_ready_for_sampling("scene_ready", &[vol, tf[0], tf[1], tf[2], majorant, env]);
+    frame.add_ready_for_sampling(
+        "scene_ready",
+        &[vol, tf[0], tf[1], tf[2], majorant, env, pool, table],
+    );
     Ok(SceneImages {
         volume: vol,
         tf,
         majorant,
         environment: env,
+        pool,
+        brick_table: table,
     })
+}
+
+/// Adds a pass that copies bricks of `volume` into their pool slots through the staging
+/// buffer `staging` (at least `uploads.len()` bricks long).
+pub fn add_brick_uploads(
+    graph: &mut RenderGraph,
+    frame: &mut Frame<'_>,
+    staging: BufferHandle,
+    pool: ImageHandle,
+    volume: &VolumeUpload,
+    layout: &PoolLayout,
+    uploads: &[(u32, u32)],
+) -> Result<()> {
+    let size = brick_pool::brick_bytes(volume.format);
+    let mut bytes = vec![0u8; size * uploads.len()];
+    let [gx, gy, _] = layout.grid;
+    let mut regions = Vec::with_capacity(uploads.len());
+    for (i, (&(b, s), out)) in uploads.iter().zip(bytes.chunks_mut(size)).enumerate() {
+        let brick = [b % gx, (b / gx) % gy, b / (gx * gy)];
+        brick_pool::write_brick(volume, brick, out);
+        let [x, y, z] = layout.slot_origin(s);
+        regions.push(
+            vk::BufferImageCopy::default()
+                .buffer_offset((i * size) as u64)
+                .image_subresource(
+                    vk::ImageSubresourceLayers::default()
+                        .aspect_mask(vk::ImageAspectFlags::COLOR)
+                        .layer_count(1),
+                )
+                .image_offset(vk::Offset3D {
+                    x: x as i32,
+                    y: y as i32,
+                    z: z as i32,
+                })
+                .image_extent(vk::Extent3D {
+                    width: STORED,
+                    height: STORED,
+                    depth: STORED,
+                }),
+        );
+    }
+    graph.buffer_mut(staging).write(&bytes)?;
+    frame.add_pass(
+        "upload_bricks".to_string(),
+        |b| {
+            b.transfer_src(staging).transfer_dst(pool);
+        },
+        move |pc| pc.copy_buffer_to_image_regions(staging, pool, &regions),
+    );
+    Ok(())
 }
 
 /// Max extinction per brick for the current TF: the largest LUT opacity over the

@@ -36,7 +36,7 @@ pub struct SceneSetup {
     /// The scene's render settings, with the spp override applied.
     pub settings: RenderSettings,
     pub config: RendererConfig,
-    pub volume: VolumeUpload,
+    pub volume: Arc<VolumeUpload>,
     pub environment: Option<EnvironmentUpload>,
     lut_a: TfLut,
     lut_b: Option<TfLut>,
@@ -72,7 +72,7 @@ impl SceneSetup {
         let lut_a = scene.tf_a.lut();
         let lut_b = scene.tf_b.as_ref().map(|b| b.lut());
         Ok(Self {
-            volume: VolumeUpload::from_volume(volume),
+            volume: Arc::new(VolumeUpload::from_volume(volume)),
             settings,
             config,
             environment,
@@ -93,7 +93,7 @@ impl SceneSetup {
             ctx,
             self.settings,
             self.config.clone(),
-            &self.volume,
+            self.volume.clone(),
             self.environment.as_ref(),
             denoisers,
             LUT_SIZE as u32,
@@ -167,6 +167,7 @@ pub fn renderer_config(scene: &Scene, size: Extent) -> RendererConfig {
             VolumeSource::Builtin { dataset, .. } => Some(dataset.name()),
             VolumeSource::File { .. } => None,
         },
+        gpu_memory: scene.render.gpu_memory(),
         ..Default::default()
     }
 }

@@ -76,6 +76,13 @@ pub struct RenderSettings {
     step_size: f64,
     /// Whether the TF's emissive colour is added (off compiles emission out).
     emission: bool,
+    /// Bytes the volume may take on the device ("512M", "2G" or a byte count); past it
+    /// the volume is paged through the brick pool. Unset: half the device-local heap.
+    #[serde(
+        deserialize_with = "de_memory_size",
+        serialize_with = "ser_memory_size"
+    )]
+    gpu_memory: Option<u64>,
     // Not in scene files: a scene's frames always draw seed 1's sample streams (eval's
     // baseline and tests pick others), and the pixel filter and feature threshold are
     // the renderer's, set by tests that need a pinhole or another surface.
@@ -113,10 +120,66 @@ impl Default for RenderSettings {
             russian_roulette_depth: 3,
             step_size: 0.5,
             emission: false,
+            gpu_memory: None,
             seed: 1,
             filter_sigma: 0.5,
             feature_threshold: 0.5,
         }
+    }
+}
+
+/// A memory size: a number with an optional binary suffix, `K`, `M`, `G` or `T`
+/// (`KiB`, `MB`, … and lower case are read the same: always powers of 1024), e.g. `512M`,
+/// `1.5G`, `1073741824`.
+pub fn parse_memory_size(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let scale: u64 = match unit
+        .trim()
+        .to_ascii_lowercase()
+        .trim_end_matches("ib")
+        .trim_end_matches('b')
+    {
+        "" => 1,
+        "k" => 1 << 10,
+        "m" => 1 << 20,
+        "g" => 1 << 30,
+        "t" => 1 << 40,
+        _ => return Err(format!("{s:?}: unknown unit {unit:?} (use K, M, G or T)")),
+    };
+    let value: f64 = num
+        .parse()
+        .map_err(|_| format!("{s:?} is not a memory size (e.g. 512M, 2G)"))?;
+    let bytes = value * scale as f64;
+    if !bytes.is_finite() || bytes < 1.0 || bytes > u64::MAX as f64 {
+        return Err(format!("{s:?} is not a memory size (e.g. 512M, 2G)"));
+    }
+    Ok(bytes as u64)
+}
+
+fn de_memory_size<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Size {
+        Bytes(u64),
+        Text(String),
+    }
+    match Option::<Size>::deserialize(d)? {
+        None => Ok(None),
+        Some(Size::Bytes(b)) => Ok(Some(b)),
+        Some(Size::Text(t)) => parse_memory_size(&t)
+            .map(Some)
+            .map_err(serde::de::Error::custom),
+    }
+}
+
+fn ser_memory_size<S: serde::Serializer>(v: &Option<u64>, s: S) -> Result<S::Ok, S::Error> {
+    match v {
+        Some(b) => s.serialize_u64(*b),
+        None => s.serialize_none(),
     }
 }
 
@@ -160,6 +223,19 @@ impl RenderSettings {
     }
     pub fn seed(&self) -> u32 {
         self.seed
+    }
+    pub fn gpu_memory(&self) -> Option<u64> {
+        self.gpu_memory
+    }
+    /// The volume's memory budget on the device (see [`parse_memory_size`]): at least
+    /// 1 MiB. Renderers read it when they are made (it is their
+    /// [`RendererConfig::gpu_memory`](crate::renderer::RendererConfig::gpu_memory)).
+    pub fn set_gpu_memory(&mut self, bytes: Option<u64>) -> Result<()> {
+        if let Some(b) = bytes {
+            allow("gpu_memory", b, b >= 1 << 20, "at least 1M (1 MiB)")?;
+        }
+        self.gpu_memory = bytes;
+        Ok(())
     }
     pub fn filter_sigma(&self) -> f64 {
         self.filter_sigma
@@ -284,6 +360,7 @@ impl RenderSettings {
             .and_then(|_| copy.set_step_size(self.step_size))
             .and_then(|_| copy.set_filter_sigma(self.filter_sigma))
             .and_then(|_| copy.set_feature_threshold(self.feature_threshold))
+            .and_then(|_| copy.set_gpu_memory(self.gpu_memory))
             .map_err(|e| match e {
                 EngineError::InvalidSetting {
                     name,
@@ -298,6 +375,18 @@ impl RenderSettings {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn memory_sizes_read_with_binary_units() {
+        assert_eq!(parse_memory_size("512M"), Ok(512 << 20));
+        assert_eq!(parse_memory_size("2G"), Ok(2 << 30));
+        assert_eq!(parse_memory_size("1.5GiB"), Ok(3 << 29));
+        assert_eq!(parse_memory_size("64 kb"), Ok(64 << 10));
+        assert_eq!(parse_memory_size("4096"), Ok(4096));
+        for bad in ["", "G", "-1G", "1X", "nanG", "0"] {
+            assert!(parse_memory_size(bad).is_err(), "{bad:?}");
+        }
+    }
 
     #[test]
     fn setters_refuse_values_out_of_range_and_keep_the_old_one() {

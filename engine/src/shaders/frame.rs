@@ -116,6 +116,8 @@ pub struct FrameParams<'a> {
     pub volume_dims: [u32; 3],
     /// Edge of a majorant-grid brick in voxels.
     pub brick: u32,
+    /// Edge of a brick-pool brick in voxels; 0 when the volume is one dense texture.
+    pub pool_brick: u32,
     /// At most [`MAX_LIGHTS`] (scenes and the renderer refuse more).
     pub lights: &'a [GpuLight],
     pub stream: SampleStream,
@@ -133,8 +135,8 @@ pub struct FrameParams<'a> {
 }
 
 impl FrameBlock {
-    /// Packs `p` into the lanes frame.glsl declares. Lanes no shader reads (`counts.z`,
-    /// `seeds.y`, `seeds.w`) are zero.
+    /// Packs `p` into the lanes frame.glsl declares. Lanes no shader reads (`seeds.y`,
+    /// `seeds.w`) are zero.
     pub fn new(p: &FrameParams) -> Self {
         let mut lights = [GpuLight::default(); MAX_LIGHTS];
         for (dst, src) in lights.iter_mut().zip(p.lights) {
@@ -152,7 +154,7 @@ impl FrameBlock {
             counts: IVec4::new(
                 p.lights.len().min(MAX_LIGHTS) as i32,
                 p.stream.index(),
-                0,
+                p.pool_brick as i32,
                 p.max_bounces as i32,
             ),
             params: Vec4::new(p.step, p.hg_g, p.feature_threshold, p.filter_sigma),
@@ -250,6 +252,7 @@ mod tests {
             majorant_max: 7.0,
             volume_dims: [8, 9, 10],
             brick: 4,
+            pool_brick: 0,
             lights: &[light],
             stream: SampleStream::Frame(5),
             max_bounces: 6,

@@ -10,12 +10,53 @@ layout(binding = 2) uniform sampler1D tf_diffuse_opacity;  // rgb albedo, a opac
 layout(binding = 3) uniform sampler1D tf_specular_roughness;
 layout(binding = 4) uniform sampler1D tf_emissive;
 layout(binding = 5) uniform sampler3D majorant_grid;       // max μt per brick (texelFetch)
+// The brick pool (engine/src/renderer/brick_pool.rs), read when frame.counts.z is set;
+// volume_density is then the coarse copy beneath it.
+layout(binding = 30) uniform sampler3D brick_pool;         // resident bricks with aprons
+layout(binding = 31) uniform sampler3D brick_table;        // per brick: slot, stand-in (texelFetch)
+
+#define POOL_BRICK 32
+#define POOL_APRON 2
+#define POOL_STORED (POOL_BRICK + 2 * POOL_APRON)
 
 vec3 box_size() { return frame.box_max.xyz - frame.box_min.xyz; }
 
 vec3 to_uvw(vec3 p) { return (p - frame.box_min.xyz) / box_size(); }
 
-float density_at(vec3 p) { return texture(volume_density, to_uvw(p)).r; }
+// Brick of `voxel` (voxel units, centres at i + 0.5).
+ivec3 pool_brick(vec3 voxel) {
+    return clamp(ivec3(floor(voxel / float(POOL_BRICK))), ivec3(0), textureSize(brick_table, 0) - 1);
+}
+
+// Density at `voxel` through brick `b` (its table entry: x the slot or −1, y the stand-in
+// density or −1 for the coarse copy): the slot's texels (the apron reaches 2 voxels past
+// the brick), the stand-in, or the coarse copy.
+float pool_density(vec3 voxel, ivec3 b, vec2 entry) {
+    if (entry.x < 0.0) {
+        return entry.y >= 0.0 ? entry.y : texture(volume_density, voxel / vec3(frame.dims.xyz)).r;
+    }
+    ivec3 pool = textureSize(brick_pool, 0);
+    int sx = pool.x / POOL_STORED;
+    int sy = pool.y / POOL_STORED;
+    int s = int(entry.x);
+    int z = s / (sx * sy);
+    int rest = s - z * sx * sy;
+    int y = rest / sx;
+    ivec3 origin = ivec3(rest - y * sx, y, z) * POOL_STORED;
+    vec3 t = vec3(origin) + (voxel - vec3(b * POOL_BRICK)) + float(POOL_APRON);
+    return texture(brick_pool, t / vec3(pool)).r;
+}
+
+bool pooled() { return frame.counts.z != 0; }
+
+float density_at(vec3 p) {
+    if (pooled()) {
+        vec3 voxel = to_uvw(p) * vec3(frame.dims.xyz);
+        ivec3 b = pool_brick(voxel);
+        return pool_density(voxel, b, texelFetch(brick_table, b, 0).xy);
+    }
+    return texture(volume_density, to_uvw(p)).r;
+}
 
 // LUT coordinate hitting texel centres: entry i is density i/(N-1).
 float lut_coord(float d) {
@@ -33,8 +74,18 @@ float extinction_at(vec3 p) {
 }
 
 // Central-difference gradient of density, in density per voxel.
+// Pooled, all six samples read the centre's brick, whose apron holds them.
 vec3 density_gradient(vec3 p) {
     vec3 h = box_size() / vec3(frame.dims.xyz);
+    if (pooled()) {
+        vec3 v = to_uvw(p) * vec3(frame.dims.xyz);
+        ivec3 b = pool_brick(v);
+        vec2 e = texelFetch(brick_table, b, 0).xy;
+        return 0.5 * vec3(
+            pool_density(v + vec3(1, 0, 0), b, e) - pool_density(v - vec3(1, 0, 0), b, e),
+            pool_density(v + vec3(0, 1, 0), b, e) - pool_density(v - vec3(0, 1, 0), b, e),
+            pool_density(v + vec3(0, 0, 1), b, e) - pool_density(v - vec3(0, 0, 1), b, e));
+    }
     return 0.5 * vec3(
         density_at(p + vec3(h.x, 0, 0)) - density_at(p - vec3(h.x, 0, 0)),
         density_at(p + vec3(0, h.y, 0)) - density_at(p - vec3(0, h.y, 0)),

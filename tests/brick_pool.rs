@@ -1,0 +1,221 @@
+//! The brick pool against the dense path, on a volume small enough for both: a budget
+//! below the dense texture pages it through the pool, and its frames must be the dense
+//! path's; a TF edit that makes hidden bricks visible must show them in the frame after
+//! the edit exactly as a renderer that started with that TF.
+//!
+//! Tolerance: a resident brick's samples are the dense texture's (same voxels, same
+//! clamping at the edge), but its texture coordinate is computed in the pool's texel
+//! space, so trilinear weights round differently in the last bits. Delta tracking
+//! compares a random number with the density, so a rare sample flips a decision and
+//! walks another path: a few pixels of a noisy frame differ, the rest are equal.
+
+mod common;
+
+use common::*;
+use dvr_engine::renderer::scene_gpu::{LutUpload, VolumeUpload};
+use dvr_engine::renderer::{FrameRequest, Renderer, VolumeResidency};
+use dvr_engine::volume::{Volume, VolumeData};
+use glam::Vec3;
+use std::sync::Arc;
+
+const N: u32 = 96;
+const SIZE: u32 = 48;
+
+/// Two blobs in a 96³ volume: a dense one (peak 1.0) in brick (1, 1, 1) and a faint one
+/// (peak 0.4) in brick (0, 1, 1); both fall to 0 more than a voxel inside their brick, so
+/// every other brick is empty (its range, apron included, is 0).
+fn two_blobs() -> VolumeUpload {
+    let blob = |p: [f32; 3], c: [f32; 3], peak: f32| {
+        let r = ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)).sqrt();
+        peak * (1.0 - r / 13.0).max(0.0).powi(2)
+    };
+    let mut data = Vec::with_capacity((N * N * N) as usize);
+    for z in 0..N {
+        for y in 0..N {
+            for x in 0..N {
+                let p = [x as f32 + 0.5, y as f32 + 0.5, z as f32 + 0.5];
+                let d = blob(p, [48.0, 48.0, 48.0], 1.0) + blob(p, [16.0, 48.0, 48.0], 0.4);
+                data.push((d.min(1.0) * 255.0).round() as u8);
+            }
+        }
+    }
+    VolumeUpload::from_volume(&Volume {
+        name: "two-blobs".into(),
+        dims: [N; 3],
+        spacing: [1.0; 3],
+        window: [0.0, 1.0],
+        data: VolumeData::U8(data),
+    })
+}
+
+/// Opaque, white, above `threshold`; transparent below.
+fn step_tf(threshold: f32) -> LutUpload {
+    let mut lut = constant_lut(0.0, 0.8);
+    for (i, e) in lut.diffuse_opacity.iter_mut().enumerate() {
+        if i as f32 / (LUT - 1) as f32 > threshold {
+            e[3] = 1.0;
+        }
+    }
+    lut
+}
+
+fn make(volume: &VolumeUpload, budget: Option<u64>, denoisers: &[&str]) -> Renderer {
+    let mut s = settings(SIZE, 1);
+    s.settings.set_max_bounces(2).expect("bounces");
+    s.config.gpu_memory = budget;
+    s.config.density_scale = 200.0;
+    Renderer::new(
+        context(),
+        s.settings,
+        s.config,
+        Arc::new(volume.clone()),
+        None,
+        denoisers,
+        LUT as u32,
+    )
+    .expect("renderer")
+}
+
+/// Renders one frame per TF in `tfs`; returns each frame's outputs by method name.
+fn run(r: &mut Renderer, tfs: &[LutUpload]) -> Vec<Vec<(String, Vec<[f32; 4]>)>> {
+    let camera = front_camera(2.2, 40.0);
+    let lights = vec![point_light(Vec3::new(0.8, 1.0, 1.5), 6.0), environment(0.3)];
+    let request = FrameRequest {
+        readback: true,
+        ..Default::default()
+    };
+    let mut results = Vec::new();
+    for lut in tfs {
+        let i = inputs(camera, lights.clone(), lut.clone());
+        results.extend(r.frame(&i, &request).expect("frame"));
+    }
+    results.extend(r.flush().expect("flush"));
+    results.sort_by_key(|f| f.index);
+    results.into_iter().map(|f| f.images).collect()
+}
+
+/// PSNR of `b` against `a` (values clamped to [0, 1]) and the share of pixels that
+/// differ by more than 1e-4.
+fn compare(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f64, f64) {
+    let clamp = |p: &[[f32; 4]]| {
+        p.iter()
+            .map(|x| x.map(|c| c.clamp(0.0, 1.0)))
+            .collect::<Vec<_>>()
+    };
+    let e = mse(&clamp(a), &clamp(b));
+    let differ = a
+        .iter()
+        .zip(b)
+        .filter(|(x, y)| (0..3).any(|c| (x[c] - y[c]).abs() > 1e-4))
+        .count();
+    (
+        10.0 * (1.0 / e.max(1e-20)).log10(),
+        differ as f64 / a.len() as f64,
+    )
+}
+
+fn assert_same(what: &str, a: &[[f32; 4]], b: &[[f32; 4]]) {
+    let (psnr, differ) = compare(a, b);
+    println!(
+        "{what}: {psnr:.1} dB, {:.2}% of pixels differ",
+        differ * 100.0
+    );
+    assert!(
+        psnr > 50.0 && differ < 0.02,
+        "{what}: {psnr:.1} dB, {:.2}% of pixels differ",
+        differ * 100.0
+    );
+}
+
+/// 200 KiB: below the dense texture's 864 KiB, room for a 24³ coarse copy and 4 slots.
+const BUDGET: u64 = 200 << 10;
+
+#[test]
+fn pooled_frames_equal_the_dense_path() {
+    let volume = two_blobs();
+    let tfs = vec![step_tf(0.1); 3];
+    let mut dense = make(&volume, None, &["none", "ours"]);
+    assert_eq!(dense.volume_residency(), VolumeResidency::Dense);
+    let want = run(&mut dense, &tfs);
+    drop(dense);
+    let mut pooled = make(&volume, Some(BUDGET), &["none", "ours"]);
+    let got = run(&mut pooled, &tfs);
+    match pooled.volume_residency() {
+        VolumeResidency::Pool {
+            layout,
+            visible,
+            resident,
+            pending,
+        } => {
+            assert_eq!(layout.grid, [3, 3, 3]);
+            assert_eq!(
+                (visible, resident, pending),
+                (2, 2, 0),
+                "both blobs' bricks resident"
+            );
+            assert!(layout.slot_count() >= 2 && layout.level >= 1, "{layout:?}");
+        }
+        VolumeResidency::Dense => panic!("a budget below the dense texture must page"),
+    }
+    for (f, (w, g)) in want.iter().zip(&got).enumerate() {
+        for ((name, a), (_, b)) in w.iter().zip(g) {
+            assert_same(&format!("frame {f} {name}"), a, b);
+        }
+    }
+    assert_validation_clean();
+}
+
+#[test]
+fn a_tf_edit_shows_the_bricks_it_reveals_in_the_next_frame() {
+    let volume = two_blobs();
+    // The faint blob (peak 0.4) is hidden by a threshold of 0.6 and revealed by 0.1.
+    let (hide, show) = (step_tf(0.6), step_tf(0.1));
+    let mut edited = make(&volume, Some(BUDGET), &["none"]);
+    let frames = run(&mut edited, &[hide.clone(), hide.clone(), show.clone()]);
+    let VolumeResidency::Pool {
+        visible, resident, ..
+    } = edited.volume_residency()
+    else {
+        panic!("pooled");
+    };
+    assert_eq!((visible, resident), (2, 2));
+    drop(edited);
+    let mut fresh = make(&volume, Some(BUDGET), &["none"]);
+    let want = run(&mut fresh, &[show.clone(), show.clone(), show]);
+    drop(fresh);
+    // The edit's frame draws the same random numbers as the fresh renderer's frame 2.
+    assert_same("frame after the edit", &want[2][0].1, &frames[2][0].1);
+    // The test can fail: the faint blob changes the frame (before the edit it is absent).
+    let (psnr, _) = compare(&frames[1][0].1, &frames[2][0].1);
+    let (hidden_psnr, _) = compare(&want[1][0].1, &frames[1][0].1);
+    println!("hidden vs shown: {psnr:.1} dB; frame 1 hidden vs shown: {hidden_psnr:.1} dB");
+    assert!(
+        hidden_psnr < 40.0,
+        "the faint blob must show: {hidden_psnr:.1} dB"
+    );
+    assert_validation_clean();
+}
+
+#[test]
+fn a_budget_too_small_for_one_brick_is_a_clear_error() {
+    let volume = two_blobs();
+    let mut s = settings(SIZE, 1);
+    s.config.gpu_memory = Some(20 << 10);
+    let err = match Renderer::new(
+        context(),
+        s.settings,
+        s.config,
+        Arc::new(volume),
+        None,
+        &["none"],
+        LUT as u32,
+    ) {
+        Ok(_) => panic!("20 KiB cannot hold a brick"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("two-blobs") && err.contains("no room for one"),
+        "{err}"
+    );
+    assert_validation_clean();
+}
