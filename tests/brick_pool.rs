@@ -219,3 +219,44 @@ fn a_budget_too_small_for_one_brick_is_a_clear_error() {
     );
     assert_validation_clean();
 }
+
+/// A volume made brick by brick on demand (`sparse`: its dense array never exists on the
+/// pool path) renders as the same volume held dense.
+#[test]
+fn a_volume_made_on_demand_pools_like_the_dense_volume() {
+    use dvr_engine::transfer::TransferFunction;
+    use dvr_engine::volume::sparse::Sparse;
+    let blocks = Arc::new(Sparse::new(256));
+    let on_demand = VolumeUpload::on_demand("sparse", blocks);
+    // The same voxels held dense, with the same (analytic, looser) majorant bounds: a
+    // different majorant draws different random numbers, and the frames would differ
+    // as two noise samples of one image do.
+    let dense = VolumeUpload {
+        bricks: on_demand.bricks.clone(),
+        ..VolumeUpload::from_volume(&Volume::builtin("sparse", 256).expect("sparse"))
+    };
+    assert_eq!(dense.bytes, on_demand.dense_bytes().as_ref());
+    let lut = LutUpload::from(&TransferFunction::preset("sparse").expect("preset").lut());
+    let tfs = vec![lut; 2];
+    let mut d = make(&dense, None, &["none"]);
+    let want = run(&mut d, &tfs);
+    drop(d);
+    // 12 MiB: below the 16 MiB dense texture.
+    let mut p = make(&on_demand, Some(12 << 20), &["none"]);
+    let got = run(&mut p, &tfs);
+    let VolumeResidency::Pool {
+        visible, resident, ..
+    } = p.volume_residency()
+    else {
+        panic!("pooled");
+    };
+    println!("{resident} of {visible} visible bricks resident");
+    assert!(
+        visible > 0 && resident == visible,
+        "{resident} of {visible}"
+    );
+    for (f, (w, g)) in want.iter().zip(&got).enumerate() {
+        assert_same(&format!("frame {f}"), &w[0].1, &g[0].1);
+    }
+    assert_validation_clean();
+}

@@ -142,6 +142,7 @@ fn a_volume_past_the_device_limits_is_paged_and_a_mis_sized_one_refused_before_a
         dims: [4096, 4096, 4096],
         format: VolumeFormat::R16,
         bytes: Vec::new(),
+        blocks: None,
         world_size: [1.0; 3],
         bricks: BrickRanges {
             brick: 8,

@@ -21,7 +21,7 @@ use anyhow::{Context, Result};
 use dvr_engine::files::Durability;
 use dvr_engine::image_io::{encode_exr, encode_png, read_exr, to_rgb, write_file};
 use dvr_engine::metrics::Rgb32Image;
-use dvr_engine::renderer::scene_setup::{load_environment, load_volume};
+use dvr_engine::renderer::scene_setup::{load_environment, load_volume, on_demand};
 use dvr_engine::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -76,15 +76,21 @@ fn content_hash(scene: &Scene, volume_size: u32) -> Result<String> {
     if let Some(b) = &scene.tf_b {
         h.write(b.to_toml().as_bytes());
     }
-    let volume = load_volume(scene, volume_size)
-        .with_context(|| format!("loading the volume of {}", scene.name))?;
-    for d in volume.dims {
-        h.write(&d.to_le_bytes());
+    // A volume made on demand is named by its generator and size (its voxels are made
+    // brick by brick and never held whole).
+    if let Some(v) = on_demand(scene, volume_size) {
+        h.write(v.identity().as_bytes());
+    } else {
+        let volume = load_volume(scene, volume_size)
+            .with_context(|| format!("loading the volume of {}", scene.name))?;
+        for d in volume.dims {
+            h.write(&d.to_le_bytes());
+        }
+        for x in volume.spacing.iter().chain(&volume.window) {
+            h.write(&x.to_le_bytes());
+        }
+        h.write(volume.data.as_bytes());
     }
-    for x in volume.spacing.iter().chain(&volume.window) {
-        h.write(&x.to_le_bytes());
-    }
-    h.write(volume.data.as_bytes());
     let environment = load_environment(&scene.lights)
         .with_context(|| format!("loading the environment map of {}", scene.name))?;
     if let Some(env) = environment {

@@ -35,7 +35,7 @@ use dvr_engine::gpu::{ContextOptions, GpuContext, Swapchain};
 use dvr_engine::graph::Extent;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png, PNG_EXPOSURE};
 use dvr_engine::passes::present::PresentLayout;
-use dvr_engine::renderer::scene_setup::{inputs_for, load_volume, SceneSetup};
+use dvr_engine::renderer::scene_setup::{inputs_for, load_volume, on_demand, SceneSetup};
 use dvr_engine::renderer::{
     FrameRequest, FrameResult, PresentTarget, Renderer, Screenshot, SettingsChange,
 };
@@ -123,15 +123,27 @@ pub fn run(args: ExploreArgs) -> Result<()> {
             raw: None,
         };
     }
-    let volume = load_volume(&scene, args.render.volume_size)?;
-    let histogram = volume.histogram(HISTOGRAM_BINS);
     let size = Extent {
         width: args.size.0,
         height: args.size.1,
     };
-    let mut setup = SceneSetup::with_volume(scene, &volume, size, args.render.spp)?;
+    // A volume made on demand has no dense array to count: the TF editor shows no
+    // histogram for it.
+    let (mut setup, histogram) = if on_demand(&scene, args.render.volume_size).is_some() {
+        let setup = SceneSetup::new(scene, size, args.render.spp, args.render.volume_size)?;
+        (setup, vec![0u32; HISTOGRAM_BINS])
+    } else {
+        let volume = load_volume(&scene, args.render.volume_size)?;
+        let histogram = volume.histogram(HISTOGRAM_BINS);
+        (
+            SceneSetup::with_volume(scene, &volume, size, args.render.spp)?,
+            histogram,
+        )
+    };
     setup.config.motion_source = args.render.motion;
-    drop(volume);
+    if let Some(bytes) = args.render.gpu_memory {
+        setup.config.gpu_memory = Some(bytes);
+    }
     let event_loop = EventLoop::new().map_err(|e| anyhow::anyhow!("{NO_DISPLAY} ({e})"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = Explorer::new(args, setup, &histogram, script, &names)?;

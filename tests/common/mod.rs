@@ -28,6 +28,7 @@ pub fn constant_volume(n: u32, d: f32) -> VolumeUpload {
         dims: [n, n, n],
         format: VolumeFormat::R8,
         bytes: vec![v; (n * n * n) as usize],
+        blocks: None,
         world_size: [1.0, 1.0, 1.0],
         bricks: BrickRanges {
             brick: n,

@@ -171,9 +171,12 @@ pub fn human_bytes(b: u64) -> String {
 /// Writes brick `b`'s stored texels (interior and apron, clamped to the volume's edge)
 /// into `out`, x fastest.
 pub fn write_brick(v: &VolumeUpload, b: [u32; 3], out: &mut [u8]) {
+    let origin = b.map(|c| (c * BRICK) as i64 - APRON as i64);
+    if let Some(blocks) = &v.blocks {
+        return blocks.fill(origin, [STORED; 3], out);
+    }
     let bpp = v.format.bytes();
     let [nx, ny, nz] = v.dims.map(|d| d as i64);
-    let origin = b.map(|c| (c * BRICK) as i64 - APRON as i64);
     let s = STORED as usize;
     let mut o = 0;
     for z in 0..s {
@@ -446,6 +449,7 @@ mod tests {
             dims,
             format: VolumeFormat::R8,
             bytes: bytes.clone(),
+            blocks: None,
             world_size: [1.0; 3],
             bricks: BrickRanges {
                 brick: 8,

@@ -6,9 +6,11 @@ use super::brick_pool::{self, Limits, PoolLayout, VolumePath, STORED};
 use crate::error::{EngineError, Result};
 use crate::gpu::{GpuContext, ImageDesc};
 use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
+use crate::volume::blocks::VoxelBlocks;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use std::borrow::Cow;
+use std::sync::Arc;
 
 /// Texel format of an uploaded volume.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,8 +54,10 @@ pub struct VolumeUpload {
     pub name: String,
     pub dims: [u32; 3],
     pub format: VolumeFormat,
-    /// Texel bytes, x fastest.
+    /// Texel bytes, x fastest; empty when `blocks` makes them.
     pub bytes: Vec<u8>,
+    /// A volume made block by block on demand (R16), whose dense bytes never exist.
+    pub blocks: Option<Arc<dyn VoxelBlocks>>,
     /// World-space size of the box (the volume is centred at the origin).
     pub world_size: [f32; 3],
     pub bricks: BrickRanges,
@@ -80,6 +84,7 @@ impl VolumeUpload {
             dims: v.dims,
             format,
             bytes: v.data.as_bytes().to_vec(),
+            blocks: None,
             world_size: extent.map(|e| e / longest),
             bricks: BrickRanges {
                 brick: grid.brick,
@@ -87,6 +92,44 @@ impl VolumeUpload {
                 min: grid.min,
                 max: grid.max,
             },
+        }
+    }
+}
+
+impl VolumeUpload {
+    /// A volume made on demand: 1-voxel spacing, world space as [`Self::from_volume`],
+    /// the majorant grid's bounds from the blocks' own.
+    pub fn on_demand(name: &str, blocks: Arc<dyn VoxelBlocks>) -> Self {
+        let dims = blocks.dims();
+        let longest = dims.iter().copied().max().unwrap_or(1).max(1) as f32;
+        let (min, max) = blocks.cell_bounds(Self::BRICK);
+        Self {
+            name: name.to_string(),
+            dims,
+            format: VolumeFormat::R16,
+            bytes: Vec::new(),
+            world_size: dims.map(|d| d as f32 / longest),
+            bricks: BrickRanges {
+                brick: Self::BRICK,
+                grid: dims.map(|d| d.div_ceil(Self::BRICK)),
+                min,
+                max,
+            },
+            blocks: Some(blocks),
+        }
+    }
+
+    /// The dense bytes: held, or made from the blocks (the dense path of a volume made on
+    /// demand, where the budget holds it).
+    pub fn dense_bytes(&self) -> Cow<'_, [u8]> {
+        match &self.blocks {
+            None => Cow::Borrowed(&self.bytes),
+            Some(b) => {
+                let texels: usize = self.dims.iter().map(|&d| d as usize).product();
+                let mut out = vec![0u8; texels * self.format.bytes()];
+                b.fill([0; 3], self.dims, &mut out);
+                Cow::Owned(out)
+            }
         }
     }
 }
@@ -205,7 +248,7 @@ pub fn check_volume_fits(
 ) -> Result<VolumePath> {
     let texels: u64 = v.dims.iter().map(|&d| d as u64).product();
     let needed = texels * v.format.bytes() as u64;
-    if needed != v.bytes.len() as u64 {
+    if v.blocks.is_none() && needed != v.bytes.len() as u64 {
         return Err(EngineError::Resource {
             resource: v.name.clone(),
             problem: format!(
@@ -254,20 +297,13 @@ pub fn create<'f>(
     // coarse copy, the pool (slots are written as the TF makes their bricks visible, and
     // read only through the table, which starts with no slot) and the table.
     let (volume_dims, volume_bytes, pool_extent, grid, no_slot) = match path {
-        VolumePath::Dense => (
-            volume.dims,
-            Cow::Borrowed(&volume.bytes[..]),
-            [1; 3],
-            [1; 3],
-            0.0,
-        ),
+        VolumePath::Dense => (volume.dims, volume.dense_bytes(), [1; 3], [1; 3], 0.0),
         VolumePath::Pool(layout) => (
             layout.coarse_dims,
-            Cow::Owned(brick_pool::coarse_copy(
-                volume,
-                layout.level,
-                layout.coarse_dims,
-            )),
+            Cow::Owned(match &volume.blocks {
+                Some(b) => b.coarse(layout.level, layout.coarse_dims),
+                None => brick_pool::coarse_copy(volume, layout.level, layout.coarse_dims),
+            }),
             layout.pool_extent(),
             layout.grid,
             -1.0,

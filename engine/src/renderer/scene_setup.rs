@@ -10,9 +10,12 @@ use crate::error::{EngineError, Result as EngineResult};
 use crate::gpu::GpuContext;
 use crate::graph::Extent;
 use crate::image_io::ImageIoError;
+use crate::scene::BuiltinVolume;
 use crate::scene::{Camera, EnvSource, Light, RenderSettings, Scene, VolumeSource};
 use crate::shaders::frame::{self, GpuLight};
 use crate::transfer::{TfLut, LUT_SIZE};
+use crate::volume::blocks::VoxelBlocks;
+use crate::volume::sparse::Sparse;
 use crate::volume::{RawParams, Volume, VolumeError};
 use glam::{Vec3, Vec4};
 use std::sync::Arc;
@@ -51,8 +54,11 @@ impl SceneSetup {
         spp: Option<u32>,
         volume_size: u32,
     ) -> Result<Self, SetupError> {
-        let volume = load_volume(&scene, volume_size)?;
-        Self::with_volume(scene, &volume, size, spp)
+        let upload = match on_demand(&scene, volume_size) {
+            Some(blocks) => VolumeUpload::on_demand(blocks.name(), blocks.into_blocks()),
+            None => VolumeUpload::from_volume(&load_volume(&scene, volume_size)?),
+        };
+        Self::with_upload(scene, upload, size, spp)
     }
 
     /// [`SceneSetup::new`] with the volume already loaded (the explorer also draws its
@@ -60,6 +66,15 @@ impl SceneSetup {
     pub fn with_volume(
         scene: Scene,
         volume: &Volume,
+        size: Extent,
+        spp: Option<u32>,
+    ) -> Result<Self, SetupError> {
+        Self::with_upload(scene, VolumeUpload::from_volume(volume), size, spp)
+    }
+
+    fn with_upload(
+        scene: Scene,
+        volume: VolumeUpload,
         size: Extent,
         spp: Option<u32>,
     ) -> Result<Self, SetupError> {
@@ -72,7 +87,7 @@ impl SceneSetup {
         let lut_a = scene.tf_a.lut();
         let lut_b = scene.tf_b.as_ref().map(|b| b.lut());
         Ok(Self {
-            volume: Arc::new(VolumeUpload::from_volume(volume)),
+            volume: Arc::new(volume),
             settings,
             config,
             environment,
@@ -139,6 +154,45 @@ pub fn inputs_for(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -
 /// Edge length of procedural volumes (phantom, cloud) when neither the scene nor the
 /// caller gives one: the CLI's `--volume-size` default and the Python package's.
 pub const DEFAULT_VOLUME_SIZE: u32 = 128;
+
+/// A scene volume made brick by brick on demand (the `sparse` dataset), which only the
+/// renderer's upload holds: its dense array is never made.
+pub enum OnDemand {
+    Sparse(u32, Arc<Sparse>),
+}
+
+impl OnDemand {
+    pub fn name(&self) -> &'static str {
+        match self {
+            OnDemand::Sparse(..) => "sparse",
+        }
+    }
+    /// What identifies its voxels (a reference cache key): the generator and its size.
+    pub fn identity(&self) -> String {
+        match self {
+            OnDemand::Sparse(n, _) => format!("sparse v1 {n}"),
+        }
+    }
+    pub fn into_blocks(self) -> Arc<dyn VoxelBlocks> {
+        match self {
+            OnDemand::Sparse(_, s) => s,
+        }
+    }
+}
+
+/// The scene's volume when it is made on demand (see [`OnDemand`]).
+pub fn on_demand(scene: &Scene, volume_size: u32) -> Option<OnDemand> {
+    match &scene.volume.source {
+        VolumeSource::Builtin {
+            dataset: BuiltinVolume::Sparse,
+            size,
+        } => {
+            let n = size.unwrap_or(volume_size);
+            Some(OnDemand::Sparse(n, Arc::new(Sparse::new(n))))
+        }
+        _ => None,
+    }
+}
 
 /// The scene's volume: a built-in dataset or a file.
 pub fn load_volume(scene: &Scene, volume_size: u32) -> Result<Volume, VolumeError> {

@@ -88,8 +88,9 @@ fn look(dataset: BuiltinVolume) -> Look {
             max_bounces: 4,
             sweep: (-0.12, 0.18),
         },
-        // Albedo ~0.97: light survives many scattering events.
-        BuiltinVolume::Cloud => Look {
+        // Albedo ~0.97: light survives many scattering events. (`sparse` is in no
+        // built-in scene; a scene file that names it takes this look's defaults.)
+        BuiltinVolume::Cloud | BuiltinVolume::Sparse => Look {
             density_scale: 20.0,
             tf_a: "cloud",
             tf_b: "cloud-edit",

@@ -34,6 +34,9 @@ pub enum BuiltinVolume {
     Mri,
     /// A homogeneous semi-transparent shape (procedural, density 0.5 inside).
     Cloud,
+    /// Blobs and tubes in a mostly empty N×N×N/2 box (procedural, U16, made brick by
+    /// brick on demand): for the brick pool's large volumes. No built-in scene uses it.
+    Sparse,
 }
 
 impl BuiltinVolume {
@@ -46,6 +49,7 @@ impl BuiltinVolume {
             Self::Phantom => "phantom",
             Self::Mri => "mri",
             Self::Cloud => "cloud",
+            Self::Sparse => "sparse",
         }
     }
 }
@@ -167,7 +171,7 @@ impl VolumeFile {
                 }
                 (None, None) => return Err(ctx.invalid(
                     "volume",
-                    "missing `builtin = \"phantom\" | \"mri\" | \"cloud\"` or `file = \"path\"`",
+                    "missing `builtin = \"phantom\" | \"mri\" | \"cloud\" | \"sparse\"` or `file = \"path\"`",
                 )),
                 (Some(dataset), None) => {
                     for (field, given) in [

@@ -2,12 +2,13 @@
 
 use std::path::Path;
 
+use super::blocks::VoxelBlocks;
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
 use super::{cloud, phantom, validate_dims, Volume};
 
 /// Names accepted by [`Volume::builtin`].
-pub const BUILTIN_NAMES: [&str; 3] = ["phantom", "cloud", "mri"];
+pub const BUILTIN_NAMES: [&str; 4] = ["phantom", "cloud", "mri", "sparse"];
 
 pub(crate) fn build(name: &str, size: u32) -> Result<Volume, VolumeError> {
     let procedural = |size: u32| validate_dims(Path::new(name), [i64::from(size); 3]);
@@ -20,6 +21,12 @@ pub(crate) fn build(name: &str, size: u32) -> Result<Volume, VolumeError> {
         "cloud" => {
             let dims = procedural(size)?;
             let stored = Stored::plain(Samples::U8(cloud::generate(size)));
+            Volume::from_stored(Path::new(name), name.into(), dims, [1.0; 3], stored)
+        }
+        "sparse" => {
+            let v = super::sparse::Sparse::new(size);
+            let dims = validate_dims(Path::new(name), v.dims().map(i64::from))?;
+            let stored = Stored::plain(Samples::U16(v.dense()));
             Volume::from_stored(Path::new(name), name.into(), dims, [1.0; 3], stored)
         }
         "mri" => {

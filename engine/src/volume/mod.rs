@@ -44,6 +44,7 @@
 //! GPUs this engine targets; Vulkan itself guarantees only 256 (`maxImageDimension3D`),
 //! so the GPU layer still checks the device's limit before uploading.
 
+pub mod blocks;
 mod builtin;
 mod cloud;
 mod dicom;
@@ -58,6 +59,7 @@ mod phantom;
 mod procedural;
 mod raw;
 mod samples;
+pub mod sparse;
 #[cfg(test)]
 mod write;
 mod zarr;
