@@ -73,7 +73,7 @@ pub struct RenderArgs {
     /// Bytes the volume may take on the device, e.g. `512M`, `2G` (default: the scene's
     /// `[render] gpu_memory`, else half the device-local heap). A volume past it is paged
     /// through a brick pool of the bricks the TF makes visible.
-    #[arg(long, value_parser = setup::parse_gpu_memory)]
+    #[arg(long, value_parser = dvr_engine::scene::parse_gpu_memory)]
     pub gpu_memory: Option<u64>,
 }
 

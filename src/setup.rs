@@ -180,16 +180,6 @@ pub fn create_out_dir(out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))
 }
 
-/// `--gpu-memory`: a memory size of at least 1 MiB.
-pub fn parse_gpu_memory(s: &str) -> Result<u64, String> {
-    let bytes = dvr_engine::scene::parse_memory_size(s)?;
-    let mut settings = dvr_engine::scene::RenderSettings::default();
-    settings
-        .set_gpu_memory(Some(bytes))
-        .map_err(|e| e.to_string())?;
-    Ok(bytes)
-}
-
 /// A scene opened from the command line, made ready for rendering.
 pub struct Setup {
     pub name: String,

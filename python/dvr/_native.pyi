@@ -44,6 +44,7 @@ class Renderer:
         spp: Optional[int] = None,
         motion: str = "features",
         device: Optional[str] = None,
+        gpu_memory: Optional[str] = None,
     ) -> None: ...
     def render(
         self, frame: Optional[int] = None, reset: bool = False, aux: bool = False, features: bool = False
@@ -56,6 +57,8 @@ class Renderer:
     def denoisers(self) -> list[str]: ...
     @property
     def device(self) -> str: ...
+    @property
+    def volume_residency(self) -> str: ...
     @property
     def spp(self) -> int: ...
     @property

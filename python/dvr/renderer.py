@@ -21,9 +21,16 @@ class Renderer:
     ``device`` picks the Vulkan device by a substring of its name; by default it is the
     one the CLI picks (a discrete GPU first; ``DVR_DEVICE`` forces one). Without a
     Vulkan device, or with none of that name, this raises ``RuntimeError``.
+
+    ``gpu_memory`` (``"512M"``, ``"2G"``, a byte count as a string) is the volume's
+    budget on the device, as the CLI's ``--gpu-memory``: past it the volume is paged
+    through the brick pool (:attr:`volume_residency` says how it is held).
     """
 
-    def __init__(self, scene: Scene, size=(128, 128), spp=None, denoisers=("ours",), motion="features", device=None):
+    def __init__(
+        self, scene: Scene, size=(128, 128), spp=None, denoisers=("ours",), motion="features", device=None,
+        gpu_memory=None,
+    ):
         if isinstance(scene, str):
             scene = Scene.builtin(scene) if scene in _native.builtin_scene_names() else Scene.load(scene)
         if isinstance(denoisers, str):
@@ -35,7 +42,7 @@ class Renderer:
         tf = scene.tf.to_dict() if getattr(scene, "tf", None) is not None else None
         self._r = _native.Renderer(
             scene._engine_dict(), size, list(denoisers), volume=scene.volume, tf=tf, spp=spp, motion=motion,
-            device=device,
+            device=device, gpu_memory=None if gpu_memory is None else str(gpu_memory),
         )
 
     def render(self, frame=None, reset=False, aux=False, features=False) -> dict:
@@ -71,6 +78,13 @@ class Renderer:
     @property
     def device(self) -> str:
         return self._r.device
+
+    @property
+    def volume_residency(self) -> str:
+        """``"dense volume"``, or the brick pool's ``"brick pool: R of V visible bricks
+        resident (S slots of 32³), coarse level L (dims)"`` (visible under the TF of the
+        last rendered frame; 0 of 0 before the first)."""
+        return self._r.volume_residency
 
     @property
     def spp(self) -> int:

@@ -12,6 +12,7 @@ use dvr_engine::graph::Extent;
 use dvr_engine::passes::aux_features::{ALBEDO, NORMAL};
 use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup, DEFAULT_VOLUME_SIZE};
 use dvr_engine::renderer::{FrameRequest, FrameResult, Renderer as EngineRenderer, FEATURE_IMAGES};
+use dvr_engine::scene::parse_gpu_memory;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -64,9 +65,10 @@ impl Renderer {
     /// A renderer for `scene` (a scene dict, see `dvr.Scene`) at `size` = (width,
     /// height). `volume` replaces the scene's `[volume]` source (its density scale
     /// stays), `tf` its `transfer.a`; `spp` overrides the scene's samples per frame;
-    /// `device` picks the Vulkan device by a substring of its name.
+    /// `device` picks the Vulkan device by a substring of its name; `gpu_memory` ("512M",
+    /// "2G", a byte count) is the volume's budget on it, past which it is paged.
     #[new]
-    #[pyo3(signature = (scene, size, denoisers, volume = None, tf = None, spp = None, motion = "features", device = None))]
+    #[pyo3(signature = (scene, size, denoisers, volume = None, tf = None, spp = None, motion = "features", device = None, gpu_memory = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
@@ -78,6 +80,7 @@ impl Renderer {
         spp: Option<u32>,
         motion: &str,
         device: Option<String>,
+        gpu_memory: Option<String>,
     ) -> PyResult<Self> {
         let mut scene = scene_from_dict(scene, "scene")?;
         if let Some(tf) = tf {
@@ -90,6 +93,9 @@ impl Renderer {
             )));
         }
         let motion = motion.parse().map_err(value_error)?;
+        let gpu_memory = gpu_memory
+            .map(|s| parse_gpu_memory(&s).map_err(|e| value_error(format!("gpu_memory: {e}"))))
+            .transpose()?;
         // The noisy input comes back through the pass-through method, first.
         let mut names: Vec<&str> = vec![NOISY_METHOD];
         names.extend(
@@ -120,6 +126,9 @@ impl Renderer {
             )
             .map_err(value_error)?;
             setup.config.motion_source = motion;
+            if gpu_memory.is_some() {
+                setup.config.gpu_memory = gpu_memory;
+            }
             if custom {
                 // The trained RAE networks are per dataset; an array is none of them.
                 setup.config.dataset = None;
@@ -274,6 +283,13 @@ impl Renderer {
     #[getter]
     fn device(&self) -> String {
         self.inner.0.renderer.ctx().info.name.clone()
+    }
+
+    /// How the volume is held on the device: "dense volume", or the brick pool's
+    /// residency ("brick pool: R of V visible bricks resident …").
+    #[getter]
+    fn volume_residency(&self) -> String {
+        self.inner.0.renderer.volume_residency().to_string()
     }
 
     /// Samples per pixel per frame.

@@ -214,3 +214,25 @@ def test_surface_features_come_back_with_a_frame():
     # Positions lie inside the volume's box (longest side 1, centred on the origin).
     assert (np.abs(f["position"][met][:, :3]) <= 0.5 + 1e-3).all()
     assert "features" not in r.render()
+
+
+def test_a_volume_past_its_budget_is_paged_and_renders_the_same_frames():
+    # A blob in one 32³ brick of a 96³ array (864 KiB as uint8): under a 200 KiB budget
+    # only that brick is resident, and the frames are the dense path's.
+    z, y, x = np.mgrid[0:96, 0:96, 0:96].astype(np.float32) + 0.5
+    r2 = ((x - 48) ** 2 + (y - 48) ** 2 + (z - 48) ** 2) / 13.0**2
+    blob = (255 * np.clip(1 - np.sqrt(r2), 0, 1) ** 2).astype(np.uint8)
+    tf = dvr.TransferFunction.from_array([[0.0, 0.9, 0.8, 0.7, 0.0], [0.1, 0.9, 0.8, 0.7, 0.0], [1.0, 0.9, 0.8, 0.7, 1.0]])
+    scene = dvr.Scene(dvr.Volume(blob), tf=tf, frames=2, density_scale=200.0)
+    dense = dvr.Renderer(scene, size=(24, 24), denoisers=["none"], spp=1)
+    pooled = dvr.Renderer(scene, size=(24, 24), denoisers=["none"], spp=1, gpu_memory="200K")
+    for _ in range(2):
+        a, b = dense.render(), pooled.render()
+        assert np.abs(a["noisy"] - b["noisy"]).max() < 1e-4
+    assert a["noisy"].max() > 0
+    assert dense.volume_residency == "dense volume"
+    assert pooled.volume_residency.startswith("brick pool: 1 of 1 visible bricks resident"), pooled.volume_residency
+    with pytest.raises(ValueError, match="gpu_memory"):
+        dvr.Renderer(scene, size=(8, 8), gpu_memory="lots")
+    with pytest.raises(ValueError, match="at least 64K"):
+        dvr.Renderer(scene, size=(8, 8), gpu_memory="20K")

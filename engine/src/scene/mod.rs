@@ -58,7 +58,9 @@ pub use frame::{changed, Change, FrameState};
 pub use light::{
     AreaLight, EnvMode, EnvSource, EnvironmentLight, Facing, Light, LightKind, PointLight,
 };
-pub use render::{parse_memory_size, Estimator, Phase, PipelineKey, RenderSettings, MAX_BOUNCES};
+pub use render::{
+    parse_gpu_memory, parse_memory_size, Estimator, Phase, PipelineKey, RenderSettings, MAX_BOUNCES,
+};
 pub use transfer_ref::TransferSpec;
 pub use volume::{BuiltinVolume, RawLayout, VolumeSource, VolumeSpec};
 

@@ -137,6 +137,10 @@ pub fn parse_memory_size(s: &str) -> Result<u64, String> {
         .find(|c: char| !(c.is_ascii_digit() || c == '.'))
         .unwrap_or(t.len());
     let (num, unit) = t.split_at(split);
+    let not_a_size = || format!("{s:?} is not a memory size (e.g. 512M, 2G)");
+    if num.is_empty() {
+        return Err(not_a_size());
+    }
     let scale: u64 = match unit
         .trim()
         .to_ascii_lowercase()
@@ -150,14 +154,22 @@ pub fn parse_memory_size(s: &str) -> Result<u64, String> {
         "t" => 1 << 40,
         _ => return Err(format!("{s:?}: unknown unit {unit:?} (use K, M, G or T)")),
     };
-    let value: f64 = num
-        .parse()
-        .map_err(|_| format!("{s:?} is not a memory size (e.g. 512M, 2G)"))?;
+    let value: f64 = num.parse().map_err(|_| not_a_size())?;
     let bytes = value * scale as f64;
     if !bytes.is_finite() || bytes < 1.0 || bytes > u64::MAX as f64 {
-        return Err(format!("{s:?} is not a memory size (e.g. 512M, 2G)"));
+        return Err(not_a_size());
     }
     Ok(bytes as u64)
+}
+
+/// A memory budget as `--gpu-memory` and `gpu_memory=` take it: [`parse_memory_size`],
+/// then the range [`RenderSettings::set_gpu_memory`] allows.
+pub fn parse_gpu_memory(s: &str) -> Result<u64, String> {
+    let bytes = parse_memory_size(s)?;
+    RenderSettings::default()
+        .set_gpu_memory(Some(bytes))
+        .map_err(|e| e.to_string())?;
+    Ok(bytes)
 }
 
 fn de_memory_size<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
@@ -228,11 +240,16 @@ impl RenderSettings {
         self.gpu_memory
     }
     /// The volume's memory budget on the device (see [`parse_memory_size`]): at least
-    /// 1 MiB. Renderers read it when they are made (it is their
+    /// 64 KiB (one 8-bit brick and a little more). Renderers read it when they are made (it is their
     /// [`RendererConfig::gpu_memory`](crate::renderer::RendererConfig::gpu_memory)).
     pub fn set_gpu_memory(&mut self, bytes: Option<u64>) -> Result<()> {
         if let Some(b) = bytes {
-            allow("gpu_memory", b, b >= 1 << 20, "at least 1M (1 MiB)")?;
+            allow(
+                "gpu_memory",
+                b,
+                b >= 64 << 10,
+                "at least 64K (64 KiB: one 8-bit brick)",
+            )?;
         }
         self.gpu_memory = bytes;
         Ok(())

@@ -414,6 +414,8 @@ fn errors_name_the_file_and_the_field() {
         ("[render]", "[camera]\nposition = [0, 0, 2]\n[render]", "bad.toml: camera.up:"),
         ("[render]", "[camera]\nposition = [0, 2, 0]\nfov_y_degrees = 180\n[render]", "bad.toml: camera.fov_y_degrees:"),
         ("spp = 2", "hg_g = 1.0", "bad.toml: render.hg_g:"),
+        ("spp = 2", "gpu_memory = \"lots\"", "bad.toml|gpu_memory|memory size"),
+        ("spp = 2", "gpu_memory = \"16K\"", "bad.toml: render.gpu_memory:|at least 64K"),
         ("[volume]", "[volume\n", "bad.toml|line 2"),
     ];
     for (from, to, want) in cases {
@@ -427,6 +429,23 @@ fn errors_name_the_file_and_the_field() {
             assert!(e.contains(w), "error for `{to}` lacks `{w}`:\n{e}");
         }
     }
+}
+
+#[test]
+fn a_memory_budget_reads_from_the_render_section() {
+    let s = Scene::from_toml_str(
+        &MINIMAL.replace("spp = 2", "gpu_memory = \"512M\""),
+        "m.toml",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.render.gpu_memory(), Some(512 << 20));
+    let s = Scene::from_toml_str(
+        &MINIMAL.replace("spp = 2", "gpu_memory = 1048576"),
+        "m.toml",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.render.gpu_memory(), Some(1 << 20));
+    assert_eq!(builtin("phantom/orbit").render.gpu_memory(), None);
 }
 
 #[test]
