@@ -77,6 +77,17 @@ pub struct RenderArgs {
     pub gpu_memory: Option<u64>,
 }
 
+impl RenderArgs {
+    /// `--gpu-memory` into the scene's render settings, where the renderer and the
+    /// OME-Zarr level choice read it.
+    pub fn apply_budget(&self, scene: &mut dvr_engine::scene::Scene) -> anyhow::Result<()> {
+        if let Some(bytes) = self.gpu_memory {
+            scene.render.set_gpu_memory(Some(bytes))?;
+        }
+        Ok(())
+    }
+}
+
 impl Default for RenderArgs {
     fn default() -> Self {
         Self {

@@ -198,11 +198,9 @@ impl Setup {
             width: args.size.0,
             height: args.size.1,
         };
+        args.render.apply_budget(&mut scene)?;
         let mut inner = SceneSetup::new(scene, size, args.render.spp, args.render.volume_size)?;
         inner.config.motion_source = args.render.motion;
-        if let Some(bytes) = args.render.gpu_memory {
-            inner.config.gpu_memory = Some(bytes);
-        }
         Ok(Self {
             name: inner.scene.name.clone(),
             frames: inner.scene.frames,

@@ -6,6 +6,7 @@
 //! them; `assets` says where the shipped files are.
 
 pub mod assets;
+pub mod bytes;
 pub mod denoise;
 pub mod error;
 pub mod files;

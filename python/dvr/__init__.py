@@ -42,9 +42,10 @@ __all__ = [
 ]
 
 
-def load_volume(path) -> Volume:
+def load_volume(path, gpu_memory=None) -> Volume:
     """Load a volume file as the CLI does: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr),
     DICOM (a folder or a .dcm file), OME-Zarr (an image folder: its finest level that
-    fits one texture; or one level's folder inside it) or raw data with a
-    ``<file>.json``/``.toml`` sidecar."""
-    return Volume.load(str(path))
+    a volume in memory holds and, with ``gpu_memory`` ("512M"), that fits that budget;
+    or one level's folder inside it) or raw data with a ``<file>.json``/``.toml``
+    sidecar."""
+    return Volume.load(str(path), None if gpu_memory is None else str(gpu_memory))

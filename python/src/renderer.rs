@@ -93,9 +93,14 @@ impl Renderer {
             )));
         }
         let motion = motion.parse().map_err(value_error)?;
-        let gpu_memory = gpu_memory
-            .map(|s| parse_gpu_memory(&s).map_err(|e| value_error(format!("gpu_memory: {e}"))))
-            .transpose()?;
+        if let Some(s) = gpu_memory {
+            let bytes =
+                parse_gpu_memory(&s).map_err(|e| value_error(format!("gpu_memory: {e}")))?;
+            scene
+                .render
+                .set_gpu_memory(Some(bytes))
+                .map_err(value_error)?;
+        }
         // The noisy input comes back through the pass-through method, first.
         let mut names: Vec<&str> = vec![NOISY_METHOD];
         names.extend(
@@ -126,9 +131,6 @@ impl Renderer {
             )
             .map_err(value_error)?;
             setup.config.motion_source = motion;
-            if gpu_memory.is_some() {
-                setup.config.gpu_memory = gpu_memory;
-            }
             if custom {
                 // The trained RAE networks are per dataset; an array is none of them.
                 setup.config.dataset = None;

@@ -5,6 +5,7 @@
 
 use crate::convert::value_error;
 use dvr_engine::renderer::scene_setup::DEFAULT_VOLUME_SIZE;
+use dvr_engine::scene::parse_gpu_memory;
 use dvr_engine::volume::{Volume as EngineVolume, VolumeData, Voxels};
 use numpy::{PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -88,16 +89,22 @@ impl Volume {
 
     /// Loads a volume file: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), DICOM (a folder or
     /// a .dcm file) or raw data with a `<file>.json`/`.toml` sidecar, as the CLI does.
+    /// `gpu_memory` ("512M"): of an OME-Zarr image's levels, the finest that fits it.
     #[staticmethod]
-    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+    #[pyo3(signature = (path, gpu_memory = None))]
+    fn load(py: Python<'_>, path: PathBuf, gpu_memory: Option<String>) -> PyResult<Self> {
+        let budget = gpu_memory
+            .map(|s| parse_gpu_memory(&s).map_err(|e| value_error(format!("gpu_memory: {e}"))))
+            .transpose()?;
         let inner = py
-            .detach(|| EngineVolume::load(&path, None))
+            .detach(|| EngineVolume::load_within(&path, None, budget))
             .map_err(value_error)?;
         Ok(Self { inner })
     }
 
     /// A built-in dataset: `phantom` (CT-like head), `cloud` (a homogeneous medium),
-    /// both `size`³, or `mri` (the bundled MNI152 T1; `size` is ignored).
+    /// both `size`³, `sparse` (blobs and tubes, size×size×size/2, held dense here) or
+    /// `mri` (the bundled MNI152 T1; `size` is ignored).
     #[staticmethod]
     #[pyo3(signature = (name, size = DEFAULT_VOLUME_SIZE))]
     fn builtin(py: Python<'_>, name: &str, size: u32) -> PyResult<Self> {

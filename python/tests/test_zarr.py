@@ -136,3 +136,16 @@ def test_bad_metadata_missing_chunks_and_unknown_codecs_are_named(tmp_path):
     chunk.write_bytes(chunk.read_bytes()[:5])
     with pytest.raises(ValueError, match=r"cut\.zarr"):
         dvr.load_volume(cut / "s0")
+
+
+def test_the_finest_level_within_the_memory_budget_is_read(tmp_path):
+    """With a budget (the renderer's --gpu-memory), the finest level whose voxels fit it
+    is read; with none fitting, the coarsest (the renderer pages it)."""
+    data = image((64, 128, 128))  # uint16: 2 MiB, then 256 KiB and 32 KiB
+    path = write(tmp_path / "img.zarr", "0.5", data)
+    assert dvr.load_volume(path).shape == (64, 128, 128)
+    assert dvr.load_volume(path, gpu_memory="2M").shape == (64, 128, 128)
+    assert dvr.load_volume(path, gpu_memory="1M").shape == (32, 64, 64)
+    assert dvr.load_volume(path, gpu_memory="64K").shape == (16, 32, 32)
+    with pytest.raises(ValueError, match="gpu_memory"):
+        dvr.load_volume(path, gpu_memory="lots")

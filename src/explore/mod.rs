@@ -123,6 +123,7 @@ pub fn run(args: ExploreArgs) -> Result<()> {
             raw: None,
         };
     }
+    args.render.apply_budget(&mut scene)?;
     let size = Extent {
         width: args.size.0,
         height: args.size.1,
@@ -141,9 +142,6 @@ pub fn run(args: ExploreArgs) -> Result<()> {
         )
     };
     setup.config.motion_source = args.render.motion;
-    if let Some(bytes) = args.render.gpu_memory {
-        setup.config.gpu_memory = Some(bytes);
-    }
     let event_loop = EventLoop::new().map_err(|e| anyhow::anyhow!("{NO_DISPLAY} ({e})"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = Explorer::new(args, setup, &histogram, script, &names)?;

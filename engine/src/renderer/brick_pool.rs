@@ -14,6 +14,7 @@
 //! dense texture's, up to the rounding of a different texture coordinate.
 
 use super::scene_gpu::{BrickRanges, VolumeFormat, VolumeUpload};
+use crate::bytes::human_bytes;
 
 /// Interior edge of a pool brick in voxels: a multiple of the majorant grid's brick, so a
 /// majorant cell never straddles two pool bricks (`POOL_BRICK` in include/volume.glsl).
@@ -150,22 +151,6 @@ pub fn plan(dims: [u32; 3], format: VolumeFormat, limits: &Limits) -> Result<Vol
         level,
         coarse_dims,
     }))
-}
-
-/// `1.5 GiB`, `512 MiB`, `36 KiB`.
-pub fn human_bytes(b: u64) -> String {
-    const UNITS: [(&str, u64); 3] = [("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)];
-    for (name, size) in UNITS {
-        if b >= size {
-            let v = b as f64 / size as f64;
-            return if v.fract() == 0.0 {
-                format!("{v:.0} {name}")
-            } else {
-                format!("{v:.1} {name}")
-            };
-        }
-    }
-    format!("{b} B")
 }
 
 /// Writes brick `b`'s stored texels (interior and apron, clamped to the volume's edge)

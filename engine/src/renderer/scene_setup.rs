@@ -206,7 +206,7 @@ pub fn load_volume(scene: &Scene, volume_size: u32) -> Result<Volume, VolumeErro
                 format: r.format,
                 spacing: r.spacing.map(|s| s as f32),
             });
-            Volume::load(path, params.as_ref())
+            Volume::load_within(path, params.as_ref(), scene.render.gpu_memory())
         }
     }
 }

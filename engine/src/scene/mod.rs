@@ -51,6 +51,7 @@ mod tests;
 
 use std::path::Path;
 
+pub use crate::bytes::parse_memory_size;
 pub use animation::{Animation, CameraKey, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES};
 pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR};
 pub use error::SceneError;
@@ -58,9 +59,7 @@ pub use frame::{changed, Change, FrameState};
 pub use light::{
     AreaLight, EnvMode, EnvSource, EnvironmentLight, Facing, Light, LightKind, PointLight,
 };
-pub use render::{
-    parse_gpu_memory, parse_memory_size, Estimator, Phase, PipelineKey, RenderSettings, MAX_BOUNCES,
-};
+pub use render::{parse_gpu_memory, Estimator, Phase, PipelineKey, RenderSettings, MAX_BOUNCES};
 pub use transfer_ref::TransferSpec;
 pub use volume::{BuiltinVolume, RawLayout, VolumeSource, VolumeSpec};
 

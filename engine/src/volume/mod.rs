@@ -198,11 +198,21 @@ impl Volume {
     /// `.nii`/`.nii.gz` -> NIfTI-1; `.tif`/`.tiff` -> OME-TIFF or a page stack; `.dcm` -> a one-slice DICOM series; any file with a
     /// sidecar `<file>.json`/`<file>.toml` -> raw.
     pub fn load(path: &Path, raw: Option<&RawParams>) -> Result<Volume, VolumeError> {
+        Self::load_within(path, raw, None)
+    }
+
+    /// [`Volume::load`] for a renderer with `budget` bytes for its volume: of an OME-Zarr
+    /// image's levels, the finest whose voxels fit it is read (see `zarr.rs`).
+    pub fn load_within(
+        path: &Path,
+        raw: Option<&RawParams>,
+        budget: Option<u64>,
+    ) -> Result<Volume, VolumeError> {
         if let Some(params) = raw {
             return raw::load(path, params);
         }
         if zarr::is_zarr(path) {
-            return zarr::load(path);
+            return zarr::load(path, budget);
         }
         if path.is_dir() {
             return dicom::load_series(path);

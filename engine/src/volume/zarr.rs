@@ -15,6 +15,7 @@
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
 use super::{name_of, Volume, MAX_DIM, MAX_VOXELS};
+use crate::bytes::human_bytes;
 use ome_zarr_metadata::v0_4::{Axis, AxisType, CoordinateTransform, CoordinateTransformScale};
 use ome_zarr_metadata::AnyOmeFields;
 use std::path::{Path, PathBuf};
@@ -53,7 +54,7 @@ fn malformed(path: &Path, field: &str, problem: impl Into<String>) -> VolumeErro
     }
 }
 
-pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
+pub(crate) fn load(path: &Path, budget: Option<u64>) -> Result<Volume, VolumeError> {
     // A level's array names its group as its parent folder.
     let is_array = path.join(".zarray").is_file() || array_metadata_v3(path);
     let (group, wanted) = match (is_array, path.parent(), path.file_name()) {
@@ -83,7 +84,7 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
                     ),
                 )
             })?,
-        None => finest_that_fits(&image)?,
+        None => finest_that_fits(&image, budget)?,
     };
     read_level(path, &image, index)
 }
@@ -246,32 +247,56 @@ fn millimetres_per_unit(axis: &Axis) -> Option<f64> {
     Some(factor)
 }
 
-/// The first level (the finest) whose spatial size one dense texture holds.
-fn finest_that_fits(image: &Image) -> Result<usize, VolumeError> {
+/// The first level (the finest) that a volume in memory holds (`MAX_DIM` per side,
+/// `MAX_VOXELS`) and, when the renderer has a `budget`, whose voxels fit it, so it is
+/// rendered as one dense texture. Where no level fits the budget, the coarsest one the
+/// limits allow is read (and paged through the brick pool). The log says which level was
+/// read and why the finer ones were not.
+fn finest_that_fits(image: &Image, budget: Option<u64>) -> Result<usize, VolumeError> {
     let mut sizes = Vec::new();
+    let mut within_limits = None;
     for (i, level) in image.levels.iter().enumerate() {
         let array = open_array(image, level)?;
         let dims = spatial_dims(&array);
+        let bytes = dims.iter().product::<u64>() * voxel_bytes(&array);
         sizes.push(format!(
-            "{}: {}x{}x{}",
-            level.path, dims[0], dims[1], dims[2]
+            "{}: {}x{}x{}, {}",
+            level.path,
+            dims[0],
+            dims[1],
+            dims[2],
+            human_bytes(bytes)
         ));
         let voxels: u64 = dims.iter().product();
-        if dims.iter().all(|&d| d <= u64::from(MAX_DIM)) && voxels <= MAX_VOXELS {
+        if !(dims.iter().all(|&d| d <= u64::from(MAX_DIM)) && voxels <= MAX_VOXELS) {
+            continue;
+        }
+        within_limits = Some(i);
+        if budget.is_none_or(|b| bytes <= b) {
             if i > 0 {
                 log::warn!(
-                    "{}: reading resolution level {} ({}x{}x{}); the finer ones ({}) exceed one \
-                     volume texture ({MAX_DIM} per side, {MAX_VOXELS} voxels)",
+                    "{}: reading resolution level {}; the finer ones ({}) exceed {}",
                     image.group.display(),
-                    level.path,
-                    dims[0],
-                    dims[1],
-                    dims[2],
-                    sizes[..i].join(", ")
+                    sizes[i],
+                    sizes[..i].join("; "),
+                    match budget {
+                        Some(b) => format!("the memory budget ({}) or one volume in memory ({MAX_DIM} per side, {MAX_VOXELS} voxels)", human_bytes(b)),
+                        None => format!("one volume in memory ({MAX_DIM} per side, {MAX_VOXELS} voxels)"),
+                    }
                 );
             }
             return Ok(i);
         }
+    }
+    if let Some(i) = within_limits {
+        log::warn!(
+            "{}: no resolution level fits the memory budget ({}): reading the coarsest, {}, \
+             paged through the brick pool",
+            image.group.display(),
+            human_bytes(budget.unwrap_or(0)),
+            sizes[i]
+        );
+        return Ok(i);
     }
     Err(VolumeError::BadDims {
         path: image.group.clone(),
@@ -281,6 +306,22 @@ fn finest_that_fits(image: &Image) -> Result<usize, VolumeError> {
             sizes.join(", ")
         ),
     })
+}
+
+/// The array's data type, as Zarr v3 names it (displayed as "<v3 name> / <v2 name>"
+/// where the two differ: the v3 name is first).
+fn dtype_name(array: &Array<FilesystemStore>) -> String {
+    let shown = array.data_type().to_string();
+    shown.split(" / ").next().unwrap_or_default().to_string()
+}
+
+/// Bytes a voxel of `array` takes once read (16-bit types stay 16-bit).
+fn voxel_bytes(array: &Array<FilesystemStore>) -> u64 {
+    match dtype_name(array).as_str() {
+        "uint8" => 1,
+        "uint16" | "int16" => 2,
+        _ => 4,
+    }
 }
 
 fn open_array(image: &Image, level: &Level) -> Result<Array<FilesystemStore>, VolumeError> {
@@ -343,11 +384,9 @@ fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, Volume
             path.display()
         );
     }
-    // Displayed as "<v3 name> / <v2 name>" where the two differ: the v3 name is first.
-    let shown = array.data_type().to_string();
-    let dtype = shown.split(" / ").next().unwrap_or_default();
+    let dtype = dtype_name(&array);
     let subset = ranges.as_slice();
-    let samples = match dtype {
+    let samples = match dtype.as_str() {
         "uint8" => Samples::U8(read(path, &array, subset)?),
         "uint16" => Samples::U16(read(path, &array, subset)?),
         "int16" => Samples::I16(read(path, &array, subset)?),
