@@ -81,7 +81,8 @@ pub struct RenderSettings {
     /// the volume is paged through the brick pool. Unset: half the device-local heap.
     #[serde(
         deserialize_with = "de_memory_size",
-        serialize_with = "ser_memory_size"
+        serialize_with = "ser_memory_size",
+        skip_serializing_if = "Option::is_none"
     )]
     gpu_memory: Option<u64>,
     // Not in scene files: a scene's frames always draw seed 1's sample streams (eval's

@@ -244,6 +244,11 @@ fn to_toml_round_trips() {
     let ex = Scene::load(example_path()).unwrap_or_else(|e| panic!("{e}"));
     let back = Scene::from_toml_str(&ex.to_toml().expect("serialises"), "ex.toml").expect("parses");
     assert_eq!(back, ex);
+    // A memory budget round-trips as its byte count.
+    let mut s = builtin("mri/orbit");
+    s.render.set_gpu_memory(Some(3 << 29)).expect("1.5 GiB");
+    let back = Scene::from_toml_str(&s.to_toml().expect("ser"), "x").expect("parse");
+    assert_eq!(back.render.gpu_memory(), Some(3 << 29));
     // Resampled scenes round-trip too.
     let s = builtin("phantom/light-jump").with_frames(8).expect("8");
     assert_eq!(
