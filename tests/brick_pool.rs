@@ -260,3 +260,74 @@ fn a_volume_made_on_demand_pools_like_the_dense_volume() {
     }
     assert_validation_clean();
 }
+
+/// A TF edit that reveals more bricks than one frame uploads streams them over several
+/// frames: each frame in between is whole (the bricks without a slot yet show at the
+/// coarse level, no validation message), and once they are resident the frames are a
+/// fresh renderer's.
+#[test]
+fn bricks_past_one_frames_upload_stream_in_over_frames() {
+    use dvr_engine::renderer::brick_pool::STREAM_PER_FRAME;
+    use dvr_engine::volume::sparse::Sparse;
+    let volume = VolumeUpload::on_demand("sparse", Arc::new(Sparse::new(768)));
+    // Only the shapes' dense cores, then nearly all of them down to their rims.
+    let (a, b) = (step_tf(0.9), step_tf(0.05));
+    // 200 MiB: below the 432 MiB dense texture, room for every brick TF b shows.
+    let budget = Some(200 << 20);
+    let tfs = [a.clone(), b.clone(), b.clone(), b.clone(), b.clone()];
+    let mut edited = make(&volume, budget, &["none"]);
+    // Frame 0 loads every brick TF a shows; count them before the edit.
+    run(&mut edited, &tfs[..1]);
+    let VolumeResidency::Pool {
+        visible: before, ..
+    } = edited.volume_residency()
+    else {
+        panic!("pooled");
+    };
+    let mut frames = run(&mut edited, &tfs[1..]);
+    let VolumeResidency::Pool {
+        visible,
+        resident,
+        pending,
+        ..
+    } = edited.volume_residency()
+    else {
+        panic!("pooled");
+    };
+    println!("TF a: {before} visible; TF b: {visible}, {resident} resident, {pending} pending");
+    assert!(
+        visible - before > STREAM_PER_FRAME,
+        "the edit must need more than one frame's upload"
+    );
+    assert_eq!(
+        (resident, pending),
+        (visible, 0),
+        "all resident four frames after the edit"
+    );
+    frames.insert(0, Vec::new());
+    drop(edited);
+    let mut fresh = make(&volume, budget, &["none"]);
+    let want = run(
+        &mut fresh,
+        &tfs.iter().map(|_| b.clone()).collect::<Vec<_>>(),
+    );
+    // The edit's frame (1) uploads one frame's worth and shows the rest coarse; frame 2
+    // uploads the rest, and from then on the frames are the fresh renderer's.
+    for (f, frame) in frames.iter().enumerate().skip(1) {
+        let got = &frame[0].1;
+        assert!(
+            got.iter().all(|p| p.iter().all(|c| c.is_finite())),
+            "frame {f} finite"
+        );
+        if f >= 2 {
+            assert_same(&format!("frame {f}"), &want[f][0].1, got);
+        }
+    }
+    let (psnr, _) = compare(&want[1][0].1, &frames[1][0].1);
+    println!("frame 1, half streamed: {psnr:.1} dB");
+    assert!(
+        psnr < 50.0,
+        "frame 1 must show the bricks still streaming at the coarse level: {psnr:.1} dB"
+    );
+    assert_validation_clean();
+}
