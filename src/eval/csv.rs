@@ -326,6 +326,7 @@ pub(crate) mod tests {
                 psnr: 18.0,
             }],
             path_trace_ms_per_spp: 0.5,
+            volume: "dense volume".into(),
             device: "test".into(),
         }
     }

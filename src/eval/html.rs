@@ -81,6 +81,7 @@ fn scene_json(r: &SceneResult) -> Value {
         "spp": r.spp,
         "event_frame": r.event_frame,
         "path_trace_ms_per_spp": r.path_trace_ms_per_spp,
+        "volume": r.volume,
         "methods": r.methods,
         "metrics": metrics,
         "summary": summary,

@@ -134,6 +134,10 @@ pub struct SceneResult {
     #[serde(with = "float")]
     pub path_trace_ms_per_spp: f64,
     pub device: String,
+    /// How the volume was held: "dense volume", or the brick pool's residency at the
+    /// scene's last frame (the page shows it); empty in results written before it.
+    #[serde(default)]
+    pub volume: String,
 }
 
 impl SceneResult {
@@ -484,6 +488,7 @@ pub fn evaluate_scene(
         baseline,
         path_trace_ms_per_spp: ms_per_spp,
         device,
+        volume: renderer.volume_residency().to_string(),
     })
 }
 

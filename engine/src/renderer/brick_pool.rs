@@ -140,11 +140,23 @@ pub fn plan(dims: [u32; 3], format: VolumeFormat, limits: &Limits) -> Result<Vol
             human_bytes(per_brick)
         ));
     }
+    // Whole rows and layers of slots: of a near-cube and of full rows first, the
+    // arrangement that keeps more of the `wanted` slots.
     let per_axis = (max_dim / STORED).max(1) as u64;
-    let side = ((wanted as f64).cbrt().floor() as u64).clamp(1, per_axis);
-    let sx = side.min(wanted);
-    let sy = side.min(wanted / sx).max(1);
-    let sz = (wanted / (sx * sy)).clamp(1, per_axis);
+    let arrange = |sx: u64| {
+        let sx = sx.clamp(1, per_axis.min(wanted));
+        let sy = (wanted / sx).clamp(1, per_axis.min(sx));
+        let sz = (wanted / (sx * sy)).clamp(1, per_axis);
+        [sx, sy, sz]
+    };
+    let cube = arrange((wanted as f64).cbrt().floor() as u64);
+    let rows = arrange(per_axis);
+    let count = |s: [u64; 3]| s[0] * s[1] * s[2];
+    let [sx, sy, sz] = if count(rows) > count(cube) {
+        rows
+    } else {
+        cube
+    };
     Ok(VolumePath::Pool(PoolLayout {
         grid,
         slots: [sx as u32, sy as u32, sz as u32],
@@ -389,7 +401,18 @@ mod tests {
         // The coarse copy within an eighth of the budget: 1024/4 = 256³ × 2 B = 32 MiB.
         assert_eq!((p.level, p.coarse_dims), (2, [256; 3]));
         assert!(p.bytes(VolumeFormat::R16) <= LIMITS.budget, "{:?}", p);
-        assert!(p.slot_count() > 1000, "most of the budget is slots: {p:?}");
+        // Most of the budget is slots: (1 GiB − 32 MiB − 256 KiB) / 93312 B = 11142, of
+        // which 22×22×23 fit in whole layers.
+        assert_eq!(p.slot_count(), 11132, "{p:?}");
+        // A few slots go in one row, none lost to a cube's layers.
+        let small = Limits {
+            budget: 1 << 20,
+            ..LIMITS
+        };
+        let Ok(VolumePath::Pool(p)) = plan([128, 128, 64], VolumeFormat::R16, &small) else {
+            panic!("2 MiB over 1 MiB is pooled");
+        };
+        assert_eq!((p.slots, p.slot_count()), ([10, 1, 1], 10));
         assert!(p.pool_extent().iter().all(|&e| e <= 4096));
         // A budget past the heap does not make a texture and its upload copy fit.
         let generous = Limits {
