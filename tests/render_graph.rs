@@ -132,9 +132,7 @@ fn new_images_start_at_zero() {
 #[test]
 fn a_volume_past_the_device_limits_is_paged_and_a_mis_sized_one_refused_before_allocation() {
     use dvr_engine::renderer::brick_pool::VolumePath;
-    use dvr_engine::renderer::scene_gpu::{
-        check_volume_fits, BrickRanges, VolumeFormat, VolumeUpload,
-    };
+    use dvr_engine::renderer::scene_gpu::{plan_volume, BrickRanges, VolumeFormat, VolumeUpload};
     let ctx = context();
     // A header whose bytes are missing: refused, naming the volume, before anything else.
     let huge = VolumeUpload {
@@ -151,7 +149,7 @@ fn a_volume_past_the_device_limits_is_paged_and_a_mis_sized_one_refused_before_a
             max: vec![1.0],
         },
     };
-    let err = check_volume_fits(&ctx, &huge, None)
+    let err = plan_volume(&ctx, &huge, None)
         .expect_err("no bytes for 128 GiB")
         .to_string();
     assert!(
@@ -162,7 +160,7 @@ fn a_volume_past_the_device_limits_is_paged_and_a_mis_sized_one_refused_before_a
     let mut too_tall = huge.clone();
     too_tall.dims = [8, 8, ctx.info.max_image_dimension_3d + 1];
     too_tall.bytes = vec![0; 8 * 8 * too_tall.dims[2] as usize * 2];
-    match check_volume_fits(&ctx, &too_tall, None).expect("pooled") {
+    match plan_volume(&ctx, &too_tall, None).expect("pooled") {
         VolumePath::Pool(p) => assert!(p
             .pool_extent()
             .iter()

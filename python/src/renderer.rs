@@ -12,7 +12,7 @@ use dvr_engine::graph::Extent;
 use dvr_engine::passes::aux_features::{ALBEDO, NORMAL};
 use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup, DEFAULT_VOLUME_SIZE};
 use dvr_engine::renderer::{FrameRequest, FrameResult, Renderer as EngineRenderer, FEATURE_IMAGES};
-use dvr_engine::scene::parse_gpu_memory;
+use dvr_engine::scene::parse_memory_size;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -95,7 +95,7 @@ impl Renderer {
         let motion = motion.parse().map_err(value_error)?;
         if let Some(s) = gpu_memory {
             let bytes =
-                parse_gpu_memory(&s).map_err(|e| value_error(format!("gpu_memory: {e}")))?;
+                parse_memory_size(&s).map_err(|e| value_error(format!("gpu_memory: {e}")))?;
             scene
                 .render
                 .set_gpu_memory(Some(bytes))

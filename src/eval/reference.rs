@@ -79,7 +79,7 @@ fn content_hash(scene: &Scene, volume_size: u32) -> Result<String> {
     // A volume made on demand is named by its generator and size (its voxels are made
     // brick by brick and never held whole).
     if let Some(v) = on_demand(scene, volume_size) {
-        h.write(v.identity().as_bytes());
+        h.write(v.identity.as_bytes());
     } else {
         let volume = load_volume(scene, volume_size)
             .with_context(|| format!("loading the volume of {}", scene.name))?;

@@ -168,31 +168,56 @@ pub fn plan(dims: [u32; 3], format: VolumeFormat, limits: &Limits) -> Result<Vol
 /// Writes brick `b`'s stored texels (interior and apron, clamped to the volume's edge)
 /// into `out`, x fastest.
 pub fn write_brick(v: &VolumeUpload, b: [u32; 3], out: &mut [u8]) {
-    let origin = b.map(|c| (c * BRICK) as i64 - APRON as i64);
-    if let Some(blocks) = &v.blocks {
-        return blocks.fill(origin, [STORED; 3], out);
-    }
-    let bpp = v.format.bytes();
-    let [nx, ny, nz] = v.dims.map(|d| d as i64);
-    let s = STORED as usize;
+    v.fill(
+        b.map(|c| (c * BRICK) as i64 - APRON as i64),
+        [STORED; 3],
+        out,
+    );
+}
+
+/// Writes the `size` block of `bytes` (a dense `dims` volume of `bpp`-byte voxels, x
+/// fastest) starting at `origin` into `out`, reading the nearest edge voxel outside the
+/// volume as a clamp-to-edge sampler does. Rows are copied whole where they lie inside.
+pub fn fill_clamped(
+    bytes: &[u8],
+    dims: [u32; 3],
+    bpp: usize,
+    origin: [i64; 3],
+    size: [u32; 3],
+    out: &mut [u8],
+) {
+    let [nx, ny, nz] = dims.map(|d| d as i64);
+    let w = size[0] as usize;
+    // The run of x inside the volume: [x0, x1) in the block, starting at voxel origin.x + x0.
+    let x0 = (-origin[0]).clamp(0, w as i64) as usize;
+    let x1 = (nx - origin[0]).clamp(x0 as i64, w as i64) as usize;
     let mut o = 0;
-    for z in 0..s {
-        let sz = (origin[2] + z as i64).clamp(0, nz - 1);
-        for y in 0..s {
-            let sy = (origin[1] + y as i64).clamp(0, ny - 1);
-            let row = ((sz * ny + sy) * nx) as usize;
-            for x in 0..s {
-                let sx = (origin[0] + x as i64).clamp(0, nx - 1) as usize;
-                let i = (row + sx) * bpp;
-                out[o..o + bpp].copy_from_slice(&v.bytes[i..i + bpp]);
-                o += bpp;
+    for z in 0..size[2] as i64 {
+        let sz = (origin[2] + z).clamp(0, nz - 1);
+        for y in 0..size[1] as i64 {
+            let sy = (origin[1] + y).clamp(0, ny - 1);
+            let row = &bytes[((sz * ny + sy) * nx) as usize * bpp..][..nx as usize * bpp];
+            let dst = &mut out[o..o + w * bpp];
+            let first = &row[..bpp];
+            let last = &row[row.len() - bpp..];
+            for px in dst[..x0 * bpp].chunks_exact_mut(bpp) {
+                px.copy_from_slice(first);
             }
+            if x1 > x0 {
+                let start = (origin[0] + x0 as i64) as usize * bpp;
+                dst[x0 * bpp..x1 * bpp].copy_from_slice(&row[start..start + (x1 - x0) * bpp]);
+            }
+            for px in dst[x1 * bpp..].chunks_exact_mut(bpp) {
+                px.copy_from_slice(last);
+            }
+            o += w * bpp;
         }
     }
 }
 
 /// The volume averaged over 2^level voxels per side (a box filter; partial blocks at the
-/// far edges average what they hold), in the volume's own format.
+/// far edges average what they hold), in the volume's own format: the coarse copy of a
+/// volume held dense (see [`VolumeUpload::coarse`]).
 pub fn coarse_copy(v: &VolumeUpload, level: u32, dims: [u32; 3]) -> Vec<u8> {
     let f = 1usize << level;
     let [nx, ny, nz] = v.dims.map(|d| d as usize);
@@ -269,9 +294,9 @@ pub struct Residency {
     slot_of: Vec<Option<u32>>,
     /// Per slot: its brick.
     brick_in: Vec<Option<u32>>,
-    /// Per brick: whether the current TF can make it visible.
+    /// Per brick: whether the current TF can make it visible (empty before the first TF).
     visible: Vec<bool>,
-    /// Visible bricks without a slot yet, most opaque first.
+    /// Visible bricks without a slot yet, most opaque last (taken from the end).
     pending: Vec<u32>,
     /// Bricks the current TF makes visible, and how many of them have a slot.
     pub visible_count: usize,
@@ -284,7 +309,7 @@ impl Residency {
         Self {
             slot_of: vec![None; n],
             brick_in: vec![None; layout.slot_count()],
-            visible: vec![false; n],
+            visible: Vec::new(),
             pending: Vec::new(),
             visible_count: 0,
             layout,
@@ -298,12 +323,17 @@ impl Residency {
 
     /// The TF changed: `majorants` (per brick, from [`Self::ranges`]) says which bricks
     /// it can make visible. The most opaque visible bricks, as many as there are slots,
-    /// are wanted; the rest of the visible ones show at the coarse level.
-    pub fn set_transfer_function(&mut self, majorants: &[f32]) {
+    /// are wanted; the rest of the visible ones show at the coarse level. Returns whether
+    /// the brick table changed (a TF edit that moves no brick's visibility does not).
+    pub fn set_transfer_function(&mut self, majorants: &[f32]) -> bool {
+        let visible: Vec<bool> = majorants.iter().map(|&m| m > 0.0).collect();
+        if visible == self.visible {
+            return false;
+        }
+        self.visible = visible;
         let mut want: Vec<u32> = (0..majorants.len() as u32)
-            .filter(|&b| majorants[b as usize] > 0.0)
+            .filter(|&b| self.visible[b as usize])
             .collect();
-        self.visible = majorants.iter().map(|&m| m > 0.0).collect();
         self.visible_count = want.len();
         want.sort_by(|&a, &b| majorants[b as usize].total_cmp(&majorants[a as usize]));
         want.truncate(self.layout.slot_count());
@@ -323,8 +353,10 @@ impl Residency {
         }
         self.pending = want
             .into_iter()
+            .rev()
             .filter(|&b| self.slot_of[b as usize].is_none())
             .collect();
+        true
     }
 
     /// Up to `n` bricks to upload now, each with the slot it goes to; the table (see
@@ -334,11 +366,11 @@ impl Residency {
             (0..self.brick_in.len() as u32).filter(|&s| self.brick_in[s as usize].is_none());
         let mut out = Vec::new();
         while out.len() < n {
-            let Some(&b) = self.pending.first() else {
+            let Some(&b) = self.pending.last() else {
                 break;
             };
             let Some(s) = free.next() else { break };
-            self.pending.remove(0);
+            self.pending.pop();
             out.push((b, s));
         }
         for &(b, s) in &out {
@@ -370,7 +402,7 @@ impl Residency {
         (0..self.slot_of.len())
             .map(|b| match self.slot_of[b] {
                 Some(s) => [s as f32, 0.0],
-                None if self.visible[b] => [-1.0, -1.0],
+                None if self.visible.get(b) == Some(&true) => [-1.0, -1.0],
                 None => [-1.0, self.ranges.min[b].max(0.0)],
             })
             .collect()
@@ -476,6 +508,17 @@ mod tests {
         assert_eq!(at(9, 2, 2), src(39, 0, 0));
         assert_eq!(at(20, 2, 2), src(39, 0, 0));
         assert_eq!(at(5, 4, 3), src(35, 2, 1));
+        // Before the volume's first voxel (brick 0 starts at voxel −2) the first repeats,
+        // on every axis.
+        write_brick(&v, [0, 0, 0], &mut out);
+        let at =
+            |x: usize, y: usize, z: usize| out[(z * STORED as usize + y) * STORED as usize + x];
+        assert_eq!(
+            (at(0, 0, 0), at(1, 1, 1), at(2, 2, 2)),
+            (src(0, 0, 0), src(0, 0, 0), src(0, 0, 0))
+        );
+        assert_eq!(at(7, 3, 3), src(5, 1, 1));
+        assert_eq!(at(35, 35, 35), src(33, 2, 1));
     }
 
     #[test]
@@ -493,15 +536,17 @@ mod tests {
             max: vec![0.5; 4],
         };
         let mut r = Residency::new(layout, ranges);
-        r.set_transfer_function(&[0.0, 1.0, 3.0, 2.0]);
+        assert!(r.set_transfer_function(&[0.0, 1.0, 3.0, 2.0]));
         assert_eq!(r.visible_count, 3);
         // The two most opaque get the two slots; brick 1 waits at the coarse level.
         assert_eq!(r.take_uploads(10), vec![(2, 0), (3, 1)]);
         let t = r.table();
         assert_eq!(t, vec![[-1.0, 0.1], [-1.0, -1.0], [0.0, 0.0], [1.0, 0.0]]);
         // A new TF hides brick 2: its slot goes to brick 1, and brick 3 stays put.
-        r.set_transfer_function(&[0.0, 1.0, 0.0, 2.0]);
+        assert!(r.set_transfer_function(&[0.0, 1.0, 0.0, 2.0]));
         assert_eq!(r.take_uploads(1), vec![(1, 0)]);
+        // Other opacities, the same bricks visible: nothing to upload, the table stands.
+        assert!(!r.set_transfer_function(&[0.0, 5.0, 0.0, 0.5]));
         assert_eq!(r.table()[2], [-1.0, 0.3]);
         assert_eq!(r.resident_visible(), 2);
         assert_eq!(r.pending(), 0);

@@ -204,7 +204,7 @@ impl Renderer {
         // `RenderGraph::destroy`, which an early return here would skip.
         // So is a volume not even a brick pool can hold in the budget: found here, the
         // error is not preceded by the allocator's reports of leaked buffers.
-        let volume_path = scene_gpu::check_volume_fits(&ctx, &volume, config.gpu_memory)?;
+        let volume_path = scene_gpu::plan_volume(&ctx, &volume, config.gpu_memory)?;
         let denoisers = create_methods(&ctx, &config, features, denoisers)?;
         let mut graph = RenderGraph::new(&ctx)?;
         let passes = Passes {
@@ -627,8 +627,8 @@ impl Renderer {
                 scene_gpu::add_frame_upload(ctx, graph, frame, name, slot, image, bytes)?;
             }
             if let Some(r) = &mut self.residency {
-                r.set_transfer_function(&scene_gpu::majorants(r.ranges(), &opacity, scale));
-                self.table_dirty = true;
+                let pool_majorants = scene_gpu::majorants(r.ranges(), &opacity, scale);
+                self.table_dirty |= r.set_transfer_function(&pool_majorants);
                 let slots = r.layout.slot_count();
                 // Said once each time the TF goes past the pool (not on every edit while
                 // it stays there); the HUD and profile header show the count throughout.

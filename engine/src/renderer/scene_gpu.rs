@@ -119,18 +119,37 @@ impl VolumeUpload {
         }
     }
 
+    /// Writes the `size` block of voxels at `origin` into `out` (x fastest), outside the
+    /// volume its nearest edge voxel: from the held bytes, or made by the blocks.
+    pub fn fill(&self, origin: [i64; 3], size: [u32; 3], out: &mut [u8]) {
+        match &self.blocks {
+            Some(b) => b.fill(origin, size, out),
+            None => {
+                let bpp = self.format.bytes();
+                brick_pool::fill_clamped(&self.bytes, self.dims, bpp, origin, size, out)
+            }
+        }
+    }
+
+    /// The volume at 2^level coarser (`dims`): the held bytes box-filtered, or the
+    /// blocks' own coarse copy.
+    pub fn coarse(&self, level: u32, dims: [u32; 3]) -> Vec<u8> {
+        match &self.blocks {
+            Some(b) => b.coarse(level, dims),
+            None => brick_pool::coarse_copy(self, level, dims),
+        }
+    }
+
     /// The dense bytes: held, or made from the blocks (the dense path of a volume made on
     /// demand, where the budget holds it).
     pub fn dense_bytes(&self) -> Cow<'_, [u8]> {
-        match &self.blocks {
-            None => Cow::Borrowed(&self.bytes),
-            Some(b) => {
-                let texels: usize = self.dims.iter().map(|&d| d as usize).product();
-                let mut out = vec![0u8; texels * self.format.bytes()];
-                b.fill([0; 3], self.dims, &mut out);
-                Cow::Owned(out)
-            }
+        if self.blocks.is_none() {
+            return Cow::Borrowed(&self.bytes);
         }
+        let texels: usize = self.dims.iter().map(|&d| d as usize).product();
+        let mut out = vec![0u8; texels * self.format.bytes()];
+        self.fill([0; 3], self.dims, &mut out);
+        Cow::Owned(out)
     }
 }
 
@@ -241,11 +260,7 @@ pub fn default_budget(ctx: &GpuContext) -> u64 {
 /// bytes (`None`: [`default_budget`]): one dense texture where it fits the budget and the
 /// device's limits, else a brick pool; an error names the volume and the device where
 /// not even a pool fits, or where the bytes do not match the header.
-pub fn check_volume_fits(
-    ctx: &GpuContext,
-    v: &VolumeUpload,
-    budget: Option<u64>,
-) -> Result<VolumePath> {
+pub fn plan_volume(ctx: &GpuContext, v: &VolumeUpload, budget: Option<u64>) -> Result<VolumePath> {
     let texels: u64 = v.dims.iter().map(|&d| d as u64).product();
     let needed = texels * v.format.bytes() as u64;
     if v.blocks.is_none() && needed != v.bytes.len() as u64 {
@@ -300,10 +315,7 @@ pub fn create<'f>(
         VolumePath::Dense => (volume.dims, volume.dense_bytes(), [1; 3], [1; 3], 0.0),
         VolumePath::Pool(layout) => (
             layout.coarse_dims,
-            Cow::Owned(match &volume.blocks {
-                Some(b) => b.coarse(layout.level, layout.coarse_dims),
-                None => brick_pool::coarse_copy(volume, layout.level, layout.coarse_dims),
-            }),
+            Cow::Owned(volume.coarse(layout.level, layout.coarse_dims)),
             layout.pool_extent(),
             layout.grid,
             -1.0,

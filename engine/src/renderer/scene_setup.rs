@@ -55,7 +55,7 @@ impl SceneSetup {
         volume_size: u32,
     ) -> Result<Self, SetupError> {
         let upload = match on_demand(&scene, volume_size) {
-            Some(blocks) => VolumeUpload::on_demand(blocks.name(), blocks.into_blocks()),
+            Some(v) => VolumeUpload::on_demand(v.name, v.blocks),
             None => VolumeUpload::from_volume(&load_volume(&scene, volume_size)?),
         };
         Self::with_upload(scene, upload, size, spp)
@@ -157,27 +157,11 @@ pub const DEFAULT_VOLUME_SIZE: u32 = 128;
 
 /// A scene volume made brick by brick on demand (the `sparse` dataset), which only the
 /// renderer's upload holds: its dense array is never made.
-pub enum OnDemand {
-    Sparse(u32, Arc<Sparse>),
-}
-
-impl OnDemand {
-    pub fn name(&self) -> &'static str {
-        match self {
-            OnDemand::Sparse(..) => "sparse",
-        }
-    }
+pub struct OnDemand {
+    pub name: &'static str,
     /// What identifies its voxels (a reference cache key): the generator and its size.
-    pub fn identity(&self) -> String {
-        match self {
-            OnDemand::Sparse(n, _) => format!("sparse v1 {n}"),
-        }
-    }
-    pub fn into_blocks(self) -> Arc<dyn VoxelBlocks> {
-        match self {
-            OnDemand::Sparse(_, s) => s,
-        }
-    }
+    pub identity: String,
+    pub blocks: Arc<dyn VoxelBlocks>,
 }
 
 /// The scene's volume when it is made on demand (see [`OnDemand`]).
@@ -188,7 +172,11 @@ pub fn on_demand(scene: &Scene, volume_size: u32) -> Option<OnDemand> {
             size,
         } => {
             let n = size.unwrap_or(volume_size);
-            Some(OnDemand::Sparse(n, Arc::new(Sparse::new(n))))
+            Some(OnDemand {
+                name: "sparse",
+                identity: format!("sparse v1 {n}"),
+                blocks: Arc::new(Sparse::new(n)),
+            })
         }
         _ => None,
     }
