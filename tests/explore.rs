@@ -1,6 +1,7 @@
 //! `dvr explore` in a real window under Xvfb, as a user runs it, with the validation
 //! layer on: the screenshot shows the rendered volume and the UI panel; a scripted drag
-//! changes the view; a recorded session replays through `dvr capture` to the same
+//! changes the view; a moving view renders fewer pixels, upsampled into the view, until
+//! it is still again; a recorded session replays through `dvr capture` to the same
 //! frames; and without a display the command says how to get one.
 //!
 //! Each test starts its own `Xvfb` on a free display and kills it at the end. Without
@@ -316,6 +317,88 @@ fn a_recorded_session_replays_to_the_same_frames() {
     let first = Shot::open(&rec.join("frames").join("0000.png"));
     let last = Shot::open(&rec.join("frames").join("0007.png"));
     assert!(mean_abs_diff(&first, &last, 64, 64) > 2.0);
+}
+
+#[test]
+fn a_moving_view_renders_fewer_pixels_and_the_full_size_returns_when_still() {
+    let Some(x) = xvfb() else { return };
+    let dir = tempfile::tempdir().expect("temp dir");
+    // A drag every frame from 6 to 10, F12 in the middle of it (frame 8) and after the
+    // view has settled (frame 15). A 1 ms target is below any frame's time on any
+    // device, so the motion renders at the largest divisor, 8: 16×16 for a 128² view.
+    let out = dvr(
+        Some(&x.display),
+        &[
+            "explore",
+            "--scene",
+            "phantom/orbit",
+            "--size",
+            "128x128",
+            "--volume-size",
+            "48",
+            "--frames",
+            "16",
+            "--moving-ms",
+            "1",
+            "--script",
+            "orbit:6,0@6;orbit:6,0@7;orbit:6,0@8;orbit:6,0@9;orbit:6,0@10;key:f12@8;key:f12@15",
+        ],
+        dir.path(),
+    );
+    assert_clean(&out);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    // Frames 6..=10 moving, 11 the slack frame, full size from 12 on; the summary
+    // leaves out the first 5 (warm-up) and the last (no interval ends it).
+    assert!(
+        stdout.contains("by rendered size (--moving-ms): full size: 4 frames")
+            && stdout.contains("1/8: 6 frames"),
+        "{stdout}"
+    );
+    let exr_size = |name: &str| {
+        let img = dvr_engine::image_io::read_exr(&dir.path().join(name))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        (img.width, img.height)
+    };
+    assert_eq!(
+        exr_size("dvr-explore-0000.exr"),
+        (16, 16),
+        "mid-motion frame"
+    );
+    assert_eq!(
+        exr_size("dvr-explore-0001.exr"),
+        (128, 128),
+        "settled frame"
+    );
+    // The window shows the upsampled frame over the whole 128² view (no pixel of the
+    // view is the background the present pass gives pixels outside the frame), and the
+    // same volume as the full-size frame after it.
+    let moving = Shot::open(&dir.path().join("dvr-explore-0000.png"));
+    let still = Shot::open(&dir.path().join("dvr-explore-0001.png"));
+    assert_eq!((moving.width, moving.height), (128 + PANEL_WIDTH, 128));
+    let outside = (0..128u32)
+        .flat_map(|y| (0..128u32).map(move |px| (px, y)))
+        .filter(|&(px, y)| moving.px(px, y) == PANEL_FILL)
+        .count();
+    assert_eq!(outside, 0, "{outside} view pixels show no frame");
+    let (mean_moving, _) = moving.stats(32, 32, 96, 96);
+    let (mean_still, _) = still.stats(32, 32, 96, 96);
+    assert!(
+        (mean_moving - mean_still).abs() < 25.0,
+        "the moving frame ({mean_moving:.1}) is not the still one's volume ({mean_still:.1})"
+    );
+
+    // A frame time that is not one is refused, naming the option.
+    let bad = dvr(
+        Some(&x.display),
+        &["explore", "--moving-ms", "nan"],
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(bad.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--moving-ms") && err.contains("not a frame time"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! The present pass on the device, without a window: its GLSL tone map agrees with the
 //! Rust one in `metrics::tonemap` (the project's single definition) on a ramp of HDR
-//! values, and the split view, offset and background land where they should.
+//! values, the split view, offset and background land where they should, and a frame
+//! smaller than its place is upsampled bilinearly into it.
 
 mod common;
 
@@ -133,6 +134,7 @@ fn split_offset_and_background_land_where_they_should() {
     let right = vec![[0.0f32, 0.0, 0.0, 1.0]; n];
     let layout = PresentLayout {
         offset: [2, 1],
+        size: None,
         split_x: Some(5),
         exposure: 1.0,
         background: [0.25, 0.5, 0.75],
@@ -155,5 +157,49 @@ fn split_offset_and_background_land_where_they_should() {
             };
             assert!((p[0] - want).abs() < 1e-5, "source column {sx}: {p:?}");
         }
+    }
+}
+
+#[test]
+fn a_smaller_frame_is_upsampled_bilinearly_into_its_place() {
+    // A 2×2 source of values 0, 1 (top) and 2, 3 (bottom) filling an 8×8 view at offset
+    // (1, 0) of a 10×8 target: each target pixel centre maps to source coordinates
+    // (x + 0.5) / 4 − 0.5, clamped at the edges; the tone map runs after the blend.
+    let size = Extent {
+        width: 2,
+        height: 2,
+    };
+    let target = Extent {
+        width: 10,
+        height: 8,
+    };
+    let left: Vec<[f32; 4]> = (0..4).map(|v| [v as f32, 0.0, 0.0, 1.0]).collect();
+    let right = vec![[0.0f32, 0.0, 7.0, 1.0]; 4];
+    let layout = PresentLayout {
+        offset: [1, 0],
+        size: Some([8, 8]),
+        split_x: Some(6),
+        exposure: 1.0,
+        background: [0.25, 0.5, 0.75],
+    };
+    let out = present(&left, &right, size, target, layout);
+    let at = |x: u32, y: u32| out[(y * target.width + x) as usize];
+    let tone = |v: f32| tonemap_srgb(&Rgb32Image::filled(1, 1, [v, 0.0, 0.0]), 1.0).data[0][0];
+    let coord = |i: u32| ((i as f32 + 0.5) / 4.0 - 0.5).clamp(0.0, 1.0);
+    for y in 0..8u32 {
+        assert_eq!(&at(0, y)[..3], &[0.25, 0.5, 0.75], "background at (0,{y})");
+        assert_eq!(&at(9, y)[..3], &[0.25, 0.5, 0.75], "background at (9,{y})");
+        for vx in 0..6u32 {
+            let want = tone(coord(vx) + 2.0 * coord(y));
+            let got = at(vx + 1, y);
+            assert!(
+                (got[0] - want).abs() < 1e-4 && got[2] == 0.0,
+                "view ({vx},{y}): {got:?}, want red {want}"
+            );
+        }
+        // The divider in view column 6, then the right image.
+        assert_eq!(&at(7, y)[..3], &[1.0, 1.0, 1.0], "divider at row {y}");
+        let blue = tonemap_srgb(&Rgb32Image::filled(1, 1, [0.0, 0.0, 7.0]), 1.0).data[0][2];
+        assert!((at(8, y)[2] - blue).abs() < 1e-5, "right image at row {y}");
     }
 }

@@ -18,7 +18,9 @@ impl Explorer {
         }
         let now = Instant::now();
         if let Some(t) = self.frame_started.replace(now) {
-            self.frame_ms.push((now - t).as_secs_f32() * 1000.0);
+            // The interval that just ended is the last frame's, at its divisor.
+            let ms = (now - t).as_secs_f32() * 1000.0;
+            self.frame_ms.push((ms, self.ui.stats.divisor.max(1)));
         }
         if let Some(gfx) = self.gfx.as_mut() {
             let e = gfx.swapchain.extent;
@@ -68,9 +70,19 @@ impl Explorer {
             self.completed(r)?;
         }
 
-        // Render and present.
+        // Render and present: at 1/k of the view per side while it moves (moving.rs).
         let (vw, vh) = self.view_size();
         let spec = self.camera.spec();
+        let key = ViewKey {
+            camera: spec,
+            lights: self.model.lights.clone(),
+            tf: self.model.tf.clone(),
+        };
+        let changed = self.last_view.as_ref().is_some_and(|last| *last != key);
+        self.last_view = Some(key);
+        let held = self.pointer.drag.is_some() || self.ui.tf_editor.dragging.is_some();
+        let divisor = self.moving.next(changed, held);
+        let (rw, rh) = moving::reduced((vw, vh), divisor);
         let inputs = inputs_for(
             &spec.camera(),
             vw as f32 / vh as f32,
@@ -88,12 +100,13 @@ impl Explorer {
         let (Some(renderer), Some(overlay)) = (gfx.renderer.as_mut(), gfx.overlay.as_ref()) else {
             return Ok(());
         };
-        let view = Extent {
-            width: vw,
-            height: vh,
+        let rendered = Extent {
+            width: rw,
+            height: rh,
         };
-        let finished = renderer.resize(view)?;
-        self.ui.stats.render_size = (vw, vh);
+        let finished = renderer.resize(rendered)?;
+        self.ui.stats.render_size = (rw, rh);
+        self.ui.stats.divisor = divisor;
         self.ui.stats.volume = renderer.volume_residency().to_string();
         let Some(image) = gfx.swapchain.acquire()? else {
             gfx.recreate_swapchain(size)?;
@@ -106,6 +119,7 @@ impl Explorer {
             right: split.map(|_| 1),
             layout: PresentLayout {
                 offset: [0, 0],
+                size: Some([vw, vh]),
                 split_x: split,
                 exposure: self.model.exposure,
                 background: [bg[0], bg[1], bg[2]],
@@ -120,6 +134,7 @@ impl Explorer {
             features: false,
         };
         let result = renderer.frame_presented(&inputs, &request, Some(&target))?;
+        self.in_flight.push_back((divisor, (rw, rh)));
         if !gfx.swapchain.present(&gfx.ctx, &image)? {
             self.resized = true;
         }
@@ -144,8 +159,12 @@ impl Explorer {
 
     /// Handles the results of a finished frame: timings, screenshots, recorded frames.
     pub(super) fn completed(&mut self, r: FrameResult) -> Result<()> {
-        let frame_ms = self.frame_ms.last().copied().unwrap_or(0.0);
-        let (w, h) = self.ui.stats.render_size;
+        let frame_ms = self.frame_ms.last().map_or(0.0, |f| f.0);
+        let (divisor, (w, h)) = self
+            .in_flight
+            .pop_front()
+            .unwrap_or((1, self.ui.stats.render_size));
+        self.moving.finished(divisor, ui::gpu_span_ms(&r.timings));
         let shown = r.images.first();
         if let Some(rec) = &self.recorder {
             if let Some((_, pixels)) = shown {
@@ -241,9 +260,9 @@ impl Explorer {
                 );
             }
         }
-        let timed = self.frame_ms.iter().skip(WARMUP_FRAMES).collect::<Vec<_>>();
+        let timed: Vec<(f32, u32)> = self.frame_ms.iter().skip(WARMUP_FRAMES).copied().collect();
         if let (Some((device, mode)), false) = (summary, timed.is_empty()) {
-            let mean = timed.iter().copied().sum::<f32>() / timed.len() as f32;
+            let mean = timed.iter().map(|f| f.0).sum::<f32>() / timed.len() as f32;
             println!(
                 "explore: {} frames in {:.1} s; {:.1} ms/frame ({:.2} fps) after {WARMUP_FRAMES} \
                  warm-up frames, view {}x{}, {device}, {mode}",
@@ -251,9 +270,31 @@ impl Explorer {
                 self.started.elapsed().as_secs_f64(),
                 mean,
                 1000.0 / mean,
-                self.ui.stats.render_size.0,
-                self.ui.stats.render_size.1,
+                self.args.size.0,
+                self.args.size.1,
             );
+            if timed.iter().any(|f| f.1 > 1) {
+                let mut divisors: Vec<u32> = timed.iter().map(|f| f.1).collect();
+                divisors.sort_unstable();
+                divisors.dedup();
+                let groups: Vec<String> = divisors
+                    .iter()
+                    .map(|&k| {
+                        let ms: Vec<f32> = timed.iter().filter(|f| f.1 == k).map(|f| f.0).collect();
+                        let mean = ms.iter().sum::<f32>() / ms.len() as f32;
+                        let what = if k == 1 {
+                            "full size".to_string()
+                        } else {
+                            format!("1/{k}")
+                        };
+                        format!("{what}: {} frames, {mean:.1} ms/frame", ms.len())
+                    })
+                    .collect();
+                println!(
+                    "explore: by rendered size (--moving-ms): {}",
+                    groups.join("; ")
+                );
+            }
             let passes: Vec<String> = self
                 .pass_totals
                 .iter()

@@ -11,11 +11,14 @@
 //! | `key:NAME@F` | a key: `r` (reset), `f` (fit), `h` (help), `f12` (screenshot), `tab` (UI) |
 //! | `denoiser:NAME@F` | show denoiser NAME |
 //! | `split:NAME@F` | split view with NAME on the right (`split:off` ends it) |
+//! | `tf:NAME@F` | the transfer function: a preset name, or a TF file path (as the panel's presets and load) |
 //!
 //! e.g. `--script "orbit:30,0@10;zoom:2@20"`.
 
 use super::camera::OrbitCamera;
 use anyhow::{bail, Context, Result};
+use dvr_engine::scene::transfer_ref::is_path;
+use dvr_engine::transfer::TransferFunction;
 use winit::event::MouseButton;
 use winit::keyboard::{Key as WinitKey, NamedKey};
 
@@ -91,6 +94,8 @@ pub enum Command {
     Denoiser(String),
     /// The right-hand denoiser of a split view; `None` ends the split.
     Split(Option<String>),
+    /// A transfer function in place of the current one.
+    Tf(Box<TransferFunction>),
 }
 
 /// Applies a camera command; returns false for commands that are not the camera's.
@@ -182,9 +187,20 @@ impl Script {
                     "off" | "" => Command::Split(None),
                     name => Command::Split(Some(name.to_string())),
                 },
+                "tf" => {
+                    let spec = args.trim();
+                    let tf = if is_path(spec) {
+                        TransferFunction::load(spec)
+                    } else {
+                        TransferFunction::preset(spec)
+                    };
+                    Command::Tf(Box::new(
+                        tf.with_context(|| format!("script command {part:?}"))?,
+                    ))
+                }
                 other => bail!(
                     "script command {part:?}: unknown action {other:?} \
-                     (orbit, pan, zoom, key, denoiser, split)"
+                     (orbit, pan, zoom, key, denoiser, split, tf)"
                 ),
             };
             events.push((frame, command));
@@ -209,8 +225,11 @@ mod tests {
 
     #[test]
     fn parses_every_command_and_sorts_by_frame() {
-        let s = Script::parse("zoom:2@20; orbit:30,0@10;pan:-5,7.5@10;key:F@3;denoiser:svgf@1;split:taa@2;split:off@4")
-            .expect("parses");
+        let s = Script::parse(
+            "zoom:2@20; orbit:30,0@10;pan:-5,7.5@10;key:F@3;denoiser:svgf@1;split:taa@2;\
+             split:off@4;tf:phantom-layered@6",
+        )
+        .expect("parses");
         let at = |f| s.at(f).cloned().collect::<Vec<_>>();
         assert_eq!(
             at(10),
@@ -224,6 +243,8 @@ mod tests {
         assert_eq!(at(1), vec![Command::Denoiser("svgf".into())]);
         assert_eq!(at(2), vec![Command::Split(Some("taa".into()))]);
         assert_eq!(at(4), vec![Command::Split(None)]);
+        let soft = TransferFunction::preset("phantom-layered").expect("preset");
+        assert_eq!(at(6), vec![Command::Tf(Box::new(soft))]);
         assert!(at(5).is_empty());
     }
 
@@ -236,6 +257,8 @@ mod tests {
             ("key:q@1", "unknown key"),
             ("zoom:x@1", "STEPS"),
             ("zoom:1@x", "bad frame"),
+            ("tf:no-such-preset@1", "no-such-preset"),
+            ("tf:missing/tf.toml@1", "missing/tf.toml"),
         ] {
             let e = format!("{:#}", Script::parse(text).expect_err(text));
             assert!(e.contains(needle), "{text}: {e}");

@@ -14,12 +14,14 @@
 //!
 //! Here: the arguments and the explorer's state. `window.rs` the window, its device and
 //! swapchain, and winit's events; `model.rs` model application; `frame.rs` the frame and
-//! what happens to its results; `ui.rs` the panel that edits the model.
+//! what happens to its results; `moving.rs` the rendered size while the view moves;
+//! `ui.rs` the panel that edits the model.
 
 mod camera;
 mod frame;
 mod input;
 mod model;
+mod moving;
 mod overlay;
 mod record;
 mod tf_editor;
@@ -41,9 +43,11 @@ use dvr_engine::renderer::{
 };
 use dvr_engine::scene::VolumeSource;
 use input::{apply_to_camera, Command, DragKind, Key, Pointer, Script};
+use moving::MovingScale;
 use overlay::EguiOverlay;
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
 use record::Recorder;
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -95,8 +99,23 @@ pub struct ExploreArgs {
     /// Scripted input, e.g. "orbit:30,0@10;zoom:2@20" (see README, Explorer).
     #[arg(long)]
     pub script: Option<String>,
+    /// GPU ms per frame to aim for while the view moves: a still frame slower than this
+    /// makes camera, light and TF changes render at 1/k of the view per side (k ≤ 8,
+    /// upsampled); 0 keeps every frame at full size. Off while recording.
+    #[arg(long, default_value_t = 100.0, value_parser = parse_moving_ms)]
+    pub moving_ms: f32,
     #[command(flatten)]
     pub render: crate::RenderArgs,
+}
+
+/// `--moving-ms`: a finite number of milliseconds, 0 or more.
+fn parse_moving_ms(s: &str) -> std::result::Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!(
+            "'{s}' is not a frame time in ms (a finite number, 0 or more)"
+        )),
+    }
 }
 
 /// True when the environment names an X11 or Wayland display.
@@ -151,6 +170,14 @@ pub fn run(args: ExploreArgs) -> Result<()> {
     app.finish()
 }
 
+/// What the view shows: a change of it is a motion (see [`moving`]).
+#[derive(Clone, PartialEq)]
+struct ViewKey {
+    camera: dvr_engine::scene::CameraSpec,
+    lights: Vec<dvr_engine::scene::Light>,
+    tf: dvr_engine::transfer::TransferFunction,
+}
+
 struct Explorer {
     args: ExploreArgs,
     setup: SceneSetup,
@@ -169,13 +196,21 @@ struct Explorer {
     recorder: Option<Recorder>,
     /// Frames submitted so far.
     frame: u64,
+    /// Fewer pixels while the view moves (`--moving-ms`).
+    moving: MovingScale,
+    /// Last frame's camera, lights and TF: what a change is measured against.
+    last_view: Option<ViewKey>,
+    /// (divisor, rendered size) of each submitted frame whose results have not come
+    /// back, oldest first (results arrive in submission order).
+    in_flight: VecDeque<(u32, (u32, u32))>,
     resized: bool,
     /// Frame indices whose results should be saved as F12 screenshots.
     shots: Vec<u64>,
     shot_count: u32,
     last_screenshot: Option<Screenshot>,
     frame_started: Option<Instant>,
-    frame_ms: Vec<f32>,
+    /// CPU frame intervals, ms, with the divisor each frame was rendered at.
+    frame_ms: Vec<(f32, u32)>,
     /// UI textures egui released, freed after the frames in flight.
     free_textures: Vec<egui::TextureId>,
     /// (pass, total GPU ms, frames) after the warm-up, for the summary.
@@ -216,6 +251,12 @@ impl Explorer {
         };
         let egui_ctx = egui::Context::default();
         ui::style(&egui_ctx);
+        // Recorded frames keep one size, the one the replay renders.
+        let moving = MovingScale::new(if args.record.is_some() {
+            0.0
+        } else {
+            args.moving_ms
+        });
         Ok(Self {
             args,
             setup,
@@ -231,6 +272,9 @@ impl Explorer {
             window: None,
             recorder,
             frame: 0,
+            moving,
+            last_view: None,
+            in_flight: VecDeque::new(),
             resized: false,
             shots: Vec::new(),
             shot_count: 0,

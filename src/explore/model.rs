@@ -80,6 +80,11 @@ impl Explorer {
                 Err(e) => self.ui.set_status(e.to_string()),
             },
             Command::Split(right) => self.model.right = right.clone(),
+            Command::Tf(tf) => {
+                self.model.tf = (**tf).clone();
+                self.ui.tf_editor.selected = None;
+                self.ui.tf_editor.dragging = None;
+            }
             _ => {}
         }
     }

@@ -18,7 +18,8 @@ const PICK_RADIUS: f32 = 8.0;
 
 pub struct TfEditor {
     pub selected: Option<usize>,
-    dragging: Option<usize>,
+    /// The control point under a drag (a drag held counts as the view moving).
+    pub dragging: Option<usize>,
     presets: Vec<String>,
     pub path: String,
     pub message: String,

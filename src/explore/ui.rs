@@ -44,6 +44,8 @@ pub struct Model {
 pub struct Stats {
     pub device: String,
     pub render_size: (u32, u32),
+    /// Pixels per side one rendered pixel stands for (1; more while the view moves).
+    pub divisor: u32,
     pub present_mode: String,
     /// How the volume is held on the device: "dense volume" or the brick pool's residency.
     pub volume: String,
@@ -191,10 +193,14 @@ fn panel(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model, requests: &m
     };
     ui.label(
         RichText::new(format!(
-            "{} · {}×{} · {fps:.1} fps{}",
+            "{} · {}×{}{} · {fps:.1} fps{}",
             state.stats.device,
             state.stats.render_size.0,
             state.stats.render_size.1,
+            match state.stats.divisor {
+                k if k > 1 => format!(" (1/{k}, moving)"),
+                _ => String::new(),
+            },
             if state.recording { " · ● rec" } else { "" }
         ))
         .small(),

@@ -2,7 +2,7 @@
 //! image, usually the acquired swapchain image, with the project's one tone map (the
 //! GLSL twin of [`crate::metrics::tonemap_srgb`]). It can show two denoisers side by
 //! side (a split view) and places the frame at an offset, filling the rest with a
-//! background colour.
+//! background colour; a frame rendered smaller than its place is upsampled bilinearly.
 
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline};
@@ -19,8 +19,12 @@ gpu_block! {
         pub offset_y: i32,
         pub source_width: u32,
         pub source_height: u32,
+        pub view_width: u32,
+        pub view_height: u32,
         pub split_x: i32,
         pub exposure: f32,
+        pub pad0: f32,
+        pub pad1: f32,
         pub background: Vec4,
     }
 }
@@ -30,8 +34,11 @@ gpu_block! {
 pub struct PresentLayout {
     /// Top-left corner of the frame in the target, in pixels.
     pub offset: [i32; 2],
-    /// Columns of the frame left of this come from `left`, the rest from `right`;
-    /// `None` shows `left` only.
+    /// The frame's size in the target: `None` is the source's size (pixel for pixel); a
+    /// larger one upsamples the source bilinearly (the explorer while the view moves).
+    pub size: Option<[u32; 2]>,
+    /// Columns of the frame (in target pixels) left of this come from `left`, the rest
+    /// from `right`; `None` shows `left` only.
     pub split_x: Option<u32>,
     /// Linear scale before the tone map (1 = as rendered).
     pub exposure: f32,
@@ -43,6 +50,7 @@ impl Default for PresentLayout {
     fn default() -> Self {
         Self {
             offset: [0, 0],
+            size: None,
             split_x: None,
             exposure: 1.0,
             background: [0.0; 3],
@@ -74,6 +82,7 @@ impl Present {
         target_size: Extent,
         layout: &PresentLayout,
     ) {
+        let [view_width, view_height] = layout.size.unwrap_or([source.width, source.height]);
         let push = PresentPush {
             target_width: target_size.width,
             target_height: target_size.height,
@@ -81,10 +90,14 @@ impl Present {
             offset_y: layout.offset[1],
             source_width: source.width,
             source_height: source.height,
+            view_width,
+            view_height,
             split_x: layout
                 .split_x
                 .map_or(i32::MAX, |x| x.min(i32::MAX as u32) as i32),
             exposure: layout.exposure,
+            pad0: 0.0,
+            pad1: 0.0,
             background: Vec4::new(
                 layout.background[0],
                 layout.background[1],
