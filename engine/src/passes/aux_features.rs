@@ -5,6 +5,7 @@
 //! only (a pipeline without the normal's six extra fetches a step), when SVGF reads them
 //! to demodulate (`include/svgf.glsl`, `svgf_demod_factor`).
 
+use super::path_trace::volume_specialization;
 use super::surface_features::STEP_VOXELS;
 use super::SceneBindings;
 use crate::error::Result;
@@ -35,11 +36,15 @@ pub struct AuxFeatures {
 }
 
 impl AuxFeatures {
-    pub fn new(ctx: &GpuContext) -> Result<Self> {
+    /// `pooled`: the volume is paged through the brick pool.
+    pub fn new(ctx: &GpuContext, pooled: bool) -> Result<Self> {
+        let volume = volume_specialization(pooled);
         Ok(Self {
-            pipeline: ctx.pipeline("aux_features", &[])?,
-            albedo_only: ctx
-                .pipeline("aux_features", &[("GUIDE_NORMALS", SpecValue::Bool(false))])?,
+            pipeline: ctx.pipeline("aux_features", &[volume])?,
+            albedo_only: ctx.pipeline(
+                "aux_features",
+                &[("GUIDE_NORMALS", SpecValue::Bool(false)), volume],
+            )?,
         })
     }
 

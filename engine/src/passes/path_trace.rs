@@ -24,29 +24,38 @@ gpu_block! {
 }
 
 /// What the pipeline is specialised for (what the scene uses): the render settings'
-/// [`PipelineKey`] and whether an environment map is bound.
+/// [`PipelineKey`], whether an environment map is bound and whether the volume is paged
+/// through the brick pool.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct PathTraceFeatures {
     pub estimator: Estimator,
     pub phase: Phase,
     pub emission: bool,
     pub environment_map: bool,
+    pub pooled_volume: bool,
 }
 
 impl PathTraceFeatures {
-    pub fn new(key: PipelineKey, environment_map: bool) -> Self {
+    pub fn new(key: PipelineKey, environment_map: bool, pooled_volume: bool) -> Self {
         Self {
             estimator: key.estimator,
             phase: key.phase,
             emission: key.emission,
             environment_map,
+            pooled_volume,
         }
     }
 }
 
+/// The specialisation of a pipeline that reads the volume (include/volume.glsl): the
+/// dense texture, or the brick pool.
+pub fn volume_specialization(pooled: bool) -> (&'static str, SpecValue) {
+    ("POOLED_VOLUME", SpecValue::Bool(pooled))
+}
+
 /// The specialisation constants of a pipeline that traces paths (include/path.glsl):
 /// the path tracer's, and ours' temporal-gradient pass, which must trace the same paths.
-pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue); 4] {
+pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue); 5] {
     let estimator = match features.estimator {
         Estimator::Delta => ESTIMATOR_DELTA,
         Estimator::RayMarch => ESTIMATOR_RAY_MARCH,
@@ -61,6 +70,7 @@ pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue)
         ("PHASE", SpecValue::I32(phase)),
         ("USE_EMISSION", SpecValue::Bool(features.emission)),
         ("HAS_ENV_MAP", SpecValue::Bool(features.environment_map)),
+        volume_specialization(features.pooled_volume),
     ]
 }
 

@@ -6,6 +6,7 @@ use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline};
 use crate::gpu_block;
 use crate::graph::{Extent, Frame, History, ImageHandle, RenderGraph};
+use crate::passes::path_trace::volume_specialization;
 use ash::vk;
 
 gpu_block! {
@@ -37,9 +38,10 @@ pub struct FeatureImages {
 }
 
 impl SurfaceFeatures {
-    pub fn new(ctx: &GpuContext) -> Result<Self> {
+    /// `pooled`: the volume is paged through the brick pool.
+    pub fn new(ctx: &GpuContext, pooled: bool) -> Result<Self> {
         Ok(Self {
-            pipeline: ctx.pipeline("surface_features", &[])?,
+            pipeline: ctx.pipeline("surface_features", &[volume_specialization(pooled)])?,
         })
     }
 

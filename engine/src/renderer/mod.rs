@@ -158,7 +158,6 @@ pub struct Renderer {
     bricks: scene_gpu::BrickRanges,
     /// The volume as loaded: the brick pool reads its bricks from it.
     volume: Arc<VolumeUpload>,
-    volume_path: VolumePath,
     /// Which brick is in which pool slot (the pool path only).
     residency: Option<Residency>,
     /// The brick table changed since it was last uploaded.
@@ -198,17 +197,19 @@ impl Renderer {
     ) -> Result<Self> {
         let ctx = ctx.into();
         check_spp(&ctx, settings.spp(), config.size)?;
-        let features = PathTraceFeatures::new(settings.pipeline_key(), environment.is_some());
         // What the caller can get wrong (a denoiser's name, what it needs) is checked
         // before the graph exists: the graph's samplers and images are released only by
         // `RenderGraph::destroy`, which an early return here would skip.
         // So is a volume not even a brick pool can hold in the budget: found here, the
         // error is not preceded by the allocator's reports of leaked buffers.
         let volume_path = scene_gpu::plan_volume(&ctx, &volume, config.gpu_memory)?;
+        let pooled = matches!(volume_path, VolumePath::Pool(_));
+        let features =
+            PathTraceFeatures::new(settings.pipeline_key(), environment.is_some(), pooled);
         let denoisers = create_methods(&ctx, &config, features, denoisers)?;
         let mut graph = RenderGraph::new(&ctx)?;
         let passes = Passes {
-            features: SurfaceFeatures::new(&ctx)?,
+            features: SurfaceFeatures::new(&ctx, pooled)?,
             path_trace: PathTrace::new(&ctx, features)?,
             motion: Motion::new(&ctx)?,
             accumulate: Accumulate::new(&ctx)?,
@@ -283,7 +284,6 @@ impl Renderer {
                     brick_pool::pool_ranges(&volume.bricks),
                 )),
             },
-            volume_path,
             volume,
             table_dirty: false,
             over_budget: false,
@@ -396,10 +396,6 @@ impl Renderer {
             majorant_max,
             volume_dims: self.volume_dims,
             brick: self.bricks.brick,
-            pool_brick: match self.volume_path {
-                VolumePath::Dense => 0,
-                VolumePath::Pool(_) => brick_pool::BRICK,
-            },
             lights: &inputs.lights,
             stream,
             max_bounces: s.max_bounces(),
@@ -440,7 +436,7 @@ impl Renderer {
         }
         let guides = self.denoisers.iter().any(|m| m.info.guides());
         if (request.aux || guides) && self.passes.aux.is_none() {
-            self.passes.aux = Some(AuxFeatures::new(&self.ctx)?);
+            self.passes.aux = Some(AuxFeatures::new(&self.ctx, self.features.pooled_volume)?);
         }
         let reset = request.reset || std::mem::take(&mut self.pending_reset);
         let changes = self.changes(inputs, reset);

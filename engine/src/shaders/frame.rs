@@ -116,8 +116,6 @@ pub struct FrameParams<'a> {
     pub volume_dims: [u32; 3],
     /// Edge of a majorant-grid brick in voxels.
     pub brick: u32,
-    /// Edge of a brick-pool brick in voxels; 0 when the volume is one dense texture.
-    pub pool_brick: u32,
     /// At most [`MAX_LIGHTS`] (scenes and the renderer refuse more).
     pub lights: &'a [GpuLight],
     pub stream: SampleStream,
@@ -154,7 +152,7 @@ impl FrameBlock {
             counts: IVec4::new(
                 p.lights.len().min(MAX_LIGHTS) as i32,
                 p.stream.index(),
-                p.pool_brick as i32,
+                0,
                 p.max_bounces as i32,
             ),
             params: Vec4::new(p.step, p.hg_g, p.feature_threshold, p.filter_sigma),
@@ -252,7 +250,6 @@ mod tests {
             majorant_max: 7.0,
             volume_dims: [8, 9, 10],
             brick: 4,
-            pool_brick: 0,
             lights: &[light],
             stream: SampleStream::Frame(5),
             max_bounces: 6,

@@ -26,7 +26,7 @@ layout(binding = 0, std140) uniform FrameBlock {
     vec4 box_min;        // volume bounds in world space, w = density scale (μt per opacity)
     vec4 box_max;        // w = majorant over the whole volume
     ivec4 dims;          // volume voxels xyz, w = majorant grid brick edge in voxels
-    ivec4 counts;        // x lights, y frame index, z pool brick edge (0: dense volume), w max bounces
+    ivec4 counts;        // x lights, y frame index, z unused, w max bounces
     vec4 params;         // x ray-march step (world), y HG g, z feature opacity threshold, w filter sigma (pixels)
     uvec4 seeds;         // x seed, y sample offset (progressive accumulation), z rr depth, w width
     Light lights[MAX_LIGHTS];

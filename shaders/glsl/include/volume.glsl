@@ -4,14 +4,15 @@
 #define DVR_VOLUME_GLSL
 
 #include "frame.glsl"
+#include "specialization.glsl"
 
 layout(binding = 1) uniform sampler3D volume_density;      // normalised density [0,1]
 layout(binding = 2) uniform sampler1D tf_diffuse_opacity;  // rgb albedo, a opacity
 layout(binding = 3) uniform sampler1D tf_specular_roughness;
 layout(binding = 4) uniform sampler1D tf_emissive;
 layout(binding = 5) uniform sampler3D majorant_grid;       // max μt per brick (texelFetch)
-// The brick pool (engine/src/renderer/brick_pool.rs), read when frame.counts.z is set;
-// volume_density is then the coarse copy beneath it.
+// The brick pool (engine/src/renderer/brick_pool.rs), read when the pipeline is
+// specialised for it (POOLED_VOLUME); volume_density is then the coarse copy beneath it.
 layout(binding = 30) uniform sampler3D brick_pool;         // resident bricks with aprons
 layout(binding = 31) uniform sampler3D brick_table;        // per brick: slot, stand-in (texelFetch)
 
@@ -47,7 +48,7 @@ float pool_density(vec3 voxel, ivec3 b, vec2 entry) {
     return texture(brick_pool, t / vec3(pool)).r;
 }
 
-bool pooled() { return frame.counts.z != 0; }
+bool pooled() { return POOLED_VOLUME; }
 
 float density_at(vec3 p) {
     if (pooled()) {
