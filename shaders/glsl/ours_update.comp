@@ -80,14 +80,16 @@ float moment_noise(ivec2 q) {
     return max(m.y - m.x * m.x, 0.0) / max(pc.spp - 1.0, 1.0);
 }
 
-// R of a pixel without history: the moments' noise over the 3×3 neighbourhood (one
-// pixel's two samples say too little); at 1 spp, which has no moments, the spread of the
-// 3×3 pixels' luminance (signal detail included: an overestimate, which only slows the
-// first frames).
+// R of a pixel without history, and this frame's measurement of R: the moments' noise
+// over the 5×5 neighbourhood (one pixel's two samples say too little); at 1 spp, which has
+// no moments, the spread of the 5×5 pixels' luminance (signal detail included: an
+// overestimate, which only slows the first frames). Under heavy tails 3×3 was too few:
+// where no bright path landed in 18 samples R came out near zero, the filter looked
+// converged on a low mean, and the à-trous kept it as a dark blotch (static views).
 float fresh_noise(ivec2 p, ivec2 size) {
     float sum = 0.0, s1 = 0.0, s2 = 0.0;
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
             ivec2 q = clamp(p + ivec2(dx, dy), ivec2(0), size - 1);
             if (pc.spp >= 2.0) {
                 sum += moment_noise(q);
@@ -99,8 +101,8 @@ float fresh_noise(ivec2 p, ivec2 size) {
             }
         }
     }
-    if (pc.spp >= 2.0) return sum / 9.0 + TINY;
-    return max(s2 / 9.0 - (s1 / 9.0) * (s1 / 9.0), 0.0) * 9.0 / 8.0 + TINY;
+    if (pc.spp >= 2.0) return sum / 25.0 + TINY;
+    return max(s2 / 25.0 - (s1 / 25.0) * (s1 / 25.0), 0.0) * 25.0 / 24.0 + TINY;
 }
 
 void main() {
