@@ -1,10 +1,10 @@
 //! Recovery after sudden changes on the built-in stress scenes: after the transfer
-//! function or the light jumps, `ours` comes back to within 1 dB of the PSNR (against
-//! high-sample references) it reaches on the post-jump state when that state has been
-//! static for as long as the pre-jump one was — the level a jump-free history gives. The
-//! pre-jump PSNR itself is not the target: a jump may move the scene to a state that is
-//! intrinsically noisier (a light moved behind the volume), which no denoiser recovers
-//! from.
+//! function or the light jumps, `ours` must do as well as a filter restarted at the jump,
+//! age for age: from the jump on, no frame more than 1 dB (against high-sample references)
+//! below a renderer that starts from a fresh history on the post-jump state (the scenes
+//! hold still after their jump). A filter that kept its pre-jump history would be several
+//! dB below for many frames; the pre-jump PSNR itself is not the target (a jump may move
+//! the scene to a state that is intrinsically noisier, a light moved behind the volume).
 
 mod common;
 
@@ -18,11 +18,11 @@ use dvr_engine::scene::Scene;
 const SIZE: u32 = 24;
 const FRAMES: u32 = 30;
 const REFERENCE_SPP: u32 = 128;
-/// The bound this test asserts. A method that forgets perfectly at the jump and then
-/// averages needs about 0.8 × (frames before the jump) to come within 1 dB of the
-/// jump-free level (10·log10(15/12) ≈ 1 dB). Measured for `ours` (a model restarts once
-/// its residual is far above the noise level twice in a row): tf-jump 11, light-jump 5.
-const MAX_RECOVERY_FRAMES: usize = 12;
+/// The bound this test asserts, dB below the restarted filter at the same age. Measured
+/// for `ours` (24², 2 spp, 15 frames after the jump): tf-jump at most 0.89, light-jump at
+/// most 0.93, both within the first frames above the restart (the gradients carry the
+/// history over) and below it later (the carried noise estimate re-averages).
+const MAX_DEFICIT_DB: f64 = 1.0;
 
 fn rgb(px: &[[f32; 4]]) -> Rgb32Image {
     Rgb32Image {
@@ -32,7 +32,9 @@ fn rgb(px: &[[f32; 4]]) -> Rgb32Image {
     }
 }
 
-fn recovery(scene_name: &str, method: &str) -> (usize, Option<usize>, Vec<f64>, f64) {
+/// (the jump's frame, PSNR per frame from the jump on, the restarted filter's at the same
+/// ages).
+fn recovery(scene_name: &str, method: &str) -> (usize, Vec<f64>, Vec<f64>) {
     let scene = Scene::builtin(scene_name)
         .expect("scene")
         .with_frames(FRAMES)
@@ -83,40 +85,56 @@ fn recovery(scene_name: &str, method: &str) -> (usize, Option<usize>, Vec<f64>, 
         })
         .collect();
     drop(r);
-    // The jump-free level: the post-jump state held static for `event` frames.
+    // A filter restarted at the jump: the post-jump state from a fresh history, scored at
+    // the same ages as the jumped run (the scenes hold still after their jump).
     let post = setup.frame_inputs(event as u32);
     let mut b = setup.renderer(context(), &[method]).expect("renderer");
-    let mut last = Vec::new();
-    for _ in 0..event {
+    let mut restarted = Vec::new();
+    for _ in event..FRAMES as usize {
         if let Some(done) = b.frame(&post, &request).expect("frame") {
-            last = done.images[0].1.clone();
+            restarted.push(done.images[0].1.clone());
         }
     }
-    if let Some(done) = b.flush().expect("flush").pop() {
-        last = done.images[0].1.clone();
-    }
-    let level = score(
-        &last,
-        &b.reference(&post, REFERENCE_SPP, 4).expect("reference"),
+    restarted.extend(
+        b.flush()
+            .expect("flush")
+            .into_iter()
+            .map(|d| d.images[0].1.clone()),
     );
-    let recovered = series.iter().position(|&p| p >= level - 1.0).map(|k| k + 1);
-    (event, recovered, series, level)
+    let reference = b.reference(&post, REFERENCE_SPP, 4).expect("reference");
+    let fresh: Vec<f64> = restarted.iter().map(|o| score(o, &reference)).collect();
+    (event, series, fresh)
 }
 
 #[test]
 fn ours_recovers_after_tf_and_light_jumps() {
     for scene in ["phantom/tf-jump", "phantom/light-jump"] {
-        let (event, frames, series, level) = recovery(scene, "ours");
-        let pretty: Vec<String> = series.iter().map(|p| format!("{p:.1}")).collect();
+        let (event, series, fresh) = recovery(scene, "ours");
+        let show = |v: &[f64]| {
+            v.iter()
+                .map(|p| format!("{p:.1}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
         println!(
             "{scene}: jump at frame {event}; PSNR from the jump on: {}",
-            pretty.join(" ")
+            show(&series)
         );
-        println!("{scene}: jump-free level {level:.1} dB; frames to within 1 dB: {frames:?}");
-        let frames = frames.unwrap_or(usize::MAX);
+        println!(
+            "{scene}: restarted at the jump, same ages:  {}",
+            show(&fresh)
+        );
+        assert_eq!(series.len(), fresh.len());
+        let (deficit, age) = series
+            .iter()
+            .zip(&fresh)
+            .enumerate()
+            .map(|(k, (s, f))| (f - s, k + 1))
+            .fold((f64::MIN, 0), |a, b| if b.0 > a.0 { b } else { a });
+        println!("{scene}: at most {deficit:.2} dB below the restart (age {age})");
         assert!(
-            frames <= MAX_RECOVERY_FRAMES,
-            "{scene}: {frames} frames to recover"
+            deficit <= MAX_DEFICIT_DB,
+            "{scene}: {deficit:.2} dB below a filter restarted at the jump, {age} frames after it"
         );
     }
     assert_validation_clean();
