@@ -12,7 +12,7 @@ use common::*;
 use dvr_engine::graph::Extent;
 use dvr_engine::metrics::{psnr, tonemap_srgb, Rgb32Image};
 use dvr_engine::renderer::scene_setup::SceneSetup;
-use dvr_engine::renderer::FrameRequest;
+use dvr_engine::renderer::{FrameInputs, FrameRequest, Renderer};
 use dvr_engine::scene::Scene;
 
 const SIZE: u32 = 24;
@@ -30,6 +30,25 @@ fn rgb(px: &[[f32; 4]]) -> Rgb32Image {
         height: SIZE,
         data: px.iter().map(|p| [p[0], p[1], p[2]]).collect(),
     }
+}
+
+/// `r`'s output for each of `frames`, in order (the frames in flight flushed at the end).
+fn render_all(r: &mut Renderer, frames: impl Iterator<Item = FrameInputs>) -> Vec<Vec<[f32; 4]>> {
+    let request = FrameRequest {
+        readback: true,
+        reset: false,
+        aux: false,
+        features: false,
+    };
+    let mut outputs = Vec::new();
+    for inputs in frames {
+        if let Some(done) = r.frame(&inputs, &request).expect("frame") {
+            outputs.push(done.images[0].1.clone());
+        }
+    }
+    let flushed = r.flush().expect("flush");
+    outputs.extend(flushed.into_iter().map(|d| d.images[0].1.clone()));
+    outputs
 }
 
 /// (the jump's frame, PSNR per frame from the jump on, the restarted filter's at the same
@@ -52,24 +71,7 @@ fn recovery(scene_name: &str, method: &str) -> (usize, Vec<f64>, Vec<f64>) {
         })
         .expect("the scene has a jump") as usize;
     let mut r = setup.renderer(context(), &[method]).expect("renderer");
-    let mut outputs = Vec::new();
-    let request = FrameRequest {
-        readback: true,
-        reset: false,
-        aux: false,
-        features: false,
-    };
-    for f in 0..FRAMES {
-        if let Some(done) = r.frame(&setup.frame_inputs(f), &request).expect("frame") {
-            outputs.push(done.images[0].1.clone());
-        }
-    }
-    outputs.extend(
-        r.flush()
-            .expect("flush")
-            .into_iter()
-            .map(|d| d.images[0].1.clone()),
-    );
+    let outputs = render_all(&mut r, (0..FRAMES).map(|f| setup.frame_inputs(f)));
     let score = |out: &[[f32; 4]], reference: &[[f32; 4]]| {
         psnr(
             &tonemap_srgb(&rgb(out), 1.0),
@@ -89,18 +91,7 @@ fn recovery(scene_name: &str, method: &str) -> (usize, Vec<f64>, Vec<f64>) {
     // the same ages as the jumped run (the scenes hold still after their jump).
     let post = setup.frame_inputs(event as u32);
     let mut b = setup.renderer(context(), &[method]).expect("renderer");
-    let mut restarted = Vec::new();
-    for _ in event..FRAMES as usize {
-        if let Some(done) = b.frame(&post, &request).expect("frame") {
-            restarted.push(done.images[0].1.clone());
-        }
-    }
-    restarted.extend(
-        b.flush()
-            .expect("flush")
-            .into_iter()
-            .map(|d| d.images[0].1.clone()),
-    );
+    let restarted = render_all(&mut b, (event..FRAMES as usize).map(|_| post.clone()));
     let reference = b.reference(&post, REFERENCE_SPP, 4).expect("reference");
     let fresh: Vec<f64> = restarted.iter().map(|o| score(o, &reference)).collect();
     (event, series, fresh)

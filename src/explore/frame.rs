@@ -107,6 +107,7 @@ impl Explorer {
         let finished = renderer.resize(rendered)?;
         self.ui.stats.render_size = (rw, rh);
         self.ui.stats.divisor = divisor;
+        self.ui.stats.view = (vw, vh);
         self.ui.stats.volume = renderer.volume_residency().to_string();
         let Some(image) = gfx.swapchain.acquire()? else {
             gfx.recreate_swapchain(size)?;
@@ -270,8 +271,8 @@ impl Explorer {
                 self.started.elapsed().as_secs_f64(),
                 mean,
                 1000.0 / mean,
-                self.args.size.0,
-                self.args.size.1,
+                self.ui.stats.view.0,
+                self.ui.stats.view.1,
             );
             if timed.iter().any(|f| f.1 > 1) {
                 let mut divisors: Vec<u32> = timed.iter().map(|f| f.1).collect();

@@ -44,6 +44,8 @@ pub struct Model {
 pub struct Stats {
     pub device: String,
     pub render_size: (u32, u32),
+    /// The view the frame fills (the render size times the divisor, about).
+    pub view: (u32, u32),
     /// Pixels per side one rendered pixel stands for (1; more while the view moves).
     pub divisor: u32,
     pub present_mode: String,
