@@ -45,7 +45,7 @@ layout(binding = 5, r32f) uniform writeonly image2D noise_cur;
 layout(binding = 6, rgba32f) uniform writeonly image2D prediction;  // rgb, a variance
 layout(binding = 7, rgba32f) uniform writeonly image2D residual;    // rgb, a variance (< 0: none)
 layout(binding = 8) uniform sampler2D lag_prev;                      // rgb mean, a variance
-layout(binding = 9, rgba32f) uniform readonly image2D moments;       // x mean, y 2nd moment of luminance
+layout(binding = 9, rgba32f) uniform readonly image2D noise_rows;    // ours_noise.comp: row sums of R's measurement
 layout(binding = 10) uniform sampler2D residual_prev;                // last frame's `residual`
 
 layout(push_constant) uniform OursUpdatePush {
@@ -74,35 +74,20 @@ const float STILL_PX = 0.01;
 // residual has a third of one frame's noise variance.
 const float LAG_BLEND = 0.5;
 
-// The variance of this frame's pixel mean at `q` from its samples' luminance moments.
-float moment_noise(ivec2 q) {
-    vec2 m = imageLoad(moments, q).xy;
-    return max(m.y - m.x * m.x, 0.0) / max(pc.spp - 1.0, 1.0);
-}
-
 // R of a pixel without history, and this frame's measurement of R: the moments' noise
 // over the 5×5 neighbourhood (one pixel's two samples say too little); at 1 spp, which has
 // no moments, the spread of the 5×5 pixels' luminance (signal detail included: an
 // overestimate, which only slows the first frames). Under heavy tails 3×3 was too few:
 // where no bright path landed in 18 samples R came out near zero, the filter looked
 // converged on a low mean, and the à-trous kept it as a dark blotch (static views).
+// ours_noise.comp summed each row's 5 pixels; this sums 5 rows.
 float fresh_noise(ivec2 p, ivec2 size) {
-    float sum = 0.0, s1 = 0.0, s2 = 0.0;
+    vec3 s = vec3(0.0);
     for (int dy = -2; dy <= 2; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
-            ivec2 q = clamp(p + ivec2(dx, dy), ivec2(0), size - 1);
-            if (pc.spp >= 2.0) {
-                sum += moment_noise(q);
-            } else {
-                vec3 c = imageLoad(noisy, q).rgb;
-                float y = all_finite(c) ? luminance(c) : 0.0;
-                s1 += y;
-                s2 += y * y;
-            }
-        }
+        s += imageLoad(noise_rows, ivec2(p.x, clamp(p.y + dy, 0, size.y - 1))).xyz;
     }
-    if (pc.spp >= 2.0) return sum / 25.0 + TINY;
-    return max(s2 / 25.0 - (s1 / 25.0) * (s1 / 25.0), 0.0) * 25.0 / 24.0 + TINY;
+    if (pc.spp >= 2.0) return s.x / 25.0 + TINY;
+    return max(s.z / 25.0 - (s.y / 25.0) * (s.y / 25.0), 0.0) * 25.0 / 24.0 + TINY;
 }
 
 void main() {

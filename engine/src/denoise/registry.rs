@@ -150,7 +150,7 @@ pub const DENOISERS: &[DenoiserInfo] = &[
     ),
     ours(
         "ours",
-        "a per-pixel Kalman filter told by temporal gradients how much the scene changed, with a pooled lag test and an à-trous filter",
+        "a per-pixel Kalman filter told by temporal gradients how much the scene changed, with a pooled lag test, a spatial prior on the guide albedo and an à-trous filter",
         OURS,
     ),
     // Ablations of ours: one part each.
@@ -163,6 +163,11 @@ pub const DENOISERS: &[DenoiserInfo] = &[
         "ours-no-lag",
         "ours without the pooled lag test",
         OursVariant { lag: false, ..OURS },
+    ),
+    ours(
+        "ours-no-prior",
+        "ours without the spatial prior (young estimates left to the à-trous alone)",
+        OursVariant { prior: false, ..OURS },
     ),
     ours(
         "ours-no-atrous",
@@ -227,7 +232,11 @@ impl DenoiserInfo {
     /// Whether it reads the guide albedo composited along the ray
     /// ([`DenoiseInputs::guides`](super::DenoiseInputs::guides)): SVGF demodulates by it.
     pub fn guides(&self) -> bool {
-        matches!(self.kind, Kind::Svgf)
+        match self.kind {
+            Kind::Svgf => true,
+            Kind::Ours(v) => v.prior,
+            _ => false,
+        }
     }
 
     /// Builds the denoiser.
@@ -306,7 +315,7 @@ mod tests {
 
     #[test]
     fn each_ablation_of_ours_switches_one_part_off() {
-        let parts = |v: OursVariant| [v.gradients, v.lag, v.atrous];
+        let parts = |v: OursVariant| [v.gradients, v.lag, v.prior, v.atrous];
         let ours = parts(OURS);
         assert!(ours.iter().all(|&on| on), "ours has every part");
         let mut ablations = 0;
@@ -318,7 +327,7 @@ mod tests {
                 ablations += expected;
             }
         }
-        assert_eq!(ablations, 3, "one ablation per part");
+        assert_eq!(ablations, 4, "one ablation per part");
     }
 
     #[test]

@@ -1,31 +1,39 @@
 //! `ours`: a per-pixel local-level Kalman filter on the radiance, told by temporal
-//! gradients how much the scene changed, checked by a pooled lag test, and filtered in
+//! gradients how much the scene changed, checked by a pooled lag test, leaning where it is
+//! young on a local linear model of its neighbours on the guide albedo, and filtered in
 //! space by an à-trous wavelet on the filters' own variances.
 //!
 //! The model (what the state is, what the noise is, where each comes from) is stated in
 //! `shaders/glsl/ours_update.comp`; in short, per pixel x_t = g_t ∘ x_{t−1} + w_t (Q_t)
 //! and y_t = x_t + v_t (R_t), with g_t the measured change, Q_t what the prediction may
 //! have missed (a share of the measured change, camera motion, a shift the lag test found),
-//! and R_t the samples' own variance.
+//! and R_t the samples' own variance. The spatial prior (`shaders/glsl/ours_prior.comp`)
+//! is a second measurement of each estimate, from its neighbourhood.
 //!
 //! Passes of a frame, in order (each in its own file here):
 //! - `<name>.gradient` ([`gradient`], `ours_gradient.comp`): temporal gradients, when the
 //!   scene changed: last frame's samples re-traced in this frame's scene;
 //! - `<name>.gradient_pool` ([`gradient_pool`], `ours_gradient_pool.comp`): the gradients
 //!   pooled over 3×3, 5×5 and 9×9 strata and shrunk, once per stratum;
-//! - `<name>.update` ([`update`], `ours_update.comp`): the Kalman filter's predict and
+//! - `<name>.noise`, `<name>.update` ([`update`], `ours_noise.comp`, `ours_update.comp`):
+//!   this frame's noise measurement summed over rows, then the Kalman filter's predict and
 //!   update;
 //! - `<name>.lag` ([`lag`], `ours_lag.comp`): the pooled lag test, read by next frame's
 //!   update;
+//! - `<name>.guide`, `<name>.prior_fit`, `<name>.prior` ([`prior`], `ours_guide.comp`,
+//!   `ours_prior_fit.comp`, `ours_prior.comp`): the spatial prior, on the guide albedo
+//!   composited along each ray (`aux_features.comp`, shared with svgf); a frame without
+//!   one (synthetic inputs) goes without;
 //! - `<name>.atrous0..2` ([`atrous`], `variance_atrous.comp`): the à-trous spatial filter.
 //!
-//! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-atrous`) switch one part
-//! off each ([`OursVariant`]).
+//! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-prior`, `ours-no-atrous`)
+//! switch one part off each ([`OursVariant`]).
 
 mod atrous;
 mod gradient;
 mod gradient_pool;
 mod lag;
+mod prior;
 mod update;
 
 use super::variance_atrous::{self, VarianceAtrousPush};
@@ -38,7 +46,8 @@ use ash::vk;
 use gradient::OursGradientPush;
 use gradient_pool::OursGradientPoolPush;
 use lag::OursLagPush;
-use update::OursUpdatePush;
+use prior::PriorPipelines;
+use update::{OursNoisePush, OursUpdatePush};
 
 /// Ours' tunables, each with what it buys (README, "ours").
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -116,6 +125,10 @@ pub struct OursVariant {
     pub lag: bool,
     /// The à-trous spatial filter (without it the estimate is the output).
     pub atrous: bool,
+    /// The spatial prior: each estimate combined with a local linear model of its
+    /// neighbours' on the guide albedo and position, by their variances (without it the
+    /// à-trous filters the estimates as they are).
+    pub prior: bool,
 }
 
 impl OursVariant {
@@ -123,6 +136,7 @@ impl OursVariant {
         gradients: true,
         lag: true,
         atrous: true,
+        prior: true,
     };
 }
 
@@ -134,9 +148,11 @@ pub struct Ours {
     pub motion: MotionSource,
     gradients: Option<Pipeline<OursGradientPush>>,
     gradient_pool: Option<Pipeline<OursGradientPoolPush>>,
+    noise: Pipeline<OursNoisePush>,
     update: Pipeline<OursUpdatePush>,
     lag: Option<Pipeline<OursLagPush>>,
     atrous: Option<Pipeline<VarianceAtrousPush>>,
+    prior: Option<PriorPipelines>,
 }
 
 /// The pooled lag test's window radius (5×5).
@@ -170,6 +186,7 @@ impl Ours {
                 .gradients
                 .then(|| ctx.pipeline("ours_gradient_pool", &[]))
                 .transpose()?,
+            noise: ctx.pipeline("ours_noise", &[])?,
             update: ctx.pipeline("ours_update", &[motion_source])?,
             lag: variant
                 .lag
@@ -181,6 +198,10 @@ impl Ours {
             atrous: variant
                 .atrous
                 .then(|| variance_atrous::pipeline(ctx))
+                .transpose()?,
+            prior: variant
+                .prior
+                .then(|| PriorPipelines::new(ctx))
                 .transpose()?,
         })
     }
@@ -211,6 +232,12 @@ impl Denoiser for Ours {
         let gradients = self.add_gradients(ctx, graph, frame, input)?;
         let estimate = self.add_update(ctx, graph, frame, input, &gradients, &lag)?;
         self.add_lag(frame, input.size, &lag);
+        let estimate = match (&self.prior, input.guides) {
+            (Some(pipelines), Some(guide)) => {
+                self.add_prior(pipelines, ctx, graph, frame, input.size, estimate, guide)?
+            }
+            _ => estimate,
+        };
         match &self.atrous {
             Some(pipeline) => self.add_atrous(pipeline, ctx, graph, frame, input.size, estimate),
             None => Ok(estimate),

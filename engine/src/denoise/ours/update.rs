@@ -1,4 +1,5 @@
-//! `<name>.update` (ours_update.comp): the Kalman filter's predict (the estimate
+//! `<name>.noise` (ours_noise.comp) and `<name>.update` (ours_update.comp): the row sums
+//! of this frame's noise measurement, then the Kalman filter's predict (the estimate
 //! reprojected, scaled by the measured change, shifted by a significant pooled lag) and
 //! update with this frame's noisy colour. State: `model` (rgb estimate, a its variance)
 //! and `noise` (the measurement noise R).
@@ -13,6 +14,16 @@ use crate::gpu_block;
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use ash::vk;
 use glam::Vec4;
+
+gpu_block! {
+    /// `OursNoisePush` in ours_noise.comp.
+    pub struct OursNoisePush {
+        pub width: u32,
+        pub height: u32,
+        pub spp: f32,
+        pub pad: f32,
+    }
+}
 
 gpu_block! {
     /// `OursUpdatePush` in ours_update.comp.
@@ -55,6 +66,7 @@ impl Ours {
         };
         let noise = graph.history(ctx, &format!("{n}.noise"), noise_desc)?;
         let estimate = graph.image(ctx, &format!("{n}.estimate"), desc)?;
+        let rows = graph.image(ctx, &format!("{n}.noise_rows"), desc)?;
         let reproj = input.reprojection(n, self.motion)?;
         let p = self.params;
         let push = OursUpdatePush {
@@ -73,10 +85,21 @@ impl Ours {
             outlier_z: p.outlier_z,
         };
         let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
+        let rows_push = OursNoisePush {
+            width: size.width,
+            height: size.height,
+            spp: input.spp as f32,
+            pad: 0.0,
+        };
+        frame.add_compute(format!("{n}.noise"), &self.noise, rows_push, size, |b| {
+            b.read("noisy", noisy)
+                .read("moments", moments)
+                .write("rows", rows);
+        });
         frame.add_compute(format!("{n}.update"), &self.update, push, size, |b| {
             reproj.bind(b);
             b.read("noisy", noisy)
-                .read("moments", moments)
+                .read("noise_rows", rows)
                 .read("gradient_ratio", g.ratio)
                 .sampled("lag_prev", lag.pooled.prev)
                 .write("prediction", estimate)

@@ -1,0 +1,48 @@
+// ours' spatial prior (ours_prior_fit.comp, ours_prior.comp): the grid of fits, the
+// model's features and the small solver.
+#ifndef DVR_OURS_PRIOR_GLSL
+#define DVR_OURS_PRIOR_GLSL
+
+// Pixels between two fits' centres, and the side of a fit's window: 12×12 pixels hold
+// 144 estimates for the 6 coefficients of each channel.
+const int PRIOR_STRIDE = 4;
+const int PRIOR_WINDOW = 12;
+// The model's features: 1, the albedo's r, g, b, and the pixel's position (x, y).
+const int PRIOR_FEATURES = 6;
+// Positions in units of half a window, so that every feature varies by about 1 over it
+// (the normal equations stay well conditioned).
+const float PRIOR_POSITION_UNIT = float(PRIOR_WINDOW / 2);
+
+// Solves (A + ridge·diag(0, 1, …, 1)) β = B for three right-hand sides (the colour
+// channels) by Cholesky; false if that matrix is not positive definite. A is symmetric
+// (only its lower triangle, A[i][j] with j ≤ i, is read).
+bool solve_ridge(float A[PRIOR_FEATURES][PRIOR_FEATURES], vec3 B[PRIOR_FEATURES], float ridge,
+                 out vec3 beta[PRIOR_FEATURES]) {
+    const int D = PRIOR_FEATURES;
+    float L[D][D];
+    for (int j = 0; j < D; ++j) {
+        float d = A[j][j] + (j > 0 ? ridge : 0.0);
+        for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+        if (!(d > 1e-20)) return false;
+        L[j][j] = sqrt(d);
+        for (int i = j + 1; i < D; ++i) {
+            float s = A[i][j];
+            for (int k = 0; k < j; ++k) s -= L[i][k] * L[j][k];
+            L[i][j] = s / L[j][j];
+        }
+    }
+    vec3 z[D];
+    for (int i = 0; i < D; ++i) {
+        vec3 s = B[i];
+        for (int k = 0; k < i; ++k) s -= L[i][k] * z[k];
+        z[i] = s / L[i][i];
+    }
+    for (int i = D - 1; i >= 0; --i) {
+        vec3 s = z[i];
+        for (int k = i + 1; k < D; ++k) s -= L[k][i] * beta[k];
+        beta[i] = s / L[i][i];
+    }
+    return true;
+}
+
+#endif

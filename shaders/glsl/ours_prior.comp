@@ -1,0 +1,68 @@
+#version 460
+// ours' spatial prior: where an estimate is young (its relative standard error above
+// `keep`), a local linear model of its neighbours' estimates on the guide albedo
+// (ours_prior_fit.comp) predicts it, and the prediction is combined with the estimate by
+// their variances before the à-trous filter.
+//
+// Model. Around p, x_q = β₀ + β₁ a_q + β₂ q + ε_q, with a_q the TF albedo composited
+// along q's ray over its footprint (deterministic: ours_guide.comp) and q the position.
+// The fit's prediction x̂_p = β₀ + β₁ a_p + β₂ p has an error variance no larger than the residuals' mean square V,
+// which counts the neighbours' own noise in full (an upper bound: the prior is trusted
+// less than it could be). With the estimate's variance P, the two are combined as two
+// measurements of one value:
+//     x' = (V x_p + P x̂_p) / (V + P),   P' = V P / (V + P).
+// A young estimate (the first frames, a disocclusion, a change the gradients measured)
+// leans on the albedo's structure (a silhouette, a coloured vessel, a shell's rim) where
+// the à-trous' range term, comparing two noisy estimates, tells them apart only by
+// chance; a converged one (P ≪ V) keeps its own value; where the albedo explains little
+// (an MRI's shading), V is large and the prior weighs little.
+#include "common.glsl"
+#include "ours_prior.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = 0, rgba32f) uniform readonly image2D estimate;   // rgb x, a P
+layout(binding = 1, rgba32f) uniform readonly image2D footprint;  // rgb albedo (ours_guide.comp)
+layout(binding = 2) uniform sampler2D fit0;                       // rgb β₀, a V
+layout(binding = 3) uniform sampler2D fit_r;
+layout(binding = 4) uniform sampler2D fit_g;
+layout(binding = 5) uniform sampler2D fit_b;
+layout(binding = 6) uniform sampler2D fit_x;
+layout(binding = 7) uniform sampler2D fit_y;
+layout(binding = 8, rgba32f) uniform writeonly image2D combined;  // rgb x', a P'
+
+layout(push_constant) uniform OursPriorPush {
+    uint width;
+    uint height;
+    float keep;  // relative standard error below which an estimate is kept as it is
+    float pad;
+} pc;
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = ivec2(pc.width, pc.height);
+    if (p.x >= size.x || p.y >= size.y) return;
+    vec4 centre = imageLoad(estimate, p);
+    float P = centre.a;
+    // A converged estimate is kept (as the à-trous keeps it).
+    if (!all_finite(centre.rgb) || !(P >= pc.keep * pc.keep * dot(centre.rgb, centre.rgb) / 3.0) || isinf(P)) {
+        imageStore(combined, p, centre);
+        return;
+    }
+    // The fits interpolated bilinearly between the cells' centres (cell i's centre is
+    // pixel PRIOR_STRIDE·i + (PRIOR_STRIDE − 1)/2).
+    vec2 uv = (vec2(p) + 0.5) / (float(PRIOR_STRIDE) * vec2(textureSize(fit0, 0)));
+    vec4 f0 = texture(fit0, uv);
+    vec3 a = imageLoad(footprint, p).rgb;
+    vec2 o = vec2(p) / PRIOR_POSITION_UNIT;
+    vec3 pred = f0.rgb + texture(fit_r, uv).rgb * a.r + texture(fit_g, uv).rgb * a.g
+        + texture(fit_b, uv).rgb * a.b + texture(fit_x, uv).rgb * o.x + texture(fit_y, uv).rgb * o.y;
+    float V = f0.a;
+    if (!(V > 0.0) || isinf(V) || !all_finite(pred)) {
+        imageStore(combined, p, centre);
+        return;
+    }
+    pred = max(pred, vec3(0.0));
+    vec3 x = (V * centre.rgb + P * pred) / (V + P);
+    imageStore(combined, p, vec4(x, V * P / (V + P)));
+}
