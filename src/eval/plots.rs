@@ -86,7 +86,7 @@ fn load_font(path: &std::path::Path) -> std::result::Result<(), String> {
 
 /// Colours of the registry's rows, in its order (`dvr_engine::denoise::DENOISERS`):
 /// grey for the noisy input, red for ours, the rest a categorical palette.
-const PALETTE: [RGBColor; 18] = [
+const PALETTE: [RGBColor; 19] = [
     RGBColor(127, 127, 127),
     RGBColor(31, 119, 180),
     RGBColor(227, 119, 194),
@@ -105,6 +105,7 @@ const PALETTE: [RGBColor; 18] = [
     RGBColor(219, 219, 141),
     RGBColor(158, 218, 229),
     RGBColor(247, 182, 210),
+    RGBColor(255, 187, 120),
 ];
 
 /// A method's colour, the same in every chart and on the page: by its row in the
