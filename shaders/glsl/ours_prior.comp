@@ -6,10 +6,12 @@
 //
 // Model. Around p, x_q = β₀ + β₁ a_q + β₂ q + ε_q, with a_q the TF albedo composited
 // along q's ray over its footprint (deterministic: ours_guide.comp) and q the position.
-// The fit's prediction x̂_p = β₀ + β₁ a_p + β₂ p has an error variance no larger than the residuals' mean square V,
-// which counts the neighbours' own noise in full (an upper bound: the prior is trusted
-// less than it could be). With the estimate's variance P, the two are combined as two
-// measurements of one value:
+// The fit's prediction x̂_p = β₀ + β₁ a_p + β₂ p is given the error variance V, the
+// residuals' mean square over the window: its average error there, with the neighbours'
+// own noise counted in full (which the fit averages down), so the prior is trusted less
+// than it could be where the model holds; where it does not hold at p alone (a fold the
+// plane misses) V understates the error. With the estimate's variance P, the two are
+// combined as two measurements of one value:
 //     x' = (V x_p + P x̂_p) / (V + P),   P' = V P / (V + P).
 // A young estimate (the first frames, a disocclusion, a change the gradients measured)
 // leans on the albedo's structure (a silhouette, a coloured vessel, a shell's rim) where
