@@ -3,9 +3,10 @@
 #ifndef DVR_OURS_PRIOR_GLSL
 #define DVR_OURS_PRIOR_GLSL
 
-// Pixels between two fits' centres, and the side of a fit's window: 12×12 pixels hold
-// 144 estimates for the 6 coefficients of each channel.
-const int PRIOR_STRIDE = 4;
+// Pixels between two fits' centres (set by the engine, which sizes the grid: its
+// `prior::PRIOR_STRIDE`), and the side of a fit's window: 12×12 pixels hold 144 estimates
+// for the 6 coefficients of each channel.
+layout(constant_id = 0) const int PRIOR_STRIDE = 4;
 const int PRIOR_WINDOW = 12;
 // The model's features: 1, the albedo's r, g, b, and the pixel's position (x, y).
 const int PRIOR_FEATURES = 6;

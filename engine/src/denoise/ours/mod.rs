@@ -234,7 +234,7 @@ impl Denoiser for Ours {
         self.add_lag(frame, input.size, &lag);
         let estimate = match (&self.prior, input.guides) {
             (Some(pipelines), Some(guide)) => {
-                self.add_prior(pipelines, ctx, graph, frame, input.size, estimate, guide)?
+                self.add_prior(pipelines, ctx, graph, frame, estimate, guide)?
             }
             _ => estimate,
         };

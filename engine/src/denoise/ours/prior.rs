@@ -5,11 +5,12 @@
 
 use super::Ours;
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc, Pipeline};
+use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::gpu_block;
 use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
 
-/// Pixels between two fits' centres (`PRIOR_STRIDE` in include/ours_prior.glsl).
+/// Pixels between two fits' centres: the grid's size here, and the shaders' specialisation
+/// constant `PRIOR_STRIDE` (include/ours_prior.glsl).
 pub const PRIOR_STRIDE: u32 = 4;
 
 /// The fits' images, as both shaders name them: β₀ with the residuals' mean square V,
@@ -55,30 +56,31 @@ pub(super) struct PriorPipelines {
 
 impl PriorPipelines {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
+        let stride = [("PRIOR_STRIDE", SpecValue::I32(PRIOR_STRIDE as i32))];
         Ok(Self {
             guide: ctx.pipeline("ours_guide", &[])?,
-            fit: ctx.pipeline("ours_prior_fit", &[])?,
-            combine: ctx.pipeline("ours_prior", &[])?,
+            fit: ctx.pipeline("ours_prior_fit", &stride)?,
+            combine: ctx.pipeline("ours_prior", &stride)?,
         })
     }
 }
 
 impl Ours {
-    /// Adds the prior over `estimate` (rgb, a variance) guided by `guide` (the composited
-    /// albedo); returns the combined estimate with its variance.
-    #[allow(clippy::too_many_arguments)]
+    /// Adds the prior over `estimate` (rgb, a variance; the frame's size) guided by `guide`
+    /// (the composited albedo); returns the combined estimate with its variance.
     pub(super) fn add_prior<'f>(
         &'f self,
         pipelines: &'f PriorPipelines,
         ctx: &GpuContext,
         graph: &mut RenderGraph,
         frame: &mut Frame<'f>,
-        size: Extent,
         estimate: ImageHandle,
         guide: ImageHandle,
     ) -> Result<ImageHandle> {
         let n = &self.name;
         let desc = graph.image_desc(estimate);
+        let [width, height, _] = desc.extent;
+        let size = Extent { width, height };
         let footprint = graph.image(ctx, &format!("{n}.footprint"), desc)?;
         let cells = Extent {
             width: size.width.div_ceil(PRIOR_STRIDE),
