@@ -83,7 +83,7 @@ fn capture_writes_frames_timings_and_page_for_every_denoiser() {
         "motion",
         "accum",
         "ours.update",
-        "ours.atrous2",
+        "ours.atrous1",
         "svgf.atrous4",
     ] {
         assert!(passes.contains(&want), "no timing for {want}: {passes:?}");

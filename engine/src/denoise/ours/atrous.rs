@@ -1,6 +1,7 @@
-//! `<name>.atrous0..2` (variance_atrous.comp): the à-trous spatial filter over the
-//! filters' estimates, edge-stopped by their variances: steps 1, 2, 4 ping-ponging between
-//! the estimate and a scratch image, the last level into the denoiser's output.
+//! `<name>.atrous0..1` (variance_atrous.comp): the à-trous spatial filter over the
+//! filters' estimates, edge-stopped by their variances: steps 1 and 2 (`ATROUS_LEVELS`),
+//! ping-ponging between the estimate and a scratch image, the last level into the
+//! denoiser's output.
 
 use super::Ours;
 use crate::denoise::variance_atrous::{add_level, Level, VarianceAtrousPush};

@@ -24,7 +24,7 @@
 //!   `ours_prior_fit.comp`, `ours_prior.comp`): the spatial prior, on the guide albedo
 //!   composited along each ray (`aux_features.comp`, shared with svgf); a frame without
 //!   one (synthetic inputs) goes without;
-//! - `<name>.atrous0..2` ([`atrous`], `variance_atrous.comp`): the à-trous spatial filter.
+//! - `<name>.atrous0..1` ([`atrous`], `variance_atrous.comp`): the à-trous spatial filter.
 //!
 //! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-prior`, `ours-no-atrous`)
 //! switch one part off each ([`OursVariant`]).
@@ -82,7 +82,7 @@ pub struct OursParams {
 impl Default for OursParams {
     fn default() -> Self {
         Self {
-            stratum: 4,
+            stratum: 5,
             shrink: 4.0,
             change_q: 3.0,
             motion_q: 0.01,
@@ -158,9 +158,10 @@ pub struct Ours {
 /// The pooled lag test's window radius (5×5).
 const LAG_RADIUS: i32 = 2;
 
-/// À-trous levels (steps 1, 2, 4: up to 17×17 pixels). Fixed, not tuned: two levels
-/// measured 0.06 dB lower on the development subset (README, "ours").
-pub const ATROUS_LEVELS: u32 = 3;
+/// À-trous levels (steps 1, 2: up to 9×9 pixels). Fixed, not tuned: a third level (step
+/// 4) bought 0.02 dB on the development suite for 2.9 ms of ours' 40 at 256² on lavapipe,
+/// and ours' cost bound (0.6× svgf) needs those (docs/experiments.md).
+pub const ATROUS_LEVELS: u32 = 2;
 
 impl Ours {
     pub fn new(
