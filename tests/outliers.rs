@@ -9,12 +9,12 @@
 //! The bounds, from this test's own setting (frames 4–11):
 //! - phantom/orbit, 1.5%: svgf demodulated by the threshold surface's albedo turned the
 //!   phantom's thin vessels into dark red dots, 1.69% (commit 311d772's binary); with
-//!   the composited albedo 1.11%; the highest now is ours-no-atrous, 1.23% (fireflies
-//!   of a per-pixel estimate); ours 0.12%, the RAE 0.01%, the noisy input 0.20%.
+//!   the composited albedo 1.11%, now the highest; ours 0.03%, the RAE 0.01%, the noisy
+//!   input 0.20%.
 //! - mri/point-light, 2.5%: the paper's per-pixel models without a spatial filter keep
 //!   fireflies at the cortex's edge (wrls-paper 1.95%, rls-paper 2.00%; neither the
 //!   paper nor Falcor's SVGF clamps fireflies, so no method here does); svgf 1.15%,
-//!   ours 0.50%; the noisy input 5.0%.
+//!   ours 0.23%; the noisy input 5.0%.
 
 mod common;
 
