@@ -23,18 +23,20 @@ use dvr_engine::renderer::scene_setup::SceneSetup;
 use dvr_engine::renderer::{FrameInputs, FrameRequest, Renderer};
 use dvr_engine::scene::Scene;
 
-/// 40×40, a whole number of the gradients' 5×5-pixel strata. Where the image's edge cuts
-/// a stratum the TF jump is followed worse, a defect not yet found: `ours-no-prior` trails
-/// its restart by at most 2.41 dB at 24² and 1.52 at 32², against 0.80 at 25², 0.88 at
-/// 30² and 0.55 here (with 4×4 strata, 24² gave 0.89). Sizes that are not multiples of
-/// the stratum (64², 128²) are what `dvr eval` measures, so its numbers include it.
+/// The deficit below the restart varies with the image size, and not with whether the
+/// image's edge cuts a 5×5 stratum (stratum 6 gives 2.00 dB at 24², which it divides).
+/// Measured for `ours-no-prior` over twelve sizes from 20² to 64²: tf-jump from −0.40 to
+/// 2.41 dB (24²), light-jump from 0.16 to 2.10 (56²); at 40² 0.55 and 0.59. So 40² is one
+/// of the sizes where the bound holds: the test guards against a regression there, it does
+/// not show recovery within 1 dB at every size. The cause (a bias the lag test does not
+/// correct in the still frames after a jump) and a candidate fix: docs/experiments.md.
 const SIZE: u32 = 40;
 const FRAMES: u32 = 30;
 const REFERENCE_SPP: u32 = 128;
 /// The bound this test asserts, dB below the restarted filter at the same age. Measured
 /// for `ours-no-prior` (40², 2 spp, 15 frames after the jump): tf-jump at most 0.55,
 /// light-jump at most 0.59, both within the first frames above the restart (the gradients
-/// carry the history over) and below it later (the carried noise estimate re-averages).
+/// carry the history over) and below it later.
 const MAX_DEFICIT_DB: f64 = 1.0;
 
 fn rgb(px: &[[f32; 4]]) -> Rgb32Image {
