@@ -18,6 +18,8 @@
 // the à-trous' range term, comparing two noisy estimates, tells them apart only by
 // chance; a converged one (P ≪ V) keeps its own value; where the albedo explains little
 // (an MRI's shading), V is large and the prior weighs little.
+// Every pixel's prediction x̂ is also written out, converged or not: the à-trous carries
+// each neighbour's estimate to the pixel by it (variance_atrous.comp, CARRY).
 #include "common.glsl"
 #include "ours_prior.glsl"
 
@@ -32,6 +34,7 @@ layout(binding = 5) uniform sampler2D fit_b;
 layout(binding = 6) uniform sampler2D fit_x;
 layout(binding = 7) uniform sampler2D fit_y;
 layout(binding = 8, rgba32f) uniform writeonly image2D combined;  // rgb x', a P'
+layout(binding = 9, rgba32f) uniform writeonly image2D prediction;  // rgb x̂, a 1 where there is one
 
 layout(push_constant) uniform OursPriorPush {
     uint width;
@@ -44,13 +47,6 @@ void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
     if (p.x >= size.x || p.y >= size.y) return;
-    vec4 centre = imageLoad(estimate, p);
-    float P = centre.a;
-    // A converged estimate is kept (as the à-trous keeps it).
-    if (!all_finite(centre.rgb) || !(P >= pc.keep * pc.keep * dot(centre.rgb, centre.rgb) / 3.0) || isinf(P)) {
-        imageStore(combined, p, centre);
-        return;
-    }
     // The fits interpolated bilinearly between the cells' centres (cell i's centre is
     // pixel PRIOR_STRIDE·i + (PRIOR_STRIDE − 1)/2).
     vec2 uv = (vec2(p) + 0.5) / (float(PRIOR_STRIDE) * vec2(textureSize(fit0, 0)));
@@ -60,7 +56,13 @@ void main() {
     vec3 pred = f0.rgb + texture(fit_r, uv).rgb * a.r + texture(fit_g, uv).rgb * a.g
         + texture(fit_b, uv).rgb * a.b + texture(fit_x, uv).rgb * o.x + texture(fit_y, uv).rgb * o.y;
     float V = f0.a;
-    if (!(V > 0.0) || isinf(V) || !all_finite(pred)) {
+    bool fitted = V > 0.0 && V < NO_FIT && all_finite(pred);
+    // Every pixel's prediction, for the à-trous to carry neighbours by (a 0: none).
+    imageStore(prediction, p, fitted ? vec4(pred, 1.0) : vec4(0.0));
+    vec4 centre = imageLoad(estimate, p);
+    float P = centre.a;
+    // A converged estimate is kept (as the à-trous keeps it).
+    if (!fitted || !all_finite(centre.rgb) || !(P >= pc.keep * pc.keep * dot(centre.rgb, centre.rgb) / 3.0) || isinf(P)) {
         imageStore(combined, p, centre);
         return;
     }

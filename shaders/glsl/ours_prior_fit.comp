@@ -34,9 +34,6 @@ layout(push_constant) uniform OursPriorFitPush {
 // albedo (one material, or only background) leaves its coefficients undetermined, and the
 // fit falls back to a plane.
 const float RIDGE = 1e-3;
-// Where there is no fit (no finite estimate in the window): V so large that the prior
-// leaves the pixels near the cell as they are.
-const float NO_FIT = 1e30;
 
 void main() {
     const int D = PRIOR_FEATURES;

@@ -14,8 +14,9 @@
 //     view-dependent change of a semi-transparent volume), and a shift the pooled lag test
 //     found (its own size);
 //   - R_t, the variance of one frame's pixel mean, estimated from the samples' own
-//     luminance moments (at 1 spp: from the innovations), averaged over the filter's own
-//     memory and scaled with the radiance by g_t.
+//     luminance moments over 5×5 pixels (at 1 spp: the 5×5 luminances' spread), scaled
+//     with the radiance by g_t and averaged over the filter's memory; this frame's
+//     measurement joins before the gain uses it, with the weight P⁻ / (P⁻ + R).
 // Predict: x⁻ = g ∘ x, P⁻ = ḡ² P + Q. Update: K = P⁻ / (P⁻ + R), x = x⁻ + K (y − x⁻),
 // P = (1 − K) P⁻. With nothing changing Q = 0 and K = 1/n: the running mean, which only
 // improves.
@@ -27,8 +28,10 @@
 // is clipped (heavy-tailed noise puts bright paths in a pixel in successive frames); a
 // change of the scene moves a region.
 //
-// State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (r32f:
-// the measurement noise R).
+// State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (rg32f:
+// the measurement noise R, and D, the part of P that process noise put there: the update
+// splits P = (1 − K)² P⁻ + K² R, so D = (1 − K)² (ḡ² D + Q), the Q of the frames the
+// filter's memory still spans; a filter that restarted (K ≈ 1) carries none).
 // Outputs: the estimate with its variance for the à-trous filter (variance_atrous.comp), and
 // the a-posteriori residual with its variance for the pooled lag test (ours_lag.comp).
 #include "common.glsl"
@@ -41,7 +44,7 @@ layout(binding = 1, rgba32f) uniform readonly image2D noisy;
 layout(binding = 2) uniform sampler2D model_prev;
 layout(binding = 3) uniform sampler2D noise_prev;
 layout(binding = 4, rgba32f) uniform writeonly image2D model_cur;
-layout(binding = 5, r32f) uniform writeonly image2D noise_cur;
+layout(binding = 5, rg32f) uniform writeonly image2D noise_cur;
 layout(binding = 6, rgba32f) uniform writeonly image2D prediction;  // rgb, a variance
 layout(binding = 7, rgba32f) uniform writeonly image2D residual;    // rgb, a variance (< 0: none)
 layout(binding = 8) uniform sampler2D lag_prev;                      // rgb mean, a variance
@@ -90,6 +93,40 @@ float fresh_noise(ivec2 p, ivec2 size) {
     return max(s.z / 25.0 - (s.y / 25.0) * (s.y / 25.0), 0.0) * 25.0 / 24.0 + TINY;
 }
 
+// The history's estimate resampled by Catmull-Rom over the 4×4 texels around `r.uv`
+// where the bilinear footprint's four taps all show this pixel's surface (elsewhere, and
+// for the variance, the bilinear blend of the taps that do). A bilinear fetch averages
+// four estimates whenever the camera moves by a fraction of a pixel, and a filter with a
+// long memory averages those averages frame after frame: the detail blurs. Catmull-Rom
+// interpolates (it returns each texel's value at its centre) and keeps it; its result is
+// clamped to the four taps' range, so its negative lobes cannot ring at an edge.
+vec4 history_fetch_sharp(sampler2D history, Reprojection r) {
+    if (!all(greaterThan(r.weights, vec4(0.0)))) return history_fetch(history, r);
+    ivec2 hi = textureSize(history, 0) - 1;
+    vec2 f = r.uv * vec2(textureSize(history, 0)) - 0.5 - vec2(r.tap);
+    vec2 w[4] = vec2[](f * (-0.5 + f * (1.0 - 0.5 * f)), 1.0 + f * f * (-2.5 + 1.5 * f),
+                       f * (0.5 + f * (2.0 - 1.5 * f)), f * f * (-0.5 + 0.5 * f));
+    vec3 sum = vec3(0.0);
+    vec3 lo = vec3(1e30), up = vec3(-1e30);
+    // The four central texels are the bilinear footprint: their blend (the same sum
+    // history_fetch makes) gives the variance and the fallback.
+    vec4 bilinear = vec4(0.0);
+    bool finite = true;
+    for (int j = 0; j < 4; ++j) {
+        for (int i = 0; i < 4; ++i) {
+            vec4 t = texelFetch(history, clamp(r.tap + ivec2(i - 1, j - 1), ivec2(0), hi), 0);
+            finite = finite && all_finite(t.rgb);
+            sum += w[i].x * w[j].y * t.rgb;
+            if (i >= 1 && i <= 2 && j >= 1 && j <= 2) {
+                bilinear += r.weights[(i - 1) + 2 * (j - 1)] * t;
+                lo = min(lo, t.rgb);
+                up = max(up, t.rgb);
+            }
+        }
+    }
+    return finite ? vec4(clamp(sum, lo, up), bilinear.a) : bilinear;
+}
+
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
@@ -101,21 +138,25 @@ void main() {
 
     vec3 x;
     float P, R;
+    float D = 0.0;  // the part of P that process noise put there (none in a fresh filter)
     vec4 res = vec4(0.0, 0.0, 0.0, -1.0);  // no residual (a new filter has no history to lag)
-    vec4 m = r.valid ? history_fetch(model_prev, r) : vec4(0.0);
+    vec4 m = r.valid ? history_fetch_sharp(model_prev, r) : vec4(0.0);
     bool fresh = !r.valid || !all_finite(m.rgb) || !(m.a >= 0.0) || isinf(m.a);
     if (fresh) {
         x = y;
         R = fresh_noise(p, size);
         P = R;
     } else {
-        float noise = history_fetch(noise_prev, r).x;
+        vec2 noise_state = history_fetch(noise_prev, r).xy;
+        float noise = noise_state.x;
         // Predict: the measured change scales the estimate, its variance and the noise.
         SceneChange sc = scene_change(r.uv, size, pc.gradient_valid != 0u, pc.stratum);
         float g = dot(sc.ratio, vec3(1.0 / 3.0));
         x = m.rgb * sc.ratio;
         P = m.a * g * g;
         R = max(noise * g * g, TINY);
+        D = max(noise_state.y, 0.0) * g * g;
+        float P_carried = P;
         float level = luminance(max(x, vec3(0.0)));
         float Q = pc.change_q * sc.change * level;
         Q *= Q;
@@ -124,15 +165,16 @@ void main() {
         bool jump = false;
         if (pc.lag_valid != 0u) {
             // A residual the neighbourhood shares, beyond lag_z standard errors, is a
-            // measurement of what this frame's prediction missed, whose prior variance
-            // is the process noise Q: it is added with the gain Q / (Q + its variance),
-            // and its size is uncertain. Where nothing changes (Q = 0) nothing is added:
-            // a static view only averages.
+            // measurement of what the prediction missed, whose prior variance B is the
+            // process noise the estimate carries, D + Q: it is added with the gain
+            // B / (B + its variance), and its size is uncertain. The residual shows a
+            // change's miss in the frames after it, when Q may be 0 again; D still holds
+            // it.
+            // Where nothing ever changed (D = Q = 0) nothing is added: a static view
+            // only averages.
             vec4 lag = history_fetch(lag_prev, r);
             float z2 = dot(lag.rgb, lag.rgb) / 3.0 / max(lag.a, TINY);
-            // The lag accumulates what the filter missed over its memory, about
-            // (P + R) / P frames of process noise.
-            float B = Q * (P + Q + R) / max(P + Q, TINY);
+            float B = D + Q;
             if (z2 > pc.lag_z * pc.lag_z) shift = B / (B + max(lag.a, TINY)) * lag.rgb;
             x += shift;
             Q += dot(shift, shift) / 3.0;
@@ -148,6 +190,10 @@ void main() {
         // At a jump the level moved by about the innovation: its square joins the
         // prediction's variance and the update follows this frame's samples.
         if (jump) P_prior += e2;
+        // This frame's noise measurement joins R before the gain uses it, weighted as the
+        // prediction leaves room for it: where a change made the prediction uncertain
+        // (P⁻ ≫ R) R is this frame's, as a fresh pixel's; converged, it moves by about 1/n.
+        R = max(R + P_prior / (P_prior + R) * (fresh_noise(p, size) - R), TINY);
         float nu2 = e2 / max(P_prior + R, TINY);
         float z2 = pc.outlier_z * pc.outlier_z;
         bool far = nu2 > z2;
@@ -156,11 +202,8 @@ void main() {
         P = P_prior;
         float K = P / (P + R_eff);
         x += K * e;
+        D = (1.0 - K) * (1.0 - K) * (D + P_prior - P_carried);
         P = (1.0 - K) * P;
-        // The noise estimate over the filter's own memory: this frame's moments, or at
-        // 1 spp the innovation's excess over the prediction's variance.
-        float sample_R = fresh_noise(p, size);
-        R = max(R + K * (sample_R - R), TINY);
         // What the update left unexplained, with the clipped innovation (a spike must not
         // look like a shared lag), for the pooled lag test.
         float clip = far ? sqrt(z2 / nu2) : 1.0;
@@ -176,9 +219,10 @@ void main() {
         x = y;
         R = fresh_noise(p, size);
         P = R;
+        D = 0.0;
     }
     imageStore(model_cur, p, vec4(x, P));
-    imageStore(noise_cur, p, vec4(R, 0.0, 0.0, 0.0));
+    imageStore(noise_cur, p, vec4(R, D, 0.0, 0.0));
     imageStore(prediction, p, vec4(max(x, vec3(0.0)), P));
     imageStore(residual, p, res);
 }

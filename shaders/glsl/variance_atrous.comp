@@ -7,6 +7,14 @@
 // estimates keep the detail they resolved while young ones (after a change or a
 // disocclusion) are averaged over an ever wider footprint; each iteration passes on the
 // variance of its output.
+// With CARRY (ours), each neighbour's estimate is first carried to this pixel by ours'
+// spatial prior (ours_prior.comp): x_q + x̂_p − x̂_q, the difference the local linear model
+// on the guide albedo and the position predicts between the two pixels (a vessel's colour
+// against the shell, a silhouette's edge, a lit side), clamped between x_q and x_p so a
+// model that overstates a difference cannot overshoot. The range term still compares
+// the estimates as they are, so the carry changes what a blended neighbour contributes,
+// not which neighbours are blended: the kernel averages noise while the model keeps the
+// structure it explains.
 #include "common.glsl"
 #include "atrous_tile.glsl"
 
@@ -14,6 +22,9 @@ layout(local_size_x = TILE, local_size_y = TILE) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D color_in;   // rgb prediction, a variance
 layout(binding = 1, rgba32f) uniform writeonly image2D color_out; // the same, filtered
+layout(binding = 2, rgba32f) uniform readonly image2D prediction;  // rgb x̂ (CARRY), a 0 where none
+
+layout(constant_id = 16) const bool CARRY = false;
 
 layout(push_constant) uniform VarianceAtrousPush {
     uint width;
@@ -53,6 +64,7 @@ void main() {
         imageStore(color_out, p, vec4(max(centre.rgb, vec3(0.0)), pc.last != 0u ? 1.0 : centre.a));
         return;
     }
+    vec4 model = CARRY ? imageLoad(prediction, p) : vec4(0.0);
     float k0 = B3[0] * B3[0];
     vec3 sum = k0 * centre.rgb;
     float var_sum = k0 * k0 * centre.a;
@@ -63,6 +75,13 @@ void main() {
             if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
             vec4 cq = tap(win, q);
             vec3 d = cq.rgb - centre.rgb;
+            if (CARRY) {
+                vec4 mq = imageLoad(prediction, q);
+                if (model.a > 0.0 && mq.a > 0.0) {
+                    cq.rgb = clamp(cq.rgb + model.rgb - mq.rgb, min(cq.rgb, centre.rgb),
+                                   max(cq.rgb, centre.rgb));
+                }
+            }
             float range = dot(d, d) / 3.0 / (pc.kappa * pc.kappa * (centre.a + cq.a) + 1e-10);
             float w = B3[abs(dx)] * B3[abs(dy)] * exp(-range);
             sum += w * cq.rgb;

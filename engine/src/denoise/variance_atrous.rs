@@ -21,11 +21,15 @@ gpu_block! {
     }
 }
 
-/// The pass's pipeline (shared-memory tiles where the device gains from them).
-pub fn pipeline(ctx: &GpuContext) -> Result<Pipeline<VarianceAtrousPush>> {
+/// The pass's pipeline (shared-memory tiles where the device gains from them); `carry`:
+/// neighbours are carried to the pixel by a prediction image first (ours' prior).
+pub fn pipeline(ctx: &GpuContext, carry: bool) -> Result<Pipeline<VarianceAtrousPush>> {
     ctx.pipeline(
         "variance_atrous",
-        &[("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles))],
+        &[
+            ("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles)),
+            ("CARRY", SpecValue::Bool(carry)),
+        ],
     )
 }
 
@@ -42,7 +46,8 @@ pub struct Level {
     pub last: bool,
 }
 
-/// Adds one level `name` from `src` into `dst`.
+/// Adds one level `name` from `src` into `dst` (with `prediction` for a `carry` pipeline).
+#[allow(clippy::too_many_arguments)]
 pub fn add_level<'f>(
     frame: &mut Frame<'f>,
     pipeline: &'f Pipeline<VarianceAtrousPush>,
@@ -51,6 +56,7 @@ pub fn add_level<'f>(
     level: Level,
     src: ImageHandle,
     dst: ImageHandle,
+    prediction: Option<ImageHandle>,
 ) {
     let push = VarianceAtrousPush {
         width: size.width,
@@ -63,6 +69,9 @@ pub fn add_level<'f>(
         pad2: 0,
     };
     frame.add_compute(name, pipeline, push, size, |b| {
-        b.read("color_in", src).write("color_out", dst);
+        // Without CARRY the shader never reads `prediction`, but the binding exists.
+        b.read("color_in", src)
+            .write("color_out", dst)
+            .read("prediction", prediction.unwrap_or(src));
     });
 }

@@ -25,9 +25,15 @@ SceneChange scene_change(vec2 uv, ivec2 size, bool measured, uint stratum) {
     sc.ratio = vec3(1.0);
     sc.change = 0.0;
     if (!measured) return sc;
-    ivec2 k = clamp(ivec2(floor(uv * vec2(size) / float(stratum))), ivec2(0),
-                    imageSize(gradient_ratio) - 1);
-    vec4 pooled = imageLoad(gradient_ratio, k);
+    // Interpolated bilinearly between the strata's centres.
+    vec2 t = uv * vec2(size) / float(stratum) - 0.5;
+    ivec2 k0 = ivec2(floor(t));
+    vec2 f = t - vec2(k0);
+    ivec2 hi = imageSize(gradient_ratio) - 1;
+    vec4 pooled = mix(mix(imageLoad(gradient_ratio, clamp(k0, ivec2(0), hi)),
+                          imageLoad(gradient_ratio, clamp(k0 + ivec2(1, 0), ivec2(0), hi)), f.x),
+                      mix(imageLoad(gradient_ratio, clamp(k0 + ivec2(0, 1), ivec2(0), hi)),
+                          imageLoad(gradient_ratio, clamp(k0 + ivec2(1, 1), ivec2(0), hi)), f.x), f.y);
     float Ra = exp(pooled.a);
     sc.change = abs(Ra - 1.0) / max(Ra, 1.0);
     sc.ratio = pooled.rgb * Ra;

@@ -13,6 +13,9 @@ const int PRIOR_FEATURES = 6;
 // Positions in units of half a window, so that every feature varies by about 1 over it
 // (the normal equations stay well conditioned).
 const float PRIOR_POSITION_UNIT = float(PRIOR_WINDOW / 2);
+// Where there is no fit (no finite estimate in the window): V so large that the prior
+// leaves the pixels near the cell as they are.
+const float NO_FIT = 1e30;
 
 // Solves (A + ridge·diag(0, 1, …, 1)) β = B for three right-hand sides (the colour
 // channels) by Cholesky; false if that matrix is not positive definite. A is symmetric

@@ -1,24 +1,31 @@
 //! `<name>.atrous0..1` (variance_atrous.comp): the à-trous spatial filter over the
 //! filters' estimates, edge-stopped by their variances: steps 1 and 2 (`ATROUS_LEVELS`),
 //! ping-ponging between the estimate and a scratch image, the last level into the
-//! denoiser's output.
+//! denoiser's output. Where the spatial prior ran, each neighbour is carried to the pixel
+//! by the prior's prediction first (`CARRY` in variance_atrous.comp).
 
 use super::Ours;
-use crate::denoise::variance_atrous::{add_level, Level, VarianceAtrousPush};
+use crate::denoise::variance_atrous::{add_level, Level};
 use crate::error::Result;
-use crate::gpu::{GpuContext, Pipeline};
+use crate::gpu::GpuContext;
 use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
 
 impl Ours {
     pub(super) fn add_atrous<'f>(
         &'f self,
-        pipeline: &'f Pipeline<VarianceAtrousPush>,
         ctx: &GpuContext,
         graph: &mut RenderGraph,
         frame: &mut Frame<'f>,
         size: Extent,
         estimate: ImageHandle,
+        prediction: Option<ImageHandle>,
     ) -> Result<ImageHandle> {
+        // The carrying variant where there is a prediction to carry by.
+        let pipeline = match (prediction, &self.atrous_carry, &self.atrous) {
+            (Some(_), Some(carry), _) => carry,
+            (_, _, Some(plain)) => plain,
+            _ => return Ok(estimate),
+        };
         let n = &self.name;
         let desc = graph.image_desc(estimate);
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
@@ -46,6 +53,7 @@ impl Ours {
                 level,
                 src,
                 dst,
+                prediction,
             );
             src = dst;
         }

@@ -84,7 +84,7 @@ impl Default for OursParams {
         Self {
             stratum: 5,
             shrink: 4.0,
-            change_q: 3.0,
+            change_q: 3.5,
             motion_q: 0.01,
             lag_z: 1.5,
             outlier_z: 6.0,
@@ -152,6 +152,8 @@ pub struct Ours {
     update: Pipeline<OursUpdatePush>,
     lag: Option<Pipeline<OursLagPush>>,
     atrous: Option<Pipeline<VarianceAtrousPush>>,
+    /// The à-trous that carries neighbours by the prior's prediction (with the prior).
+    atrous_carry: Option<Pipeline<VarianceAtrousPush>>,
     prior: Option<PriorPipelines>,
 }
 
@@ -198,7 +200,10 @@ impl Ours {
                 .transpose()?,
             atrous: variant
                 .atrous
-                .then(|| variance_atrous::pipeline(ctx))
+                .then(|| variance_atrous::pipeline(ctx, false))
+                .transpose()?,
+            atrous_carry: (variant.atrous && variant.prior)
+                .then(|| variance_atrous::pipeline(ctx, true))
                 .transpose()?,
             prior: variant
                 .prior
@@ -233,16 +238,14 @@ impl Denoiser for Ours {
         let gradients = self.add_gradients(ctx, graph, frame, input)?;
         let estimate = self.add_update(ctx, graph, frame, input, &gradients, &lag)?;
         self.add_lag(frame, input.size, &lag);
-        let estimate = match (&self.prior, input.guides) {
+        let (estimate, prediction) = match (&self.prior, input.guides) {
             (Some(pipelines), Some(guide)) => {
-                self.add_prior(pipelines, ctx, graph, frame, estimate, guide)?
+                let (e, p) = self.add_prior(pipelines, ctx, graph, frame, estimate, guide)?;
+                (e, Some(p))
             }
-            _ => estimate,
+            _ => (estimate, None),
         };
-        match &self.atrous {
-            Some(pipeline) => self.add_atrous(pipeline, ctx, graph, frame, input.size, estimate),
-            None => Ok(estimate),
-        }
+        self.add_atrous(ctx, graph, frame, input.size, estimate, prediction)
     }
 }
 

@@ -1,7 +1,8 @@
 //! `<name>.guide`, `<name>.prior_fit`, `<name>.prior` (ours_guide.comp,
 //! ours_prior_fit.comp, ours_prior.comp): the spatial prior. Where an estimate is young,
 //! a local linear model of its neighbours' estimates on the guide albedo predicts it, and
-//! the two are combined by their variances before the à-trous filter.
+//! the two are combined by their variances before the à-trous filter, which then carries
+//! each neighbour by the model's prediction (`CARRY` in variance_atrous.comp).
 
 use super::Ours;
 use crate::error::Result;
@@ -67,7 +68,8 @@ impl PriorPipelines {
 
 impl Ours {
     /// Adds the prior over `estimate` (rgb, a variance; the frame's size) guided by `guide`
-    /// (the composited albedo); returns the combined estimate with its variance.
+    /// (the composited albedo); returns the combined estimate with its variance, and every
+    /// pixel's prediction (rgb, a 1 where there is a fit) for the à-trous to carry by.
     pub(super) fn add_prior<'f>(
         &'f self,
         pipelines: &'f PriorPipelines,
@@ -76,7 +78,7 @@ impl Ours {
         frame: &mut Frame<'f>,
         estimate: ImageHandle,
         guide: ImageHandle,
-    ) -> Result<ImageHandle> {
+    ) -> Result<(ImageHandle, ImageHandle)> {
         let n = &self.name;
         let desc = graph.image_desc(estimate);
         let [width, height, _] = desc.extent;
@@ -92,6 +94,7 @@ impl Ours {
             fits.push((name, graph.image(ctx, &format!("{n}.{name}"), cell_desc)?));
         }
         let combined = graph.image(ctx, &format!("{n}.prior"), desc)?;
+        let pred = graph.image(ctx, &format!("{n}.prior_pred"), desc)?;
         let push = OursGuidePush {
             width: size.width,
             height: size.height,
@@ -124,8 +127,8 @@ impl Ours {
             for &(name, fit) in &fits {
                 b.sampled(name, fit);
             }
-            b.write("combined", combined);
+            b.write("combined", combined).write("prediction", pred);
         });
-        Ok(combined)
+        Ok((combined, pred))
     }
 }

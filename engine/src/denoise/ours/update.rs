@@ -59,9 +59,9 @@ impl Ours {
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
         let n = &self.name;
         let model = graph.history(ctx, &format!("{n}.model"), desc)?;
-        // One channel is all the noise state needs.
+        // The noise state: R, and D, the part of P that process noise put there.
         let noise_desc = ImageDesc {
-            format: vk::Format::R32_SFLOAT,
+            format: vk::Format::R32G32_SFLOAT,
             ..desc
         };
         let noise = graph.history(ctx, &format!("{n}.noise"), noise_desc)?;

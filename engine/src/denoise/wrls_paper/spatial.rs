@@ -42,7 +42,7 @@ impl Wrls {
             last: true,
         };
         let name = format!("{}.atrous0", self.name);
-        add_level(frame, pipeline, name, size, level, prediction, out);
+        add_level(frame, pipeline, name, size, level, prediction, out, None);
     }
 
     /// The paper's spatial pass: each pixel blends the predictions of the 25 models of
