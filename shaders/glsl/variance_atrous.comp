@@ -40,9 +40,18 @@ layout(push_constant) uniform VarianceAtrousPush {
 const float B3[3] = float[](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
 
 shared vec4 tile[TILE_TEXELS];
+// The prediction's window, read by every tap of a carrying level as the estimates' is;
+// one texel where nothing is carried (the paper's models), so that use keeps its shared
+// memory.
+const int PREDICTION_TEXELS = CARRY ? TILE_TEXELS : 1;
+shared vec4 prediction_tile[PREDICTION_TEXELS];
 
 vec4 tap(TileWindow w, ivec2 q) {
     return w.on ? tile[tile_index(w, q)] : imageLoad(color_in, q);
+}
+
+vec4 prediction_tap(TileWindow w, ivec2 q) {
+    return w.on ? prediction_tile[tile_index(w, q)] : imageLoad(prediction, q);
 }
 
 void main() {
@@ -51,6 +60,7 @@ void main() {
     TileWindow win = tile_window(pc.step);
     if (win.on) {
         TILE_LOAD(win, tile, color_in, size);
+        if (CARRY) TILE_LOAD(win, prediction_tile, prediction, size);
         barrier();
     }
     if (p.x >= size.x || p.y >= size.y) return;
@@ -64,7 +74,7 @@ void main() {
         imageStore(color_out, p, vec4(max(centre.rgb, vec3(0.0)), pc.last != 0u ? 1.0 : centre.a));
         return;
     }
-    vec4 model = CARRY ? imageLoad(prediction, p) : vec4(0.0);
+    vec4 model = CARRY ? prediction_tap(win, p) : vec4(0.0);
     float k0 = B3[0] * B3[0];
     vec3 sum = k0 * centre.rgb;
     float var_sum = k0 * k0 * centre.a;
@@ -76,7 +86,7 @@ void main() {
             vec4 cq = tap(win, q);
             vec3 d = cq.rgb - centre.rgb;
             if (CARRY) {
-                vec4 mq = imageLoad(prediction, q);
+                vec4 mq = prediction_tap(win, q);
                 if (model.a > 0.0 && mq.a > 0.0) {
                     cq.rgb = clamp(cq.rgb + model.rgb - mq.rgb, min(cq.rgb, centre.rgb),
                                    max(cq.rgb, centre.rgb));
