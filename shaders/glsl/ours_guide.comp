@@ -1,15 +1,17 @@
 #version 460
-// ours' guide for its spatial prior: the TF albedo composited along each pixel's ray
-// (aux_features.comp, traced through the pixel's centre) spread over the pixel's
-// footprint by a 3×3 tent. The path tracer jitters its samples over the pixel, so a
-// silhouette or a vessel edge between two pixel centres is a blend in the radiance; the
-// tent makes it one in the guide too, and the prior's fit does not draw a staircase.
+// ours' guides for its spatial prior, spread over each pixel's footprint by a 3×3 tent:
+// the TF albedo composited along the pixel's ray (aux_features.comp), as its luminance,
+// and the gradient normal of its surface (surface_features.comp; zero where the ray finds
+// none). The path tracer jitters its samples over the pixel, so a silhouette or a vessel
+// edge between two pixel centres is a blend in the radiance; the tent makes it one in the
+// guides too, and the prior's fit does not draw a staircase.
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D guide;       // rgb albedo, a opacity
-layout(binding = 1, rgba32f) uniform writeonly image2D footprint;  // rgb albedo, a 1
+layout(binding = 1, rgba32f) uniform readonly image2D normal;      // xyz normal, w distance
+layout(binding = 2, rgba32f) uniform writeonly image2D footprint;  // x albedo's luminance, yzw normal
 
 layout(push_constant) uniform OursGuidePush {
     uint width;
@@ -22,13 +24,14 @@ void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
     if (p.x >= size.x || p.y >= size.y) return;
-    vec3 s = vec3(0.0);
+    vec4 s = vec4(0.0);
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
             ivec2 q = clamp(p + ivec2(dx, dy), ivec2(0), size - 1);
-            vec3 a = imageLoad(guide, q).rgb;
-            s += float((2 - abs(dx)) * (2 - abs(dy))) * (all_finite(a) ? a : vec3(0.0));
+            vec3 a = imageLoad(guide, q).rgb, n = imageLoad(normal, q).xyz;
+            vec4 g = vec4(all_finite(a) ? luminance(a) : 0.0, all_finite(n) ? n : vec3(0.0));
+            s += float((2 - abs(dx)) * (2 - abs(dy))) * g;
         }
     }
-    imageStore(footprint, p, vec4(s / 16.0, 1.0));
+    imageStore(footprint, p, s / 16.0);
 }

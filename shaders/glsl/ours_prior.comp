@@ -1,12 +1,13 @@
 #version 460
 // ours' spatial prior: where an estimate is young (its relative standard error above
-// `keep`), a local linear model of its neighbours' estimates on the guide albedo
+// `keep`), a local linear model of its neighbours' estimates on the guides
 // (ours_prior_fit.comp) predicts it, and the prediction is combined with the estimate by
 // their variances before the à-trous filter.
 //
-// Model. Around p, x_q = β₀ + β₁ a_q + β₂ q + ε_q, with a_q the TF albedo composited
-// along q's ray over its footprint (deterministic: ours_guide.comp) and q the position.
-// The fit's prediction x̂_p = β₀ + β₁ a_p + β₂ p is given the error variance V, the
+// Model. Around p, x_q = βᵀf_q + ε_q, f_q = (1, a_q, q, n_q), with a_q the luminance of
+// the TF albedo composited along q's ray and n_q its surface's gradient normal, both over
+// its footprint (deterministic: ours_guide.comp), and q the position. The fit's
+// prediction x̂_p = βᵀf_p is given the error variance V, the
 // residuals' mean square over the window: its average error there, with the neighbours'
 // own noise counted in full (which the fit averages down), so the prior is trusted less
 // than it could be where the model holds; where it does not hold at p alone (a fold the
@@ -26,14 +27,14 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D estimate;   // rgb x, a P
-layout(binding = 1, rgba32f) uniform readonly image2D footprint;  // rgb albedo (ours_guide.comp)
-layout(binding = 2) uniform sampler2D fit0;                       // rgb β₀, a V
-layout(binding = 3) uniform sampler2D fit_r;
-layout(binding = 4) uniform sampler2D fit_g;
-layout(binding = 5) uniform sampler2D fit_b;
-layout(binding = 6) uniform sampler2D fit_x;
-layout(binding = 7) uniform sampler2D fit_y;
-layout(binding = 8, rgba32f) uniform writeonly image2D combined;  // rgb x', a P'
+layout(binding = 1, rgba32f) uniform readonly image2D footprint;  // guides (ours_guide.comp)
+layout(binding = 2) uniform sampler2D fit_r_lo;                   // ours_prior_fit.comp
+layout(binding = 3) uniform sampler2D fit_r_hi;                   // a V
+layout(binding = 4) uniform sampler2D fit_g_lo;
+layout(binding = 5) uniform sampler2D fit_g_hi;
+layout(binding = 6) uniform sampler2D fit_b_lo;
+layout(binding = 7) uniform sampler2D fit_b_hi;
+layout(binding = 8, rgba32f) uniform writeonly image2D combined;    // rgb x', a P'
 layout(binding = 9, rgba32f) uniform writeonly image2D prediction;  // rgb x̂, a 1 where there is one
 
 layout(push_constant) uniform OursPriorPush {
@@ -49,13 +50,15 @@ void main() {
     if (p.x >= size.x || p.y >= size.y) return;
     // The fits interpolated bilinearly between the cells' centres (cell i's centre is
     // pixel PRIOR_STRIDE·i + (PRIOR_STRIDE − 1)/2).
-    vec2 uv = (vec2(p) + 0.5) / (float(PRIOR_STRIDE) * vec2(textureSize(fit0, 0)));
-    vec4 f0 = texture(fit0, uv);
-    vec3 a = imageLoad(footprint, p).rgb;
-    vec2 o = vec2(p) / PRIOR_POSITION_UNIT;
-    vec3 pred = f0.rgb + texture(fit_r, uv).rgb * a.r + texture(fit_g, uv).rgb * a.g
-        + texture(fit_b, uv).rgb * a.b + texture(fit_x, uv).rgb * o.x + texture(fit_y, uv).rgb * o.y;
-    float V = f0.a;
+    vec2 uv = (vec2(p) + 0.5) / (float(PRIOR_STRIDE) * vec2(textureSize(fit_r_lo, 0)));
+    vec4 g = imageLoad(footprint, p);
+    vec4 lo = features_lo(g, vec2(p) / PRIOR_POSITION_UNIT);
+    vec3 hi = features_hi(g);
+    vec4 r_hi = texture(fit_r_hi, uv);
+    vec3 pred = vec3(dot(texture(fit_r_lo, uv), lo) + dot(r_hi.xyz, hi),
+                     dot(texture(fit_g_lo, uv), lo) + dot(texture(fit_g_hi, uv).xyz, hi),
+                     dot(texture(fit_b_lo, uv), lo) + dot(texture(fit_b_hi, uv).xyz, hi));
+    float V = r_hi.a;
     bool fitted = V > 0.0 && V < NO_FIT && all_finite(pred);
     // Every pixel's prediction, for the à-trous to carry neighbours by (a 0: none).
     imageStore(prediction, p, fitted ? vec4(pred, 1.0) : vec4(0.0));

@@ -104,12 +104,8 @@ const fn rae(
 }
 
 const fn ours(name: &'static str, description: &'static str, variant: OursVariant) -> DenoiserInfo {
-    entry(
-        name,
-        description,
-        FeatureUse::ForMotion,
-        Kind::Ours(variant),
-    )
+    // Always: the spatial prior's fit reads the surface's gradient normal.
+    entry(name, description, FeatureUse::Always, Kind::Ours(variant))
 }
 
 const fn wrls(name: &'static str, description: &'static str, variant: WrlsVariant) -> DenoiserInfo {

@@ -20,10 +20,11 @@
 //!   update;
 //! - `<name>.lag` ([`lag`], `ours_lag.comp`): the pooled lag test, read by next frame's
 //!   update;
-//! - `<name>.guide`, `<name>.prior_fit`, `<name>.prior` ([`prior`], `ours_guide.comp`,
-//!   `ours_prior_fit.comp`, `ours_prior.comp`): the spatial prior, on the guide albedo
-//!   composited along each ray (`aux_features.comp`, shared with svgf); a frame without
-//!   one (synthetic inputs) goes without;
+//! - `<name>.guide`, `<name>.prior_sums`, `<name>.prior_fit`, `<name>.prior` ([`prior`],
+//!   `ours_guide.comp`, `ours_prior_sums.comp`, `ours_prior_fit.comp`, `ours_prior.comp`):
+//!   the spatial prior, on the guide albedo composited along each ray
+//!   (`aux_features.comp`, shared with svgf) and the surface's gradient normal
+//!   (`surface_features.comp`); a frame without them (synthetic inputs) goes without;
 //! - `<name>.atrous0..1` ([`atrous`], `variance_atrous.comp`): the à-trous spatial filter.
 //!
 //! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-prior`, `ours-no-atrous`)
@@ -238,9 +239,11 @@ impl Denoiser for Ours {
         let gradients = self.add_gradients(ctx, graph, frame, input)?;
         let estimate = self.add_update(ctx, graph, frame, input, &gradients, &lag)?;
         self.add_lag(frame, input.size, &lag);
-        let (estimate, prediction) = match (&self.prior, input.guides) {
-            (Some(pipelines), Some(guide)) => {
-                let (e, p) = self.add_prior(pipelines, ctx, graph, frame, estimate, guide)?;
+        let normal = input.features.map(|f| f.normal);
+        let (estimate, prediction) = match (&self.prior, input.guides, normal) {
+            (Some(pipelines), Some(albedo), Some(normal)) => {
+                let guides = prior::PriorGuides { albedo, normal };
+                let (e, p) = self.add_prior(pipelines, ctx, graph, frame, estimate, guides)?;
                 (e, Some(p))
             }
             _ => (estimate, None),

@@ -1,6 +1,7 @@
-//! `<name>.guide`, `<name>.prior_fit`, `<name>.prior` (ours_guide.comp,
-//! ours_prior_fit.comp, ours_prior.comp): the spatial prior. Where an estimate is young,
-//! a local linear model of its neighbours' estimates on the guide albedo predicts it, and
+//! `<name>.guide`, `<name>.prior_sums`, `<name>.prior_fit`, `<name>.prior` (ours_guide.comp,
+//! ours_prior_sums.comp, ours_prior_fit.comp, ours_prior.comp): the spatial prior. Where an
+//! estimate is young, a local linear model of its neighbours' estimates on the guides (the
+//! albedo's luminance, the gradient normal) and the position predicts it, and
 //! the two are combined by their variances before the à-trous filter, which then carries
 //! each neighbour by the model's prediction (`CARRY` in variance_atrous.comp).
 
@@ -14,9 +15,15 @@ use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
 /// constant `PRIOR_STRIDE` (include/ours_prior.glsl).
 pub const PRIOR_STRIDE: u32 = 4;
 
-/// The fits' images, as both shaders name them: β₀ with the residuals' mean square V,
-/// then the coefficients of the albedo's r, g, b and of the position's x, y (rgb each).
-const FITS: [&str; 6] = ["fit0", "fit_r", "fit_g", "fit_b", "fit_x", "fit_y"];
+/// The fits' images, as both shaders name them: per colour channel the coefficients of
+/// the first four features (1, the albedo's luminance, the position's x, y), and of the
+/// normal's three with the residuals' mean square V.
+const FITS: [&str; 6] = [
+    "fit_r_lo", "fit_r_hi", "fit_g_lo", "fit_g_hi", "fit_b_lo", "fit_b_hi",
+];
+
+/// Texels (rgba32f) of one block's sums: `PRIOR_SUM_TEXELS` in include/ours_prior.glsl.
+const SUM_TEXELS: u32 = 13;
 
 gpu_block! {
     /// `OursGuidePush` in ours_guide.comp.
@@ -48,9 +55,18 @@ gpu_block! {
     }
 }
 
-/// The prior's three pipelines.
+/// What the prior's fit is guided by: the albedo composited along each ray (rgb, a
+/// opacity) and the surface's gradient normal (xyz; zero where the ray finds none).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PriorGuides {
+    pub albedo: ImageHandle,
+    pub normal: ImageHandle,
+}
+
+/// The prior's pipelines.
 pub(super) struct PriorPipelines {
     pub guide: Pipeline<OursGuidePush>,
+    pub sums: Pipeline<OursPriorFitPush>,
     pub fit: Pipeline<OursPriorFitPush>,
     pub combine: Pipeline<OursPriorPush>,
 }
@@ -60,6 +76,7 @@ impl PriorPipelines {
         let stride = [("PRIOR_STRIDE", SpecValue::I32(PRIOR_STRIDE as i32))];
         Ok(Self {
             guide: ctx.pipeline("ours_guide", &[])?,
+            sums: ctx.pipeline("ours_prior_sums", &stride)?,
             fit: ctx.pipeline("ours_prior_fit", &stride)?,
             combine: ctx.pipeline("ours_prior", &stride)?,
         })
@@ -67,8 +84,8 @@ impl PriorPipelines {
 }
 
 impl Ours {
-    /// Adds the prior over `estimate` (rgb, a variance; the frame's size) guided by `guide`
-    /// (the composited albedo); returns the combined estimate with its variance, and every
+    /// Adds the prior over `estimate` (rgb, a variance; the frame's size) guided by
+    /// `guides`; returns the combined estimate with its variance, and every
     /// pixel's prediction (rgb, a 1 where there is a fit) for the à-trous to carry by.
     pub(super) fn add_prior<'f>(
         &'f self,
@@ -77,8 +94,9 @@ impl Ours {
         graph: &mut RenderGraph,
         frame: &mut Frame<'f>,
         estimate: ImageHandle,
-        guide: ImageHandle,
+        guides: PriorGuides,
     ) -> Result<(ImageHandle, ImageHandle)> {
+        let PriorGuides { albedo, normal } = guides;
         let n = &self.name;
         let desc = graph.image_desc(estimate);
         let [width, height, _] = desc.extent;
@@ -89,6 +107,8 @@ impl Ours {
             height: size.height.div_ceil(PRIOR_STRIDE),
         };
         let cell_desc = ImageDesc::d2(cells.width, cells.height, desc.format);
+        let sum_desc = ImageDesc::d2(cells.width * SUM_TEXELS, cells.height, desc.format);
+        let sums = graph.image(ctx, &format!("{n}.prior_sums"), sum_desc)?;
         let mut fits = Vec::with_capacity(FITS.len());
         for name in FITS {
             fits.push((name, graph.image(ctx, &format!("{n}.{name}"), cell_desc)?));
@@ -102,7 +122,8 @@ impl Ours {
             pad1: 0,
         };
         frame.add_compute(format!("{n}.guide"), &pipelines.guide, push, size, |b| {
-            b.read("guide", guide).write("footprint", footprint);
+            b.read("guide", albedo).read("normal", normal);
+            b.write("footprint", footprint);
         });
         let push = OursPriorFitPush {
             width: size.width,
@@ -110,8 +131,18 @@ impl Ours {
             cells_x: cells.width,
             cells_y: cells.height,
         };
+        frame.add_compute(
+            format!("{n}.prior_sums"),
+            &pipelines.sums,
+            push,
+            cells,
+            |b| {
+                b.read("estimate", estimate).read("footprint", footprint);
+                b.write("sums", sums);
+            },
+        );
         frame.add_compute(format!("{n}.prior_fit"), &pipelines.fit, push, cells, |b| {
-            b.read("estimate", estimate).read("footprint", footprint);
+            b.read("sums", sums);
             for &(name, fit) in &fits {
                 b.write(name, fit);
             }
