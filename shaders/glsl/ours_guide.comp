@@ -1,7 +1,7 @@
 #version 460
 // ours' guides for its spatial prior, spread over each pixel's footprint by a 3×3 tent:
-// the TF albedo composited along the pixel's ray (aux_features.comp), as its luminance,
-// and the gradient normal of its surface (surface_features.comp; zero where the ray finds
+// the TF albedo composited along the pixel's ray (aux_features.comp) and the gradient
+// normal of its surface (surface_features.comp; zero where the ray finds
 // none). The path tracer jitters its samples over the pixel, so a silhouette or a vessel
 // edge between two pixel centres is a blend in the radiance; the tent makes it one in the
 // guides too, and the prior's fit does not draw a staircase.
@@ -11,7 +11,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D guide;       // rgb albedo, a opacity
 layout(binding = 1, rgba32f) uniform readonly image2D normal;      // xyz normal, w distance
-layout(binding = 2, rgba32f) uniform writeonly image2D footprint;  // x albedo's luminance, yzw normal
+layout(binding = 2, rgba16f) uniform writeonly image2D footprint;         // rgb albedo
+layout(binding = 3, rgba16f) uniform writeonly image2D footprint_normal;  // xyz normal
 
 layout(push_constant) uniform OursGuidePush {
     uint width;
@@ -24,14 +25,16 @@ void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
     if (p.x >= size.x || p.y >= size.y) return;
-    vec4 s = vec4(0.0);
+    vec3 sa = vec3(0.0), sn = vec3(0.0);
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
             ivec2 q = clamp(p + ivec2(dx, dy), ivec2(0), size - 1);
             vec3 a = imageLoad(guide, q).rgb, n = imageLoad(normal, q).xyz;
-            vec4 g = vec4(all_finite(a) ? luminance(a) : 0.0, all_finite(n) ? n : vec3(0.0));
-            s += float((2 - abs(dx)) * (2 - abs(dy))) * g;
+            float w = float((2 - abs(dx)) * (2 - abs(dy)));
+            sa += w * (all_finite(a) ? a : vec3(0.0));
+            sn += w * (all_finite(n) ? n : vec3(0.0));
         }
     }
-    imageStore(footprint, p, s / 16.0);
+    imageStore(footprint, p, vec4(sa / 16.0, 1.0));
+    imageStore(footprint_normal, p, vec4(sn / 16.0, 0.0));
 }

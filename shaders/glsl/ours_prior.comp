@@ -4,14 +4,13 @@
 // (ours_prior_fit.comp) predicts it, and the prediction is combined with the estimate by
 // their variances before the à-trous filter.
 //
-// Model. Around p, x_q = βᵀf_q + ε_q, f_q = (1, a_q, q, n_q), with a_q the luminance of
-// the TF albedo composited along q's ray and n_q its surface's gradient normal, both over
-// its footprint (deterministic: ours_guide.comp), and q the position. The fit's
-// prediction x̂_p = βᵀf_p is given the error variance V, the
+// Model. Around p, x_q = βᵀf_q + ε_q, f_q = (1, a_q, n_q), with a_q the TF albedo
+// composited along q's ray and n_q its surface's gradient normal, both over its footprint
+// (deterministic: ours_guide.comp). The fit's prediction x̂_p = βᵀf_p is given the error variance V, the
 // residuals' mean square over the window: its average error there, with the neighbours'
 // own noise counted in full (which the fit averages down), so the prior is trusted less
 // than it could be where the model holds; where it does not hold at p alone (a fold the
-// plane misses) V understates the error. With the estimate's variance P, the two are
+// window's fit misses) V understates the error. With the estimate's variance P, the two are
 // combined as two measurements of one value:
 //     x' = (V x_p + P x̂_p) / (V + P),   P' = V P / (V + P).
 // A young estimate (the first frames, a disocclusion, a change the gradients measured)
@@ -27,7 +26,8 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D estimate;   // rgb x, a P
-layout(binding = 1, rgba32f) uniform readonly image2D footprint;  // guides (ours_guide.comp)
+layout(binding = 1, rgba16f) uniform readonly image2D footprint;          // rgb albedo (ours_guide.comp)
+layout(binding = 10, rgba16f) uniform readonly image2D footprint_normal;  // xyz normal
 layout(binding = 2) uniform sampler2D fit_r_lo;                   // ours_prior_fit.comp
 layout(binding = 3) uniform sampler2D fit_r_hi;                   // a V
 layout(binding = 4) uniform sampler2D fit_g_lo;
@@ -51,9 +51,8 @@ void main() {
     // The fits interpolated bilinearly between the cells' centres (cell i's centre is
     // pixel PRIOR_STRIDE·i + (PRIOR_STRIDE − 1)/2).
     vec2 uv = (vec2(p) + 0.5) / (float(PRIOR_STRIDE) * vec2(textureSize(fit_r_lo, 0)));
-    vec4 g = imageLoad(footprint, p);
-    vec4 lo = features_lo(g, vec2(p) / PRIOR_POSITION_UNIT);
-    vec3 hi = features_hi(g);
+    vec4 lo = features_lo(imageLoad(footprint, p).rgb);
+    vec3 hi = features_hi(imageLoad(footprint_normal, p).xyz);
     vec4 r_hi = texture(fit_r_hi, uv);
     vec3 pred = vec3(dot(texture(fit_r_lo, uv), lo) + dot(r_hi.xyz, hi),
                      dot(texture(fit_g_lo, uv), lo) + dot(texture(fit_g_hi, uv).xyz, hi),

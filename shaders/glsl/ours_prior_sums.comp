@@ -1,16 +1,17 @@
 #version 460
 // ours' spatial prior, the sums: per block of PRIOR_STRIDE×PRIOR_STRIDE pixels (one per
 // fit's cell), the normal equations' sums over its pixels, Σ f fᵀ (lower triangle), Σ f x
-// and Σ x², with the position measured from the block's centre. A fit's window is the
-// 3×3 blocks around its cell (ours_prior_fit.comp), so each pixel's products are formed
-// once here rather than once for each of the nine windows that hold it.
+// and Σ x². A fit's window is the 3×3 blocks around its cell (ours_prior_fit.comp), so
+// each pixel's products are formed once here rather than once for each of the nine
+// windows that hold it.
 #include "common.glsl"
 #include "ours_prior.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D estimate;   // rgb x, a P
-layout(binding = 1, rgba32f) uniform readonly image2D footprint;  // guides (ours_guide.comp)
+layout(binding = 1, rgba16f) uniform readonly image2D footprint;         // rgb albedo (ours_guide.comp)
+layout(binding = 3, rgba16f) uniform readonly image2D footprint_normal;  // xyz normal
 layout(binding = 2, rgba32f) uniform writeonly image2D sums;      // PRIOR_SUM_TEXELS per block, side by side
 
 layout(push_constant) uniform OursPriorFitPush {
@@ -25,7 +26,6 @@ void main() {
     ivec2 cell = ivec2(gl_GlobalInvocationID.xy);
     if (cell.x >= int(pc.cells_x) || cell.y >= int(pc.cells_y)) return;
     ivec2 size = ivec2(pc.width, pc.height);
-    vec2 c = cell_centre(cell);
     float A[D][D];
     vec3 B[D];
     for (int i = 0; i < D; ++i) {
@@ -39,9 +39,8 @@ void main() {
             if (q.x >= size.x || q.y >= size.y) continue;
             vec3 x = imageLoad(estimate, q).rgb;
             if (!all_finite(x)) continue;
-            vec4 g = imageLoad(footprint, q);
-            vec4 lo = features_lo(g, (vec2(q) - c) / PRIOR_POSITION_UNIT);
-            vec3 hi = features_hi(g);
+            vec4 lo = features_lo(imageLoad(footprint, q).rgb);
+            vec3 hi = features_hi(imageLoad(footprint_normal, q).xyz);
             float f[D] = float[D](lo.x, lo.y, lo.z, lo.w, hi.x, hi.y, hi.z);
             for (int i = 0; i < D; ++i) {
                 B[i] += f[i] * x;

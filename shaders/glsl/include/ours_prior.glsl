@@ -6,19 +6,14 @@
 // and it stays in registers (lavapipe otherwise keeps it in memory, at twice the cost).
 #extension GL_EXT_control_flow_attributes : require
 
-// Pixels between two fits' centres (set by the engine, which sizes the grid: its
-// `prior::PRIOR_STRIDE`), and the side of a fit's window, 3×3 blocks of PRIOR_STRIDE
-// pixels: 12×12 pixels hold 144 estimates for the 7 coefficients of each channel.
+// Pixels between two fits' centres and the edge of the blocks their normal equations are
+// summed over (set by the engine, which sizes the grid: its `prior::PRIOR_STRIDE`). A
+// fit's window is the 3×3 blocks around its cell: 12×12 pixels hold 144 estimates for the
+// 7 coefficients of each channel.
 layout(constant_id = 0) const int PRIOR_STRIDE = 4;
-const int PRIOR_WINDOW = 12;
-// The model's features: 1, the guide albedo's luminance, the pixel's position (x, y) and
-// the gradient normal (x, y, z), from the guides' footprint (ours_guide.comp).
+// The model's features: 1, the guide albedo's r, g, b and the gradient normal's x, y, z,
+// from the guides' footprint (ours_guide.comp).
 const int PRIOR_FEATURES = 7;
-const int FEATURE_X = 2;  // the position's
-const int FEATURE_Y = 3;
-// Positions in units of half a window, so that every feature varies by about 1 over it
-// (the normal equations stay well conditioned).
-const float PRIOR_POSITION_UNIT = float(PRIOR_WINDOW / 2);
 // The sums of a block (ours_prior_sums.comp), packed: the lower triangle of Σ f fᵀ, then
 // Σ f x (rgb per feature), then Σ x² (rgb).
 const int SUM_A = 0;
@@ -26,15 +21,10 @@ const int SUM_B = PRIOR_FEATURES * (PRIOR_FEATURES + 1) / 2;
 const int SUM_XX = SUM_B + 3 * PRIOR_FEATURES;
 const int PRIOR_SUM_TEXELS = (SUM_XX + 3 + 3) / 4;
 
-// A cell's centre in pixels (cell i's centre is pixel PRIOR_STRIDE·i + (PRIOR_STRIDE − 1)/2).
-vec2 cell_centre(ivec2 cell) {
-    return vec2(cell * PRIOR_STRIDE) + 0.5 * float(PRIOR_STRIDE - 1);
-}
-
-// The features of a pixel with guides g (x albedo's luminance, yzw normal) at position o
-// (relative to a centre, in PRIOR_POSITION_UNIT); the first four, then the normal's.
-vec4 features_lo(vec4 g, vec2 o) { return vec4(1.0, g.x, o); }
-vec3 features_hi(vec4 g) { return g.yzw; }
+// The features of a pixel with footprint albedo a and normal n: the first four, then the
+// normal's three.
+vec4 features_lo(vec3 a) { return vec4(1.0, a); }
+vec3 features_hi(vec3 n) { return n; }
 
 // Where there is no fit (no finite estimate in the window): V so large that the prior
 // leaves the pixels near the cell as they are.

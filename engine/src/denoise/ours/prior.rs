@@ -1,7 +1,7 @@
 //! `<name>.guide`, `<name>.prior_sums`, `<name>.prior_fit`, `<name>.prior` (ours_guide.comp,
 //! ours_prior_sums.comp, ours_prior_fit.comp, ours_prior.comp): the spatial prior. Where an
 //! estimate is young, a local linear model of its neighbours' estimates on the guides (the
-//! albedo's luminance, the gradient normal) and the position predicts it, and
+//! albedo, the gradient normal) predicts it, and
 //! the two are combined by their variances before the à-trous filter, which then carries
 //! each neighbour by the model's prediction (`CARRY` in variance_atrous.comp).
 
@@ -10,14 +10,15 @@ use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::gpu_block;
 use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
+use ash::vk;
 
 /// Pixels between two fits' centres: the grid's size here, and the shaders' specialisation
 /// constant `PRIOR_STRIDE` (include/ours_prior.glsl).
 pub const PRIOR_STRIDE: u32 = 4;
 
 /// The fits' images, as both shaders name them: per colour channel the coefficients of
-/// the first four features (1, the albedo's luminance, the position's x, y), and of the
-/// normal's three with the residuals' mean square V.
+/// the first four features (1, the albedo's r, g, b), and of the normal's three with the
+/// residuals' mean square V.
 const FITS: [&str; 6] = [
     "fit_r_lo", "fit_r_hi", "fit_g_lo", "fit_g_hi", "fit_b_lo", "fit_b_hi",
 ];
@@ -77,7 +78,7 @@ impl PriorPipelines {
         Ok(Self {
             guide: ctx.pipeline("ours_guide", &[])?,
             sums: ctx.pipeline("ours_prior_sums", &stride)?,
-            fit: ctx.pipeline("ours_prior_fit", &stride)?,
+            fit: ctx.pipeline("ours_prior_fit", &[])?,
             combine: ctx.pipeline("ours_prior", &stride)?,
         })
     }
@@ -101,7 +102,10 @@ impl Ours {
         let desc = graph.image_desc(estimate);
         let [width, height, _] = desc.extent;
         let size = Extent { width, height };
-        let footprint = graph.image(ctx, &format!("{n}.footprint"), desc)?;
+        // The guides in half precision: plenty for a fit's features, half the bandwidth.
+        let half = ImageDesc::d2(width, height, vk::Format::R16G16B16A16_SFLOAT);
+        let footprint = graph.image(ctx, &format!("{n}.footprint"), half)?;
+        let footprint_normal = graph.image(ctx, &format!("{n}.footprint_normal"), half)?;
         let cells = Extent {
             width: size.width.div_ceil(PRIOR_STRIDE),
             height: size.height.div_ceil(PRIOR_STRIDE),
@@ -123,7 +127,8 @@ impl Ours {
         };
         frame.add_compute(format!("{n}.guide"), &pipelines.guide, push, size, |b| {
             b.read("guide", albedo).read("normal", normal);
-            b.write("footprint", footprint);
+            b.write("footprint", footprint)
+                .write("footprint_normal", footprint_normal);
         });
         let push = OursPriorFitPush {
             width: size.width,
@@ -138,7 +143,8 @@ impl Ours {
             cells,
             |b| {
                 b.read("estimate", estimate).read("footprint", footprint);
-                b.write("sums", sums);
+                b.read("footprint_normal", footprint_normal)
+                    .write("sums", sums);
             },
         );
         frame.add_compute(format!("{n}.prior_fit"), &pipelines.fit, push, cells, |b| {
@@ -155,6 +161,7 @@ impl Ours {
         };
         frame.add_compute(format!("{n}.prior"), &pipelines.combine, push, size, |b| {
             b.read("estimate", estimate).read("footprint", footprint);
+            b.read("footprint_normal", footprint_normal);
             for &(name, fit) in &fits {
                 b.sampled(name, fit);
             }
