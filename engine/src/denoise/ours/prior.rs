@@ -23,8 +23,14 @@ const FITS: [&str; 6] = [
     "fit_r_lo", "fit_r_hi", "fit_g_lo", "fit_g_hi", "fit_b_lo", "fit_b_hi",
 ];
 
-/// Texels (rgba32f) of one block's sums: `PRIOR_SUM_TEXELS` in include/ours_prior.glsl.
-const SUM_TEXELS: u32 = 13;
+/// The fit's features (`PRIOR_FEATURES` in include/ours_prior.glsl): 1, the albedo's r,
+/// g, b, the normal's x, y, z.
+const PRIOR_FEATURES: u32 = 7;
+
+/// Texels (rgba32f) of one block's sums, `PRIOR_SUM_TEXELS` in include/ours_prior.glsl:
+/// the lower triangle of Σ f fᵀ, Σ f x per channel and Σ x² per channel, four to a texel.
+const SUM_TEXELS: u32 =
+    (PRIOR_FEATURES * (PRIOR_FEATURES + 1) / 2 + 3 * PRIOR_FEATURES + 3).div_ceil(4);
 
 gpu_block! {
     /// `OursGuidePush` in ours_guide.comp.
@@ -168,5 +174,20 @@ impl Ours {
             b.write("combined", combined).write("prediction", pred);
         });
         Ok((combined, pred))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shader_constants_match() {
+        let glsl = include_str!("../../../../shaders/glsl/include/ours_prior.glsl");
+        assert!(glsl.contains(&format!("const int PRIOR_FEATURES = {PRIOR_FEATURES};")));
+        assert!(glsl.contains("const int PRIOR_SUM_TEXELS = (SUM_XX + 3 + 3) / 4;"));
+        assert!(glsl.contains("const int SUM_B = PRIOR_FEATURES * (PRIOR_FEATURES + 1) / 2;"));
+        assert!(glsl.contains("const int SUM_XX = SUM_B + 3 * PRIOR_FEATURES;"));
+        assert_eq!(SUM_TEXELS, 13);
     }
 }
