@@ -65,9 +65,9 @@ pub const GPU_WARMUP_FRAMES: usize = crate::profile::WARMUP_FRAMES;
 #[derive(clap::Args, Clone, Debug)]
 pub struct EvalArgs {
     /// `suite` (every built-in scene but the stress ones), `stress` (the tf-jump,
-    /// light-jump and fast-orbit scenes), a shipped set (`validation`, `static`,
-    /// `paper`: `assets/scenes/<set>/`), or a comma-separated list of these, built-in
-    /// scene names and scene files.
+    /// light-jump and fast-orbit scenes), a shipped set (`validation`, `development`,
+    /// `static`, `paper`: `assets/scenes/<set>/`), or a comma-separated list of these,
+    /// built-in scene names and scene files.
     #[arg(long, default_value = "suite")]
     pub scene: String,
     /// Frames of each animation (default: each scene's own length).

@@ -11,9 +11,10 @@ pub const STRESS_ANIMATIONS: [&str; 3] = ["tf-jump", "light-jump", "fast-orbit"]
 
 /// Scene sets shipped as folders of scene files (`assets/scenes/<set>/*.toml`): the
 /// frozen validation set (48 frames of continuous change each, never tuned on), the
-/// static views, and `paper`, the TVCG paper's conditions (ray marching, single
-/// scattering with the hybrid phase, emission, one animation type per scene).
-pub const FILE_SETS: [&str; 3] = ["validation", "static", "paper"];
+/// development scenes beside the suite (kinds of change the built-ins lack, tuned on
+/// with it), the static views, and `paper`, the TVCG paper's conditions (ray marching,
+/// single scattering with the hybrid phase, emission, one animation type per scene).
+pub const FILE_SETS: [&str; 4] = ["validation", "development", "static", "paper"];
 
 /// The scene files of a shipped set, sorted by file name.
 fn set_files(set: &str) -> Result<Vec<String>> {
@@ -157,14 +158,19 @@ mod tests {
     fn the_file_sets_are_scene_files_that_load() {
         let validation = select("validation").unwrap();
         assert!(validation.len() >= 8, "{validation:?}");
+        let development = select("development").unwrap();
+        assert!(!development.is_empty(), "{development:?}");
         let statics = select("static").unwrap();
         assert!(statics.len() >= 2, "{statics:?}");
         let paper = select("paper").unwrap();
         assert!(paper.len() >= 5, "{paper:?}");
-        for file in validation.iter().chain(&statics).chain(&paper) {
+        let all = validation.iter().chain(&development).chain(&statics);
+        for file in all.chain(&paper) {
             let scene = Scene::load(file).unwrap_or_else(|e| panic!("{file}: {e}"));
             let set = if validation.contains(file) {
                 "val/"
+            } else if development.contains(file) {
+                "dev/"
             } else if paper.contains(file) {
                 "paper/"
             } else {
