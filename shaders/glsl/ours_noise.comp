@@ -1,9 +1,10 @@
 #version 460
 // ours' noise measurement, first half: per pixel, the sums over the 5 pixels of its row
 // (clamped at the image's edge) of what R is measured from: the variance of each pixel's
-// mean from its samples' luminance moments, or at 1 spp (no moments) the luminance and
-// its square. The update (ours_update.comp) sums 5 rows of these: the 5×5 neighbourhood
-// in 10 loads instead of 25.
+// mean from its samples' luminance moments, and the luminance and its square (at 1 spp,
+// which has no moments, R comes from their spread; the luminance is also the
+// neighbourhood's level of a change). The update (ours_update.comp) sums 5 rows of these:
+// the 5×5 neighbourhood in 10 loads instead of 25.
 #include "common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -29,12 +30,11 @@ void main() {
         if (pc.spp >= 2.0) {
             vec2 m = imageLoad(moments, q).xy;
             s.x += max(m.y - m.x * m.x, 0.0) / max(pc.spp - 1.0, 1.0);
-        } else {
-            vec3 c = imageLoad(noisy, q).rgb;
-            float y = all_finite(c) ? luminance(c) : 0.0;
-            s.y += y;
-            s.z += y * y;
         }
+        vec3 c = imageLoad(noisy, q).rgb;
+        float y = all_finite(c) ? luminance(c) : 0.0;
+        s.y += y;
+        s.z += y * y;
     }
     imageStore(rows, p, vec4(s, 0.0));
 }

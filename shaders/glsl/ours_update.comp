@@ -8,9 +8,10 @@
 // with one variance per pixel shared by the channels (P for the estimate, Q, R):
 //   - g_t, the measured change: the temporal gradients' ratio of this frame's radiance to
 //     last frame's on re-traced paths (ours_gradient*.comp), 1 where nothing changed;
-//   - Q_t, what the prediction may have missed: (change_q · change · luminance)² for a
+//   - Q_t, what the prediction may have missed: (change_q · change · level)² for a
 //     change the gradients measured (their ratio is a neighbourhood's, the pixel's own may
-//     differ in proportion), motion_q · R for a pixel whose surface moved on screen (the
+//     differ in proportion; the level is the larger of the pixel's luminance and its 5×5
+//     neighbourhood's in this frame), motion_q · R for a pixel whose surface moved on screen (the
 //     view-dependent change of a semi-transparent volume), and a shift the pooled lag test
 //     found (its own size);
 //   - R_t, the variance of one frame's pixel mean, estimated from the samples' own
@@ -77,18 +78,24 @@ const float STILL_PX = 0.01;
 // residual has a third of one frame's noise variance.
 const float LAG_BLEND = 0.5;
 
+// This frame's sums over the 5×5 neighbourhood: x the moments' noise, y the luminance, z
+// its square. ours_noise.comp summed each row's 5 pixels; this sums 5 rows.
+vec3 neighbourhood_sums(ivec2 p, ivec2 size) {
+    vec3 s = vec3(0.0);
+    for (int dy = -2; dy <= 2; ++dy) {
+        s += imageLoad(noise_rows, ivec2(p.x, clamp(p.y + dy, 0, size.y - 1))).xyz;
+    }
+    return s;
+}
+
 // R of a pixel without history, and this frame's measurement of R: the moments' noise
 // over the 5×5 neighbourhood (one pixel's two samples say too little); at 1 spp, which has
 // no moments, the spread of the 5×5 pixels' luminance (signal detail included: an
 // overestimate, which only slows the first frames). Under heavy tails 3×3 was too few:
 // where no bright path landed in 18 samples R came out near zero, the filter looked
 // converged on a low mean, and the à-trous kept it as a dark blotch (static views).
-// ours_noise.comp summed each row's 5 pixels; this sums 5 rows.
-float fresh_noise(ivec2 p, ivec2 size) {
-    vec3 s = vec3(0.0);
-    for (int dy = -2; dy <= 2; ++dy) {
-        s += imageLoad(noise_rows, ivec2(p.x, clamp(p.y + dy, 0, size.y - 1))).xyz;
-    }
+// `s` is neighbourhood_sums'.
+float fresh_noise(vec3 s) {
     if (pc.spp >= 2.0) return s.x / 25.0 + TINY;
     return max(s.z / 25.0 - (s.y / 25.0) * (s.y / 25.0), 0.0) * 25.0 / 24.0 + TINY;
 }
@@ -134,6 +141,7 @@ void main() {
 
     vec3 y = imageLoad(noisy, p).rgb;
     if (!all_finite(y)) y = vec3(0.0);
+    vec3 sums = neighbourhood_sums(p, size);
     Reprojection r = reproject(p, size, pc.history_valid != 0u, pc.camera.xyz, pc.tolerance);
 
     vec3 x;
@@ -144,7 +152,7 @@ void main() {
     bool fresh = !r.valid || !all_finite(m.rgb) || !(m.a >= 0.0) || isinf(m.a);
     if (fresh) {
         x = y;
-        R = fresh_noise(p, size);
+        R = fresh_noise(sums);
         P = R;
     } else {
         vec2 noise_state = history_fetch(noise_prev, r).xy;
@@ -157,7 +165,11 @@ void main() {
         R = max(noise * g * g, TINY);
         D = max(noise_state.y, 0.0) * g * g;
         float P_carried = P;
-        float level = luminance(max(x, vec3(0.0)));
+        // The change's scale: the larger of the pixel's level and its neighbourhood's in
+        // this frame. A pixel the light is about to reach is dark (x ≈ 0), and its own
+        // level would keep Q ≈ 0 while its neighbours brighten: the gain must open
+        // there too.
+        float level = max(luminance(max(x, vec3(0.0))), sums.y / 25.0);
         float Q = pc.change_q * sc.change * level;
         Q *= Q;
         if (length(r.motion) > STILL_PX) Q += pc.motion_q * R;
@@ -193,7 +205,7 @@ void main() {
         // This frame's noise measurement joins R before the gain uses it, weighted as the
         // prediction leaves room for it: where a change made the prediction uncertain
         // (P⁻ ≫ R) R is this frame's, as a fresh pixel's; converged, it moves by about 1/n.
-        R = max(R + P_prior / (P_prior + R) * (fresh_noise(p, size) - R), TINY);
+        R = max(R + P_prior / (P_prior + R) * (fresh_noise(sums) - R), TINY);
         float nu2 = e2 / max(P_prior + R, TINY);
         float z2 = pc.outlier_z * pc.outlier_z;
         bool far = nu2 > z2;
@@ -217,7 +229,7 @@ void main() {
     }
     if (!all_finite(x) || !(P >= 0.0) || isinf(P)) {
         x = y;
-        R = fresh_noise(p, size);
+        R = fresh_noise(sums);
         P = R;
         D = 0.0;
     }

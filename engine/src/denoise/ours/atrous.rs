@@ -41,7 +41,7 @@ impl Ours {
             };
             let level = Level {
                 step: 1 << i,
-                kappa: self.params.kappa,
+                kappa: self.params.outlier_z,
                 keep: self.params.keep,
                 last,
             };

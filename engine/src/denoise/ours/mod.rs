@@ -60,7 +60,8 @@ pub struct OursParams {
     /// departure.
     pub shrink: f32,
     /// Process noise of a measured change: the pixel's own change may differ from its
-    /// neighbourhood's measured one by this share of it (Q = (change_q · change · L)²).
+    /// neighbourhood's measured one by this share of it (Q = (change_q · change · L)², L
+    /// the larger of the pixel's luminance and its 5×5 neighbourhood's).
     pub change_q: f32,
     /// Process noise of a pixel whose surface moved on screen, in units of its
     /// measurement noise (the view-dependent change of a semi-transparent volume).
@@ -68,12 +69,12 @@ pub struct OursParams {
     /// Pooled residual, in standard errors of its mean, below which it is noise; beyond,
     /// the positive-part shrinkage of it is taken as a shift of the state.
     pub lag_z: f32,
-    /// Innovation, in standard deviations, beyond which a sample is clipped; and pooled
-    /// residual, in standard errors of its mean, beyond which the level jumped.
+    /// How far, in its standard deviations, a difference lies beyond the noise: an
+    /// innovation beyond it is clipped; a pooled residual beyond it (in standard errors
+    /// of its mean) is a jump of the level; a neighbour's estimate farther from the
+    /// pixel's than this (in the two estimates' standard errors) is not blended by the
+    /// à-trous.
     pub outlier_z: f32,
-    /// Standard errors by which a neighbour's estimate may differ from the pixel's and
-    /// still be blended (the à-trous range term).
-    pub kappa: f32,
     /// Relative standard error of an estimate below which the à-trous levels keep the
     /// pixel as it is (blending could only pull a converged estimate towards noisier
     /// neighbours).
@@ -89,7 +90,6 @@ impl Default for OursParams {
             motion_q: 0.01,
             lag_z: 1.5,
             outlier_z: 6.0,
-            kappa: 2.5,
             keep: 0.02,
         }
     }
@@ -104,13 +104,12 @@ const OVERRIDABLE: &[Overridable<OursParams>] = &[
     ("motion_q", 0.0, 1e3, |p, v| p.motion_q = v),
     ("lag_z", 0.0, 1e3, |p, v| p.lag_z = v),
     ("outlier_z", 0.5, 1e3, |p, v| p.outlier_z = v),
-    ("kappa", 0.0, 1e3, |p, v| p.kappa = v),
     ("keep", 0.0, 1.0, |p, v| p.keep = v),
 ];
 
 impl OursParams {
     /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
-    /// `DVR_OURS="change_q=2,kappa=3"`.
+    /// `DVR_OURS="change_q=2,keep=0.1"`.
     pub fn with_overrides(self, spec: Option<&str>) -> Result<Self> {
         super::with_overrides(self, "DVR_OURS", spec, OVERRIDABLE)
     }
@@ -259,20 +258,21 @@ mod tests {
     #[test]
     fn overrides_are_named_and_range_checked() {
         let p = OursParams::default()
-            .with_overrides(Some("change_q=2, kappa=3"))
+            .with_overrides(Some("change_q=2, keep=0.1"))
             .expect("valid overrides");
-        assert_eq!((p.change_q, p.kappa), (2.0, 3.0));
+        assert_eq!((p.change_q, p.keep), (2.0, 0.1));
         assert_eq!(
             OursParams::default().with_overrides(None).ok(),
             Some(OursParams::default())
         );
         for (spec, says) in [
-            ("kappa=nan", "kappa must be in"),
+            ("shrink=nan", "shrink must be in"),
             ("keep=1e30", "keep must be in"),
             ("outlier_z=0.1", "outlier_z must be in"),
             ("lambda=0.9", "parameters: stratum"),
-            ("kappa", "name=value"),
-            ("kappa=x", "a number"),
+            ("keep", "name=value"),
+            ("keep=x", "a number"),
+            ("kappa=3", "parameters: stratum"),
         ] {
             let e = OursParams::default()
                 .with_overrides(Some(spec))
