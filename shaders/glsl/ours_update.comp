@@ -11,9 +11,9 @@
 //   - Q_t, what the prediction may have missed: (change_q · change · level)² for a
 //     change the gradients measured (their ratio is a neighbourhood's, the pixel's own may
 //     differ in proportion; the level is the larger of the pixel's luminance and its 5×5
-//     neighbourhood's in this frame), motion_q · R for a pixel whose surface moved on screen (the
-//     view-dependent change of a semi-transparent volume), and a shift the pooled lag test
-//     found (its own size);
+//     neighbourhood's in this frame), motion_q · R for a pixel whose surface moved on
+//     screen (the view-dependent change of a semi-transparent volume), and a shift the
+//     pooled lag test found (its own size);
 //   - R_t, the variance of one frame's pixel mean, estimated from the samples' own
 //     luminance moments over 5×5 pixels (at 1 spp: the 5×5 luminances' spread), scaled
 //     with the radiance by g_t and averaged over the filter's memory; this frame's
@@ -94,7 +94,7 @@ vec3 neighbourhood_sums(ivec2 p, ivec2 size) {
 // overestimate, which only slows the first frames). Under heavy tails 3×3 was too few:
 // where no bright path landed in 18 samples R came out near zero, the filter looked
 // converged on a low mean, and the à-trous kept it as a dark blotch (static views).
-// `s` is neighbourhood_sums'.
+// `s`: the sums neighbourhood_sums returns.
 float fresh_noise(vec3 s) {
     if (pc.spp >= 2.0) return s.x / 25.0 + TINY;
     return max(s.z / 25.0 - (s.y / 25.0) * (s.y / 25.0), 0.0) * 25.0 / 24.0 + TINY;
