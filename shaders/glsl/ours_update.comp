@@ -17,7 +17,9 @@
 //   - R_t, the variance of one frame's pixel mean, estimated from the samples' own
 //     luminance moments over 5×5 pixels (at 1 spp: the 5×5 luminances' spread), scaled
 //     with the radiance by g_t and averaged over the filter's memory; this frame's
-//     measurement joins before the gain uses it, with the weight P⁻ / (P⁻ + R).
+//     measurement joins before the gain uses it, with the weight P⁻ / (P⁻ + R). Where the
+//     lag test shifted the level, the carried R was the old level's: a lower measurement
+//     replaces it (a surface that fell into shadow has no noise left there).
 // Predict: x⁻ = g ∘ x, P⁻ = ḡ² P + Q. Update: K = P⁻ / (P⁻ + R), x = x⁻ + K (y − x⁻),
 // P = (1 − K) P⁻. With nothing changing Q = 0 and K = 1/n: the running mean, which only
 // improves.
@@ -174,6 +176,7 @@ void main() {
         Q *= Q;
         if (length(r.motion) > STILL_PX) Q += pc.motion_q * R;
         vec3 shift = vec3(0.0);
+        bool shifted = false;
         bool jump = false;
         if (pc.lag_valid != 0u) {
             // A residual the neighbourhood shares, beyond lag_z standard errors, is a
@@ -187,7 +190,8 @@ void main() {
             vec4 lag = history_fetch(lag_prev, r);
             float z2 = dot(lag.rgb, lag.rgb) / 3.0 / max(lag.a, TINY);
             float B = D + Q;
-            if (z2 > pc.lag_z * pc.lag_z) shift = B / (B + max(lag.a, TINY)) * lag.rgb;
+            shifted = z2 > pc.lag_z * pc.lag_z && B > 0.0;
+            if (shifted) shift = B / (B + max(lag.a, TINY)) * lag.rgb;
             x += shift;
             Q += dot(shift, shift) / 3.0;
             // A shared residual beyond outlier_z standard errors is a jump, announced or
@@ -205,7 +209,13 @@ void main() {
         // This frame's noise measurement joins R before the gain uses it, weighted as the
         // prediction leaves room for it: where a change made the prediction uncertain
         // (P⁻ ≫ R) R is this frame's, as a fresh pixel's; converged, it moves by about 1/n.
-        R = max(R + P_prior / (P_prior + R) * (fresh_noise(sums) - R), TINY);
+        // Where the level shifted, a lower measurement replaces R outright: the carried R
+        // is the old level's noise (a lit surface under a binary shadow ray, now in
+        // shadow, has none), and averaged in at the gain's weight it would keep the gain
+        // small while the estimate still shows the light that left. A higher one is
+        // averaged in as usual (a single frame's high measurement would shut the gain).
+        float R_now = fresh_noise(sums);
+        R = max(shifted && R_now < R ? R_now : R + P_prior / (P_prior + R) * (R_now - R), TINY);
         float nu2 = e2 / max(P_prior + R, TINY);
         float z2 = pc.outlier_z * pc.outlier_z;
         bool far = nu2 > z2;
