@@ -64,8 +64,8 @@ pub struct RenderArgs {
           value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Position the temporal denoisers reproject with: `features` (opacity-threshold
-    /// surface, or the expected first collision through semi-transparent layers; measured
-    /// 0.2–0.5 dB better for every temporal method) or `first-hit` (the closest first real
+    /// surface, or the expected first collision through semi-transparent layers; on the
+    /// suite 0.4–0.7 dB better for every temporal method) or `first-hit` (the closest first real
     /// collision among the frame's samples, the paper's choice). References do not
     /// depend on it.
     #[arg(long, default_value_t = RenderArgs::default().motion)]
