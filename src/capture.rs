@@ -43,11 +43,11 @@ pub fn capture(
     let denoisers = crate::setup::denoiser_list(denoisers)?;
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
-    let mut renderer = setup.renderer(&names)?;
+    let mut session = setup.session(&names)?;
     crate::setup::create_out_dir(out)?;
-    for m in renderer.denoiser_names() {
-        std::fs::create_dir_all(out.join(&m))
-            .with_context(|| format!("creating {}", out.join(&m).display()))?;
+    for m in session.denoisers() {
+        std::fs::create_dir_all(out.join(m))
+            .with_context(|| format!("creating {}", out.join(m).display()))?;
     }
     let started = Instant::now();
     let mut timings: Vec<Vec<PassTiming>> = Vec::new();
@@ -60,14 +60,15 @@ pub fn capture(
     let mut progress = Progress::new(f64::from(setup.frames));
     let mut rate = FrameRate::default();
     for f in 0..setup.frames {
-        if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
+        session.play(f)?;
+        if let Some(done) = session.frame(&request, None)? {
             write_frame(out, &setup, &done)?;
             timings.push(done.timings);
             rate.finished();
         }
         progress.advance(1.0, &frame_status("capture", f + 1, setup.frames, &rate));
     }
-    for done in renderer.flush()? {
+    for done in session.flush()? {
         write_frame(out, &setup, &done)?;
         timings.push(done.timings);
     }
@@ -75,17 +76,17 @@ pub fn capture(
     profile::write_json(
         &out.join("timings.json"),
         &serde_json::json!({
-            "device": renderer.ctx().info.name,
+            "device": session.ctx().info.name,
             "scene": setup.name,
             "width": setup.width(),
             "height": setup.height(),
             "spp": setup.settings.spp(),
-            "denoisers": renderer.denoiser_names(),
+            "denoisers": session.renderer()?.denoiser_names(),
             "frames": timings,
         }),
     )?;
     let (passes, total) = profile::aggregate(&timings);
-    let methods = renderer.denoiser_names();
+    let methods = session.renderer()?.denoiser_names();
     let videos = if video.video {
         let tracks: Vec<Track> = methods
             .iter()
@@ -99,7 +100,7 @@ pub fn capture(
     println!(
         "wrote {} frames × {} method(s) to {} ({:.1} s)",
         setup.frames,
-        renderer.denoiser_names().len(),
+        methods.len(),
         out.display(),
         started.elapsed().as_secs_f64()
     );
@@ -240,8 +241,8 @@ pub fn run_profile(
     let denoisers = crate::setup::denoiser_list(denoisers)?;
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
-    let mut renderer = setup.renderer(&names)?;
-    let peak = dvr_engine::passes::bandwidth::measure(renderer.ctx())
+    let mut session = setup.session(&names)?;
+    let peak = dvr_engine::passes::bandwidth::measure(session.ctx())
         .context("measuring the peak bandwidth")?;
     // Streaming statistics and a bounded window of raw frames: memory stays flat
     // however many frames run.
@@ -263,16 +264,18 @@ pub fn run_profile(
             ));
             break;
         }
-        if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
+        session.play(f)?;
+        if let Some(done) = session.frame(&request, None)? {
             keep(done.timings);
             rate.finished();
         }
         progress.advance(1.0, &frame_status("profile", f + 1, setup.frames, &rate));
     }
-    for done in renderer.flush()? {
+    for done in session.flush()? {
         keep(done.timings);
     }
     progress.finish();
+    let renderer = session.renderer()?;
     let run = profile::RunInfo {
         device: renderer.ctx().info.name.clone(),
         scene: setup.name.clone(),

@@ -8,8 +8,9 @@ use dvr_engine::denoise::registry;
 use dvr_engine::gpu::GpuContext;
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::scene_setup::SceneSetup;
-use dvr_engine::renderer::{FrameInputs, Renderer};
+use dvr_engine::renderer::FrameInputs;
 use dvr_engine::scene::{RenderSettings, Scene};
+use dvr_engine::session::Session;
 use std::path::Path;
 
 /// The scene `dvr` renders when none is named.
@@ -222,11 +223,19 @@ impl Setup {
         self.inner.config.size.height
     }
 
-    pub fn renderer(&self, denoisers: &[&str]) -> Result<Renderer> {
-        Ok(self.inner.renderer(GpuContext::headless()?, denoisers)?)
+    /// A live session over this scene on a headless device, running `denoisers`: the
+    /// engine type the explorer and the Python package drive too. Scripted frames are
+    /// [`Session::play`] then [`Session::frame`].
+    pub fn session(&self, denoisers: &[&str]) -> Result<Session> {
+        Ok(Session::new(
+            self.inner.clone(),
+            GpuContext::headless()?,
+            denoisers,
+        )?)
     }
 
-    /// The renderer's inputs for animation frame `f`.
+    /// The renderer's inputs for animation frame `f` (what the scene's view at `f`
+    /// becomes; a session playing frame `f` renders the same).
     pub fn inputs(&self, f: u32) -> FrameInputs {
         self.inner.frame_inputs(f)
     }

@@ -2,7 +2,8 @@
 //! `shaders` (the compiled SPIR-V, block layouts, the frame block and shared constants) →
 //! `gpu` (device, memory, pipelines, timestamps) → `graph` (explicit render graph) →
 //! `passes` (one GPU pass per file) and `denoise` (each denoiser's passes and history) →
-//! `renderer` (the frame). CPU-side data (`volume`, `transfer`, `scene`, `metrics`) feeds
+//! `renderer` (the frame) → `session` (a live view: edits in, frames out; what the
+//! explorer, the scripted animations and Python drive). CPU-side data (`volume`, `transfer`, `scene`, `metrics`) feeds
 //! them; `assets` says where the shipped files are.
 
 pub mod assets;
@@ -17,6 +18,7 @@ pub mod metrics;
 pub mod passes;
 pub mod renderer;
 pub mod scene;
+pub mod session;
 pub mod shaders;
 pub mod transfer;
 pub mod volume;

@@ -5,12 +5,17 @@ linear radiance, scores from :mod:`dvr.metrics` equal to what ``dvr eval`` repor
 
     import numpy as np, dvr
     vol = dvr.Volume(np.load("ct.npy"), spacing=(1.0, 0.7, 0.7))
-    scene = dvr.Scene(vol, tf=dvr.TransferFunction.preset("phantom-opaque"), frames=16)
-    scene.orbit(degrees_per_frame=2.0)
-    r = dvr.Renderer(scene, size=(128, 128), denoisers=["ours", "svgf"])
-    frames = [r.render() for _ in range(scene.frames)]   # an animation, in order
-    ref = r.reference(spp=256)                            # of the last frame
-    print(dvr.metrics.psnr(ref, frames[-1]["ours"]))
+    r = dvr.Renderer(dvr.Scene(vol, tf="phantom-opaque"), size=(128, 128), denoisers=["ours", "svgf"])
+    for _ in range(16):
+        out = r.render()          # a still view keeps refining
+    r.orbit(40, 0)                # an edit: the next frames reproject it
+    r.lights[0].intensity = 30
+    out = r.render()
+    ref = r.reference(spp=256)    # of the current view
+    print(dvr.metrics.psnr(ref, out["ours"]))
+
+A scripted animation renders with ``r.render(frame=k)`` for k in order, as ``dvr capture``
+does; :class:`dvr.Viewer` shows a live renderer in a notebook cell.
 """
 
 from . import _native, metrics
@@ -24,22 +29,37 @@ from .scene import (
     TransferFunction,
     builtin_scenes,
 )
+from .live import CameraView, LightsView, LightView, SettingsView
 from .renderer import Renderer, denoisers
 
 __all__ = [
     "AreaLight",
     "Camera",
+    "CameraView",
     "EnvironmentLight",
+    "LightView",
+    "LightsView",
     "PointLight",
     "Renderer",
     "Scene",
+    "SettingsView",
     "TransferFunction",
+    "Viewer",
     "Volume",
     "builtin_scenes",
     "denoisers",
     "load_volume",
     "metrics",
 ]
+
+
+def __getattr__(name):
+    # dvr.Viewer imports anywidget (the notebook extra) only when it is used.
+    if name == "Viewer":
+        from .viewer import Viewer
+
+        return Viewer
+    raise AttributeError(f"module 'dvr' has no attribute {name!r}")
 
 
 def load_volume(path, gpu_memory=None) -> Volume:

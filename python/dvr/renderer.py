@@ -1,9 +1,15 @@
-"""The renderer: a scene at one size with its denoisers on one Vulkan device."""
+"""The renderer: a live view of a scene on one Vulkan device, edited between frames."""
+
+import threading
+
+import numpy as np
 
 from . import _native
-from .scene import Scene
+from .live import CameraView, LightsView, SettingsView, _as_dict, _plain
+from .scene import Scene, TransferFunction
 
 __all__ = ["Renderer", "denoisers"]
+
 
 def denoisers() -> dict:
     """The names :class:`Renderer` accepts in ``denoisers`` (the CLI's ``--denoiser``
@@ -14,9 +20,22 @@ def denoisers() -> dict:
 class Renderer:
     """Renders ``scene`` at ``size`` = (width, height) with ``spp`` samples per pixel per
     frame (default: the scene's) and runs each of ``denoisers`` on the same noisy
-    frames. The temporal state lives here: calling :meth:`render` for frames 0..n in
-    order renders the animation. ``motion`` is what the temporal denoisers reproject
-    with (``"features"`` or ``"first-hit"``, as the CLI's ``--motion``).
+    frames. ``motion`` is what the temporal denoisers reproject with (``"features"`` or
+    ``"first-hit"``, as the CLI's ``--motion``).
+
+    A renderer is a live view, driven like the explorer: :meth:`render` renders the
+    current view for as long as it is called (a still view keeps refining), and
+    :attr:`camera`, :attr:`lights`, :attr:`tf`, :attr:`settings` and :attr:`denoisers`
+    are its live state. Assigning one (or a field of one: ``r.camera.position = ...``,
+    ``r.lights[0].intensity = 30``, ``r.settings.spp = 2``) is an edit that the next
+    render reprojects rather than restarts; :meth:`orbit`, :meth:`pan` and :meth:`zoom`
+    move the camera with the explorer's mouse semantics. ``render(frame=k)`` first sets
+    the view to the scene's animation at frame k: rendering frames 0..n in order renders
+    the animation exactly as ``dvr capture`` and ``dvr eval`` do.
+
+    Calls from several threads serialise on the renderer's lock; the GIL is released
+    while the device works. :meth:`close` (or ``with Renderer(...) as r:``) frees the
+    device memory at once.
 
     ``device`` picks the Vulkan device by a substring of its name; by default it is the
     one the CLI picks (a discrete GPU first; ``DVR_DEVICE`` forces one). Without a
@@ -35,45 +54,157 @@ class Renderer:
             scene = Scene.builtin(scene) if scene in _native.builtin_scene_names() else Scene.load(scene)
         if isinstance(denoisers, str):
             denoisers = [denoisers]
-        size = tuple(int(x) for x in size)
-        if len(size) != 2:
-            raise ValueError(f"size: expected (width, height), got {size!r}")
+        size = _size(size)
         self.scene = scene
         tf = scene.tf.to_dict() if getattr(scene, "tf", None) is not None else None
+        # Edits that read the view, change one part and write it back hold this, so two
+        # threads editing different parts lose neither edit.
+        self._edit = threading.Lock()
         self._r = _native.Renderer(
             scene._engine_dict(), size, list(denoisers), volume=scene.volume, tf=tf, spp=spp, motion=motion,
             device=device, gpu_memory=None if gpu_memory is None else str(gpu_memory),
         )
 
+    # Rendering.
+
     def render(self, frame=None, reset=False, aux=False, features=False) -> dict:
-        """Renders animation frame ``frame`` (default: the next) and returns
-        ``{"noisy": img, "<denoiser>": img, ...}``, each ``(h, w, 3)`` float32 linear
-        radiance; with ``aux=True`` also ``"albedo"`` and ``"normal"`` (the guides
-        single-frame denoisers such as OIDN take); with ``features=True`` also
-        ``"features"``: ``{"position", "normal", "albedo"}``, each ``(h, w, 4)`` (the
-        opacity-threshold surface the temporal denoisers reproject with: world position
-        with w = 1 where the ray met that surface or, through semi-transparent medium,
-        at the expected first collision; normal with w = the distance along the ray and
-        TF albedo with w = 1, both on the threshold surface only). ``reset=True`` is a
-        cut."""
+        """Renders the current view (with ``frame``: the scene's animation at that frame)
+        and returns ``{"noisy": img, "<denoiser>": img, ...}``, each ``(h, w, 3)``
+        float32 linear radiance; with ``aux=True`` also ``"albedo"`` and ``"normal"``
+        (the guides single-frame denoisers such as OIDN take); with ``features=True``
+        also ``"features"``: ``{"position", "normal", "albedo"}``, each ``(h, w, 4)``
+        (the opacity-threshold surface the temporal denoisers reproject with: world
+        position with w = 1 where the ray met that surface or, through semi-transparent
+        medium, at the expected first collision; normal with w = the distance along the
+        ray and TF albedo with w = 1, both on the threshold surface only).
+        ``reset=True`` is a cut: every history restarts."""
         return self._r.render(frame, reset, aux, features)
 
     def reference(self, frame=None, spp=1024):
-        """A high-sample reference of ``frame`` (default: the last rendered), from its
-        own sample stream: what ``dvr reference`` writes for that frame."""
+        """A high-sample reference from its own sample stream: of the current view, or
+        with ``frame`` of the scene's animation at that frame (what ``dvr reference``
+        writes for it), leaving the view as it is."""
         return self._r.reference(frame, spp)
 
     def timings(self) -> dict:
         """GPU milliseconds per pass of the last rendered frame."""
         return self._r.timings()
 
+    # The live state.
+
+    @property
+    def camera(self) -> CameraView:
+        """The camera, live (assign a :class:`dvr.Camera`, a dict, or a field)."""
+        return CameraView(lambda: self._r.view()["camera"], lambda d: self._put("camera", d), "camera")
+
+    @camera.setter
+    def camera(self, camera):
+        self._put("camera", _as_dict(camera, "camera"))
+
+    @property
+    def lights(self) -> LightsView:
+        """The lights, live (assign a list of light objects or dicts, or a field of
+        one: ``r.lights[0].intensity = 30``)."""
+        return LightsView(lambda: self._r.view().get("light", []), lambda l: self._put("light", l))
+
+    @lights.setter
+    def lights(self, lights):
+        self._put("light", [_as_dict(l, "light") for l in lights])
+
+    @property
+    def settings(self) -> SettingsView:
+        """The render settings, live (``r.settings.spp = 2``; a change restarts every
+        history)."""
+        return SettingsView(lambda: self._r.view().get("render", {}), lambda d: self._put("render", d), "settings")
+
+    @settings.setter
+    def settings(self, settings):
+        self._put("render", _as_dict(settings, "settings"))
+
+    @property
+    def tf(self) -> TransferFunction:
+        """The transfer function in effect, immutable (assign a preset name, a TF file
+        path, a :class:`dvr.TransferFunction` or an ``(N, 5)`` array of ``density, r,
+        g, b, opacity`` rows to change it; ``r.tf.copy()`` is an editable copy)."""
+        d = self._r.tf()
+        return TransferFunction._frozen(d["a"]["point"], d["a"].get("name", "tf"))
+
+    @tf.setter
+    def tf(self, tf):
+        self._r.set_tf(TransferFunction.coerce(tf).to_dict())
+
+    @property
+    def denoisers(self) -> tuple:
+        """The denoisers this renderer runs, in order (assign a list to change them:
+        every history restarts)."""
+        return tuple(self._r.denoisers)
+
+    @denoisers.setter
+    def denoisers(self, names):
+        if isinstance(names, str):
+            names = [names]
+        self._r.set_denoisers([str(n) for n in names])
+
+    @property
+    def size(self) -> tuple:
+        """(width, height); assign to render at another size (histories restart)."""
+        return tuple(self._r.size)
+
+    @size.setter
+    def size(self, size):
+        self._r.resize(*_size(size))
+
+    def orbit(self, dx, dy=0.0):
+        """Orbits the camera about its target as a left-drag of (dx, dy) pixels in the
+        explorer does (0.01 radians per pixel)."""
+        self._r.orbit(float(dx), float(dy))
+
+    def pan(self, dx, dy):
+        """Moves the camera as a right-drag of (dx, dy) pixels does: the point under the
+        cursor follows it."""
+        self._r.pan(float(dx), float(dy))
+
+    def zoom(self, steps):
+        """Wheel steps: positive zooms in (each step divides the distance by 1.1)."""
+        self._r.zoom(float(steps))
+
+    def reset_camera(self):
+        """Back to the camera the renderer started with."""
+        self._r.reset_camera()
+
+    def fit(self):
+        """Flies to fit the volume, keeping the viewing direction."""
+        self._r.fit()
+
+    # The rest.
+
+    def histogram(self) -> np.ndarray:
+        """Counts of the volume's normalised densities in 256 equal bins over [0, 1]
+        (what a TF editor draws behind its curve)."""
+        return np.asarray(self._r.histogram(), dtype=np.int64)
+
+    def close(self):
+        """Frees the device memory now; the renderer is unusable after."""
+        self._r.close()
+
+    @property
+    def closed(self) -> bool:
+        return self._r.closed
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
     @property
     def frames(self) -> int:
+        """Frames in the scene's animation (what ``render(frame=k)`` plays)."""
         return self._r.frames
 
     @property
-    def denoisers(self) -> list:
-        return self._r.denoisers
+    def frames_rendered(self) -> int:
+        return self._r.frames_rendered
 
     @property
     def device(self) -> str:
@@ -90,6 +221,26 @@ class Renderer:
     def spp(self) -> int:
         return self._r.spp
 
-    @property
-    def size(self) -> tuple:
-        return self._r.size
+    def _put(self, section, value):
+        with self._edit:
+            view = self._r.view()
+            view[section] = _plain(value)
+            self._r.set_view(view)
+
+    def __repr__(self):
+        return f"Renderer({self.scene.name!r}, size={self.size}, denoisers={self.denoisers})"
+
+
+def _size(size):
+    try:
+        w, h = size
+    except (TypeError, ValueError):
+        raise ValueError(f"size: expected (width, height), got {size!r}") from None
+    for name, v in (("width", w), ("height", h)):
+        try:
+            whole = not isinstance(v, bool) and float(v).is_integer()
+        except (TypeError, ValueError):
+            whole = False
+        if not whole:
+            raise ValueError(f"size: {name} must be a whole number of pixels, got {v!r}")
+    return int(w), int(h)

@@ -3,10 +3,12 @@ that dvr's scene and TF files hold (``engine/src/scene/mod.rs`` documents every 
 The engine checks them with the code that checks files, so errors read as the CLI's."""
 
 import copy
+import types
 
 import numpy as np
 
 from . import _native
+from .live import CameraView, LightsView, _as_dict
 
 __all__ = [
     "AreaLight",
@@ -44,6 +46,51 @@ class TransferFunction:
         self.name = name
         self.points = [dict(p) for p in points]
         _native.check_tf(self.to_dict())
+
+    @classmethod
+    def _frozen(cls, points, name):
+        """An immutable TF (what a renderer hands out: its TF changes only by
+        assignment, so an edit of a copy must not look as if it applied)."""
+        tf = cls(points, name)
+        tf.points = tuple(types.MappingProxyType(dict(p)) for p in tf.points)
+        object.__setattr__(tf, "_immutable", True)
+        return tf
+
+    def __setattr__(self, name, value):
+        if getattr(self, "_immutable", False):
+            raise AttributeError(
+                "this transfer function is the renderer's, immutable: assign a new one to "
+                "r.tf (tf.copy() is an editable copy)"
+            )
+        object.__setattr__(self, name, value)
+
+    def copy(self) -> "TransferFunction":
+        """An editable copy."""
+        return TransferFunction([dict(p) for p in self.points], self.name)
+
+    @classmethod
+    def coerce(cls, tf) -> "TransferFunction":
+        """A TF from what a user may hand over: a TransferFunction, a preset name, a TF
+        file path, an ``(N, 5)`` array of ``density, r, g, b, opacity`` rows, or a TF
+        dict (``{"name": ..., "point": [...]}``)."""
+        if isinstance(tf, cls):
+            return tf
+        if isinstance(tf, str):
+            if tf in _native.tf_preset_names():
+                return cls.preset(tf)
+            return cls.load(tf)
+        if isinstance(tf, dict):
+            if "point" not in tf:
+                raise ValueError("transfer function: a TF dict needs a 'point' list")
+            return cls(tf["point"], tf.get("name", "python"))
+        if hasattr(tf, "__fspath__"):
+            return cls.load(tf)
+        if isinstance(tf, (list, tuple, np.ndarray)):
+            return cls.from_array(tf)
+        raise TypeError(
+            f"transfer function: expected a TransferFunction, a preset name, a file path or an (N, 5) array, "
+            f"got {type(tf).__name__}"
+        )
 
     @classmethod
     def preset(cls, name: str) -> "TransferFunction":
@@ -229,17 +276,28 @@ class Scene:
         self.data.setdefault("animation", {})["frames"] = int(n)
 
     @property
-    def camera(self) -> Camera:
-        return Camera.from_dict(self.data.get("camera", {}))
+    def camera(self) -> CameraView:
+        """The camera at rest, live: ``scene.camera.position = (...)`` edits the scene
+        (assign a :class:`Camera` or a dict to replace it)."""
+
+        def put(d):
+            self.data["camera"] = dict(d)
+
+        return CameraView(lambda: Camera.from_dict(self.data.get("camera", {})).to_dict(), put, "camera")
 
     @camera.setter
-    def camera(self, camera: Camera):
-        self.data["camera"] = camera.to_dict()
+    def camera(self, camera):
+        self.data["camera"] = _as_dict(camera, "camera")
 
     @property
-    def lights(self) -> list:
-        """The lights as dicts (assign a list of light objects or dicts to replace)."""
-        return self.data.get("light", [])
+    def lights(self) -> LightsView:
+        """The lights, live: ``scene.lights[0].intensity = 30`` edits the scene (assign
+        a list of light objects or dicts to replace them)."""
+
+        def put(lights):
+            self.data["light"] = [dict(l) for l in lights]
+
+        return LightsView(lambda: self.data.get("light", []), put)
 
     @lights.setter
     def lights(self, lights):

@@ -6,6 +6,7 @@
 //! scenes, settings), `RuntimeError` for the device.
 
 mod convert;
+mod image;
 mod metrics;
 mod renderer;
 mod scene;
@@ -30,6 +31,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(metrics::flip, m)?)?;
     m.add_function(wrap_pyfunction!(metrics::temporal_error, m)?)?;
     m.add_function(wrap_pyfunction!(metrics::tonemap, m)?)?;
+    m.add_function(wrap_pyfunction!(image::encode_image, m)?)?;
     m.add_function(wrap_pyfunction!(validation_messages, m)?)?;
     Ok(())
 }

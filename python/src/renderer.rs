@@ -1,9 +1,11 @@
-//! `dvr.Renderer`: one scene at one size with its denoisers on one device. The temporal
-//! state lives here, so rendering frames 0..n in order is the animation `dvr eval`
-//! renders (same noisy input, same denoisers, same references).
+//! `dvr.Renderer`: a live session of the engine (`dvr_engine::session::Session`, the
+//! type the explorer and `dvr capture` drive too) behind a lock. Its view (camera,
+//! lights, TF, render settings, denoisers) is edited between renders and the next
+//! render reprojects the change; `render(frame=k)` plays the scene's animation at frame
+//! k first, so frames 0..n in order are the animation `dvr eval` renders.
 
-use crate::convert::{image_out, runtime_error, value_error};
-use crate::scene::{scene_from_dict, tf_from_dict};
+use crate::convert::{image_out, runtime_error, to_toml, value_error};
+use crate::scene::{scene_from_dict, tf_from_dict, toml_dict};
 use crate::volume::Volume;
 use dvr_engine::error::EngineError;
 use dvr_engine::gpu::timestamps::PassTiming;
@@ -11,13 +13,23 @@ use dvr_engine::gpu::{ContextOptions, GpuContext};
 use dvr_engine::graph::Extent;
 use dvr_engine::passes::aux_features::{ALBEDO, NORMAL};
 use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup, DEFAULT_VOLUME_SIZE};
-use dvr_engine::renderer::{FrameRequest, FrameResult, Renderer as EngineRenderer, FEATURE_IMAGES};
-use dvr_engine::scene::parse_memory_size;
+use dvr_engine::renderer::{FrameRequest, FrameResult, FEATURE_IMAGES};
+use dvr_engine::scene::{parse_memory_size, TfState, ViewSections};
+use dvr_engine::session::{Edit, Session, SessionError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::sync::{Mutex, PoisonError};
 
 /// The registry's pass-through method, whose output `render()` returns as `"noisy"`.
 const NOISY_METHOD: &str = "none";
+
+/// Bins of the density histogram `histogram()` returns (the viewer's TF editor draws
+/// it).
+const HISTOGRAM_BINS: usize = 256;
+
+/// Most samples per pixel a reference takes from Python (2^20: hours on lavapipe at
+/// 256², seconds on a GPU).
+const MAX_REFERENCE_SPP: i64 = 1 << 20;
 
 /// Engine errors as Python sees them: what the caller asked for is a `ValueError`,
 /// what the device did is a `RuntimeError`.
@@ -28,36 +40,62 @@ fn engine_error(e: EngineError) -> PyErr {
     }
 }
 
-/// Lets the renderer be used from any Python thread and with the GIL released. It
-/// holds Vulkan handles (raw pointers, so the compiler cannot call it `Send`); Vulkan
-/// allows a handle on any thread as long as uses are externally synchronised, and
-/// they are: every method that renders takes `&mut self`, which pyo3's borrow flag
-/// makes exclusive (a second thread gets "Already borrowed"), and the `&self` getters
-/// only read plain values.
-struct OnThisThread<T>(T);
-unsafe impl<T> Send for OnThisThread<T> {}
-unsafe impl<T> Sync for OnThisThread<T> {}
-
-impl<T> OnThisThread<T> {
-    /// Through a method, so a closure captures the wrapper (which is `Send`), not the
-    /// field it reaches (closures capture disjoint fields).
-    fn get(&mut self) -> &mut T {
-        &mut self.0
+fn session_error(e: SessionError) -> PyErr {
+    match e {
+        SessionError::Engine(e) => engine_error(e),
+        SessionError::Invalid(_) | SessionError::Setup(_) => value_error(e),
+        SessionError::NoRenderer(_) => runtime_error(e),
     }
 }
 
-#[pyclass(module = "dvr._native")]
+/// Lets the session be used from any Python thread and with the GIL released. It holds
+/// Vulkan handles (raw pointers, so the compiler cannot call it `Send`); Vulkan allows a
+/// handle on any thread as long as uses are externally synchronised, and they are:
+/// every use goes through the renderer's mutex.
+struct OnThisThread<T>(T);
+unsafe impl<T> Send for OnThisThread<T> {}
+
+#[pyclass(module = "dvr._native", frozen, weakref)]
 pub struct Renderer {
-    inner: OnThisThread<Inner>,
+    /// `None` once closed. Locked only with the GIL released (see [`Renderer::locked`]),
+    /// so a thread waiting for it never holds the GIL another thread needs.
+    state: Mutex<Option<OnThisThread<Inner>>>,
 }
 
 struct Inner {
-    setup: SceneSetup,
-    renderer: EngineRenderer,
-    /// The animation frame `render()` renders when not told.
-    next_frame: u32,
-    last_frame: Option<u32>,
+    session: Session,
     last_timings: Vec<PassTiming>,
+    /// Counts of the volume's normalised densities in [`HISTOGRAM_BINS`] bins.
+    histogram: Vec<u32>,
+}
+
+impl Renderer {
+    /// Runs `f` on the session under the lock, with the GIL released: calls from several
+    /// threads serialise here, and Python threads run meanwhile.
+    fn locked<R: Send>(
+        &self,
+        py: Python<'_>,
+        f: impl FnOnce(&mut Inner) -> PyResult<R> + Send,
+    ) -> PyResult<R> {
+        py.detach(|| {
+            let mut guard = self.state.lock().unwrap_or_else(PoisonError::into_inner);
+            match guard.as_mut() {
+                Some(inner) => f(&mut inner.0),
+                None => Err(runtime_error(
+                    "this renderer is closed (close() released its device memory)",
+                )),
+            }
+        })
+    }
+}
+
+/// An integer argument in `lo..=hi`, or a `ValueError` naming it and the range.
+fn in_range(name: &str, value: i64, lo: i64, hi: i64) -> PyResult<u32> {
+    if (lo..=hi).contains(&value) {
+        Ok(value as u32)
+    } else {
+        Err(value_error(format!("{name}={value}: must be {lo} to {hi}")))
+    }
 }
 
 #[pymethods]
@@ -73,11 +111,11 @@ impl Renderer {
     fn new(
         py: Python<'_>,
         scene: &Bound<'_, PyDict>,
-        size: (u32, u32),
+        size: (i64, i64),
         denoisers: Vec<String>,
         volume: Option<PyRef<'_, Volume>>,
         tf: Option<&Bound<'_, PyDict>>,
-        spp: Option<u32>,
+        spp: Option<i64>,
         motion: &str,
         device: Option<String>,
         gpu_memory: Option<String>,
@@ -89,9 +127,13 @@ impl Renderer {
         let (w, h) = size;
         if !(1..=8192).contains(&w) || !(1..=8192).contains(&h) {
             return Err(value_error(format!(
-                "size {w}×{h}: width and height must be 1 to 8192"
+                "size=({w}, {h}): width and height must be 1 to 8192"
             )));
         }
+        let (w, h) = (w as u32, h as u32);
+        let spp = spp
+            .map(|n| in_range("spp", n, 1, i64::from(u32::MAX)))
+            .transpose()?;
         let motion = motion.parse().map_err(value_error)?;
         if let Some(s) = gpu_memory {
             let bytes =
@@ -110,7 +152,7 @@ impl Renderer {
                 .filter(|n| *n != NOISY_METHOD),
         );
         let given = volume.as_ref().map(|v| OnThisThread(&v.inner));
-        let built = py.detach(move || -> PyResult<_> {
+        let inner = py.detach(move || -> PyResult<_> {
             let loaded;
             let volume = match given {
                 Some(v) => v.0,
@@ -120,6 +162,7 @@ impl Renderer {
                 }
             };
             let custom = given_is_custom(&scene, volume);
+            let histogram = volume.histogram(HISTOGRAM_BINS);
             let mut setup = SceneSetup::with_volume(
                 scene,
                 volume,
@@ -142,121 +185,225 @@ impl Renderer {
                 ..Default::default()
             };
             let ctx = GpuContext::new(options).map_err(runtime_error)?;
-            let renderer = setup.renderer(ctx, &names).map_err(engine_error)?;
-            Ok(OnThisThread((setup, renderer)))
-        })?;
-        let (setup, renderer) = built.0;
-        Ok(Self {
-            inner: OnThisThread(Inner {
-                setup,
-                renderer,
-                next_frame: 0,
-                last_frame: None,
+            let session = Session::new(setup, ctx, &names).map_err(session_error)?;
+            Ok(OnThisThread(Inner {
+                session,
                 last_timings: Vec::new(),
-            }),
+                histogram,
+            }))
+        })?;
+        Ok(Self {
+            state: Mutex::new(Some(inner)),
         })
     }
 
-    /// Renders animation frame `frame` (default: the one after the last) and returns a
-    /// dict of `(h, w, 3)` float32 linear images: `"noisy"` and one per denoiser, plus
-    /// `"albedo"` and `"normal"` (the single-frame denoisers' guides) with `aux=True`.
-    /// `reset=True` restarts every history first (a cut). `features=True` adds
-    /// `"features"`: `{"position", "normal", "albedo"}`, each `(h, w, 4)` float32 (the
-    /// surface features the temporal denoisers reproject with; see `FEATURE_IMAGES`).
+    /// Renders the current view and returns a dict of `(h, w, 3)` float32 linear
+    /// images: `"noisy"` and one per denoiser, plus `"albedo"` and `"normal"` (the
+    /// single-frame denoisers' guides) with `aux=True`. With `frame`, the view is first
+    /// set to the scene's animation at that frame. `reset=True` restarts every history
+    /// first (a cut). `features=True` adds `"features"`: `{"position", "normal",
+    /// "albedo"}`, each `(h, w, 4)` float32 (see `FEATURE_IMAGES`).
     #[pyo3(signature = (frame = None, reset = false, aux = false, features = false))]
     fn render<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
-        frame: Option<u32>,
+        frame: Option<i64>,
         reset: bool,
         aux: bool,
         features: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let me = &mut self.inner;
-        let f = frame.unwrap_or(me.0.next_frame);
-        if f >= me.0.setup.scene.frames {
-            return Err(value_error(format!(
-                "frame {f}: the scene has {} frame(s) (0 to {})",
-                me.0.setup.scene.frames,
-                me.0.setup.scene.frames - 1
-            )));
-        }
         let request = FrameRequest {
             readback: true,
             reset,
             aux,
             features,
         };
-        let inputs = me.0.setup.frame_inputs(f);
-        let results = py
-            .detach(|| -> Result<Vec<FrameResult>, EngineError> {
-                let renderer = &mut me.get().renderer;
-                let mut out: Vec<FrameResult> =
-                    renderer.frame(&inputs, &request)?.into_iter().collect();
-                out.extend(renderer.flush()?);
-                Ok(out)
-            })
-            .map_err(engine_error)?;
-        let result = results
-            .into_iter()
-            .max_by_key(|r| r.index)
-            .ok_or_else(|| runtime_error("the renderer returned no frame"))?;
-        me.0.next_frame = f + 1;
-        me.0.last_frame = Some(f);
-        let (w, h) = (me.0.setup.config.size.width, me.0.setup.config.size.height);
-        let out = PyDict::new(py);
-        let surface = PyDict::new(py);
-        for (name, pixels) in &result.images {
-            if let Some(i) = FEATURE_IMAGES.iter().position(|n| n == name) {
-                let key = ["position", "normal", "albedo"][i];
-                surface.set_item(key, image_out(py, w, h, pixels, 4))?;
-                continue;
+        let (size, result) = self.locked(py, |me| {
+            if let Some(f) = frame {
+                let frames = i64::from(me.session.scene().frames);
+                let f = in_range("frame", f, 0, frames - 1)?;
+                me.session.play(f).map_err(session_error)?;
             }
-            let key = match name.as_str() {
-                NOISY_METHOD => "noisy",
-                n if n == ALBEDO => "albedo",
-                n if n == NORMAL => "normal",
-                n => n,
+            let mut out: Vec<FrameResult> = me
+                .session
+                .frame(&request, None)
+                .map_err(session_error)?
+                .into_iter()
+                .collect();
+            out.extend(me.session.flush().map_err(session_error)?);
+            let result = out
+                .into_iter()
+                .max_by_key(|r| r.index)
+                .ok_or_else(|| runtime_error("the renderer returned no frame"))?;
+            me.last_timings = result.timings.clone();
+            Ok((me.session.setup().config.size, result))
+        })?;
+        frame_dict(py, size, &result, features)
+    }
+
+    /// A high-sample reference with `spp` samples per pixel, from a sample stream of its
+    /// own: of the current view, or with `frame` of the scene's animation at that frame
+    /// (the image `dvr reference` writes for it), leaving the view as it is.
+    #[pyo3(signature = (frame = None, spp = 1024))]
+    fn reference<'py>(
+        &self,
+        py: Python<'py>,
+        frame: Option<i64>,
+        spp: i64,
+    ) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
+        let spp = in_range("spp", spp, 1, MAX_REFERENCE_SPP)?;
+        let (size, pixels) = self.locked(py, |me| {
+            let s = &mut me.session;
+            let batch = s.renderer().map_err(session_error)?.samples_per_dispatch();
+            let pixels = match frame {
+                Some(f) => {
+                    let f = in_range("frame", f, 0, i64::from(s.scene().frames) - 1)?;
+                    s.reference_at(f, spp, batch)
+                }
+                None => s.reference(spp, batch),
+            }
+            .map_err(session_error)?;
+            Ok((s.setup().config.size, pixels))
+        })?;
+        Ok(image_out(py, size.width, size.height, &pixels, 3))
+    }
+
+    /// The view's camera, lights and render settings as the dict a scene file's
+    /// `[camera]`, `[[light]]` and `[render]` sections hold (`camera`, `light`,
+    /// `render`).
+    fn view<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = self.locked(py, |me| {
+            let s = &me.session;
+            let sections = ViewSections {
+                camera: s.view().camera,
+                lights: s.view().lights.clone(),
+                render: *s.settings(),
             };
-            out.set_item(key, image_out(py, w, h, pixels, 3))?;
-        }
-        if features {
-            out.set_item("features", surface)?;
-        }
-        me.0.last_timings = result.timings;
+            sections.to_toml().map_err(value_error)
+        })?;
+        toml_dict(py, &text)
+    }
+
+    /// Edits the view: `view` is a dict like [`Renderer::view`]'s (all three sections),
+    /// checked as a scene file's sections are; each section that differs from the
+    /// current one is an edit, settings first. Raises `ValueError` naming the field.
+    fn set_view(&self, py: Python<'_>, view: &Bound<'_, PyDict>) -> PyResult<()> {
+        let value = to_toml(view.as_any(), "view")?;
+        let text = toml::to_string(&value).map_err(value_error)?;
+        self.locked(py, |me| {
+            let new = ViewSections::from_toml_str(&text, "view").map_err(value_error)?;
+            let s = &mut me.session;
+            if new.render != *s.settings() {
+                s.edit(Edit::Settings(new.render)).map_err(session_error)?;
+            }
+            if new.lights != s.view().lights {
+                s.edit(Edit::Lights(new.lights)).map_err(session_error)?;
+            }
+            if new.camera != s.view().camera {
+                s.edit(Edit::Camera(new.camera)).map_err(session_error)?;
+            }
+            Ok(())
+        })
+    }
+
+    /// The transfer function in effect: `{"a": tf, "b": tf or None, "blend": x,
+    /// "shift": y}` (tf as a TF file's dict).
+    fn tf<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (a, b, blend, shift) = self.locked(py, |me| {
+            let tf = &me.session.view().tf;
+            Ok((
+                tf.a.to_toml(),
+                tf.b.as_ref().map(|b| b.to_toml()),
+                tf.blend,
+                tf.shift,
+            ))
+        })?;
+        let out = PyDict::new(py);
+        out.set_item("a", toml_dict(py, &a)?)?;
+        out.set_item("b", b.map(|b| toml_dict(py, &b)).transpose()?)?;
+        out.set_item("blend", blend)?;
+        out.set_item("shift", shift)?;
         Ok(out)
     }
 
-    /// A high-sample reference of animation frame `frame` (default: the last rendered,
-    /// else 0) with `spp` samples per pixel, from a sample stream of its own: the image
-    /// `dvr reference` writes for that frame.
-    #[pyo3(signature = (frame = None, spp = 1024))]
-    fn reference<'py>(
-        &mut self,
-        py: Python<'py>,
-        frame: Option<u32>,
-        spp: u32,
-    ) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
-        let me = &mut self.inner;
-        let f = frame.or(me.0.last_frame).unwrap_or(0);
-        if f >= me.0.setup.scene.frames {
-            return Err(value_error(format!(
-                "frame {f}: the scene has {} frame(s)",
-                me.0.setup.scene.frames
-            )));
-        }
-        let inputs = me.0.setup.frame_inputs(f);
-        let pixels = py
-            .detach(|| me.get().renderer.reference(&inputs, spp, spp))
-            .map_err(engine_error)?;
-        let (w, h) = (me.0.setup.config.size.width, me.0.setup.config.size.height);
-        Ok(image_out(py, w, h, &pixels, 3))
+    /// Sets the transfer function (a TF dict: `{"name": ..., "point": [...]}`).
+    fn set_tf(&self, py: Python<'_>, tf: &Bound<'_, PyDict>) -> PyResult<()> {
+        let tf = tf_from_dict(tf)?;
+        self.edit(py, Edit::Tf(TfState::single(tf)))
+    }
+
+    /// Runs `denoisers` (registry names) from the next render on, with fresh histories.
+    fn set_denoisers(&self, py: Python<'_>, denoisers: Vec<String>) -> PyResult<()> {
+        let mut names = vec![NOISY_METHOD.to_string()];
+        names.extend(denoisers.into_iter().filter(|n| n != NOISY_METHOD));
+        self.edit(py, Edit::Denoisers(names))
+    }
+
+    /// A left-drag of (dx, dy) pixels in the explorer: orbits the camera about its
+    /// target.
+    fn orbit(&self, py: Python<'_>, dx: f64, dy: f64) -> PyResult<()> {
+        self.edit(py, Edit::Orbit { dx, dy })
+    }
+
+    /// A right-drag of (dx, dy) pixels: the point under the cursor follows it.
+    fn pan(&self, py: Python<'_>, dx: f64, dy: f64) -> PyResult<()> {
+        self.edit(py, Edit::Pan { dx, dy })
+    }
+
+    /// Wheel steps; positive zooms in.
+    fn zoom(&self, py: Python<'_>, steps: f64) -> PyResult<()> {
+        self.edit(py, Edit::Zoom { steps })
+    }
+
+    /// Back to the camera the renderer started with.
+    fn reset_camera(&self, py: Python<'_>) -> PyResult<()> {
+        self.edit(py, Edit::ResetCamera)
+    }
+
+    /// Flies to fit the volume, keeping the viewing direction.
+    fn fit(&self, py: Python<'_>) -> PyResult<()> {
+        self.edit(py, Edit::FitCamera)
+    }
+
+    /// Renders at (width, height) from the next render on (histories restart).
+    fn resize(&self, py: Python<'_>, width: i64, height: i64) -> PyResult<()> {
+        let size = Extent {
+            width: in_range("width", width, 1, 8192)?,
+            height: in_range("height", height, 1, 8192)?,
+        };
+        self.locked(py, |me| {
+            me.session.resize(size, size).map_err(session_error)?;
+            Ok(())
+        })
+    }
+
+    /// Releases the device memory now (the renderer is unusable after).
+    fn close(&self, py: Python<'_>) {
+        let taken = py.detach(|| {
+            self.state
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .take()
+        });
+        py.detach(move || drop(taken));
+    }
+
+    /// Whether [`Renderer::close`] was called.
+    #[getter]
+    fn closed(&self, py: Python<'_>) -> bool {
+        py.detach(|| {
+            self.state
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .is_none()
+        })
     }
 
     /// GPU milliseconds per pass of the last rendered frame (`{pass: ms}`).
     fn timings<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let timings = self.locked(py, |me| Ok(me.last_timings.clone()))?;
         let out = PyDict::new(py);
-        for t in &self.inner.0.last_timings {
+        for t in &timings {
             let before: f64 = out
                 .get_item(&t.pass)?
                 .map(|v| v.extract())
@@ -267,47 +414,106 @@ impl Renderer {
         Ok(out)
     }
 
-    /// Frames in the scene's animation.
+    /// Counts of the volume's normalised densities in 256 equal bins over [0, 1].
+    fn histogram(&self, py: Python<'_>) -> PyResult<Vec<u32>> {
+        self.locked(py, |me| Ok(me.histogram.clone()))
+    }
+
+    /// Frames in the scene's animation (what `render(frame=k)` plays).
     #[getter]
-    fn frames(&self) -> u32 {
-        self.inner.0.setup.scene.frames
+    fn frames(&self, py: Python<'_>) -> PyResult<u32> {
+        self.locked(py, |me| Ok(me.session.scene().frames))
+    }
+
+    /// Frames rendered so far.
+    #[getter]
+    fn frames_rendered(&self, py: Python<'_>) -> PyResult<u64> {
+        self.locked(py, |me| Ok(me.session.frames()))
     }
 
     /// The denoisers this renderer runs, in order (the noisy input not counted).
     #[getter]
-    fn denoisers(&self) -> Vec<String> {
-        let mut names = self.inner.0.renderer.denoiser_names();
-        names.retain(|n| n != NOISY_METHOD);
-        names
+    fn denoisers(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        self.locked(py, |me| {
+            Ok(me
+                .session
+                .denoisers()
+                .iter()
+                .filter(|n| *n != NOISY_METHOD)
+                .cloned()
+                .collect())
+        })
     }
 
     /// The Vulkan device's name.
     #[getter]
-    fn device(&self) -> String {
-        self.inner.0.renderer.ctx().info.name.clone()
+    fn device(&self, py: Python<'_>) -> PyResult<String> {
+        self.locked(py, |me| Ok(me.session.ctx().info.name.clone()))
     }
 
     /// How the volume is held on the device: "dense volume", or the brick pool's
     /// residency ("brick pool: R of V visible bricks resident …").
     #[getter]
-    fn volume_residency(&self) -> String {
-        self.inner.0.renderer.volume_residency().to_string()
+    fn volume_residency(&self, py: Python<'_>) -> PyResult<String> {
+        self.locked(py, |me| {
+            let r = me.session.renderer().map_err(session_error)?;
+            Ok(r.volume_residency().to_string())
+        })
     }
 
     /// Samples per pixel per frame.
     #[getter]
-    fn spp(&self) -> u32 {
-        self.inner.0.setup.settings.spp()
+    fn spp(&self, py: Python<'_>) -> PyResult<u32> {
+        self.locked(py, |me| Ok(me.session.settings().spp()))
     }
 
     /// (width, height).
     #[getter]
-    fn size(&self) -> (u32, u32) {
-        (
-            self.inner.0.setup.config.size.width,
-            self.inner.0.setup.config.size.height,
-        )
+    fn size(&self, py: Python<'_>) -> PyResult<(u32, u32)> {
+        self.locked(py, |me| {
+            let s = me.session.view_size();
+            Ok((s.width, s.height))
+        })
     }
+}
+
+impl Renderer {
+    fn edit(&self, py: Python<'_>, edit: Edit) -> PyResult<()> {
+        self.locked(py, |me| {
+            me.session.edit(edit).map_err(session_error)?;
+            Ok(())
+        })
+    }
+}
+
+/// A finished frame as `render()`'s dict.
+fn frame_dict<'py>(
+    py: Python<'py>,
+    size: Extent,
+    result: &FrameResult,
+    features: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (w, h) = (size.width, size.height);
+    let out = PyDict::new(py);
+    let surface = PyDict::new(py);
+    for (name, pixels) in &result.images {
+        if let Some(i) = FEATURE_IMAGES.iter().position(|n| n == name) {
+            let key = ["position", "normal", "albedo"][i];
+            surface.set_item(key, image_out(py, w, h, pixels, 4))?;
+            continue;
+        }
+        let key = match name.as_str() {
+            NOISY_METHOD => "noisy",
+            n if n == ALBEDO => "albedo",
+            n if n == NORMAL => "normal",
+            n => n,
+        };
+        out.set_item(key, image_out(py, w, h, pixels, 3))?;
+    }
+    if features {
+        out.set_item("features", surface)?;
+    }
+    Ok(out)
 }
 
 /// Every denoiser name the registry knows, with its one-line description.

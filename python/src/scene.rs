@@ -22,7 +22,7 @@ pub fn tf_from_dict(d: &Bound<'_, PyDict>) -> PyResult<TransferFunction> {
     TransferFunction::from_toml_str(&text, "transfer function").map_err(value_error)
 }
 
-fn toml_dict<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
+pub fn toml_dict<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
     let value: toml::Value = toml::from_str(text).map_err(value_error)?;
     from_toml(py, &value)
 }

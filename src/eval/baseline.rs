@@ -11,7 +11,7 @@ use crate::setup::Setup;
 use anyhow::Result;
 use dvr_engine::image_io::to_rgb;
 use dvr_engine::metrics::{score, FrameReference};
-use dvr_engine::renderer::Renderer;
+use dvr_engine::session::{Edit, Session};
 use std::sync::Arc;
 
 /// Largest sample count of the baseline curve.
@@ -58,7 +58,7 @@ pub fn units(frame_count: u32, ref_spp: u32) -> f64 {
 /// renderer's seed).
 #[allow(clippy::too_many_arguments)]
 pub fn measure(
-    renderer: &mut Renderer,
+    session: &mut Session,
     setup: &Setup,
     references: &ReferenceCache,
     path_trace_ms_per_spp: f64,
@@ -67,9 +67,9 @@ pub fn measure(
     label: &str,
     timing: &Arc<Timing>,
 ) -> Result<Vec<BaselinePoint>> {
-    let mut settings = *renderer.settings();
+    let mut settings = *session.settings();
     settings.set_seed(settings.seed().wrapping_add(SEED_OFFSET));
-    renderer.set_settings(&settings)?;
+    session.edit(Edit::Settings(settings))?;
     // Each level is scored on the pool while the GPU renders the next.
     let mut jobs = Overlap::new(timing);
     let (w, h) = (setup.width(), setup.height());
@@ -77,8 +77,8 @@ pub fn measure(
         let hdr = references.load(f)?;
         let reference = Arc::new(timing.metrics.time(|| FrameReference::new(&hdr)));
         for n in levels(ref_spp) {
-            let batch = renderer.samples_per_dispatch();
-            let pixels = renderer.reference(&setup.inputs(f), n, batch)?;
+            let batch = session.renderer()?.samples_per_dispatch();
+            let pixels = session.reference_at(f, n, batch)?;
             let (reference, job_timing) = (Arc::clone(&reference), Arc::clone(timing));
             jobs.spawn(move || {
                 let s = job_timing

@@ -527,11 +527,11 @@ impl ReferenceCache {
     pub fn render(
         &self,
         setup: &Setup,
-        renderer: &mut dvr_engine::renderer::Renderer,
+        session: &mut dvr_engine::session::Session,
         f: u32,
     ) -> Result<Rgb32Image> {
-        let batch = renderer.samples_per_dispatch();
-        let pixels = renderer.reference(&setup.inputs(f), self.key.ref_spp, batch)?;
+        let batch = session.renderer()?.samples_per_dispatch();
+        let pixels = session.reference_at(f, self.key.ref_spp, batch)?;
         Ok(to_rgb(setup.width(), setup.height(), &pixels))
     }
 
@@ -617,14 +617,14 @@ impl ReferenceCache {
         }
         // The same renderer set-up for `dvr reference` and `dvr eval`, so their cached
         // frames are identical.
-        let mut renderer = setup.renderer(&["none"])?;
+        let mut session = setup.session(&["none"])?;
         report.rendered(0, state.missing.len());
         for (i, &f) in state.missing.iter().enumerate() {
-            let img = self.render(setup, &mut renderer, f)?;
+            let img = self.render(setup, &mut session, f)?;
             report.store(self, f, img)?;
             report.rendered(i + 1, state.missing.len());
         }
-        report.finished(&renderer)?;
+        report.finished(session.renderer()?)?;
         Ok(Filled {
             claim,
             reused: wanted

@@ -407,7 +407,7 @@ pub fn evaluate_scene(
     let _claim = filled.claim;
 
     let names: Vec<&str> = methods.iter().map(String::as_str).collect();
-    let mut renderer = setup.renderer(&names)?;
+    let mut session = setup.session(&names)?;
     let aux_dir = args.aux.then_some(AUX_DIR);
     for m in methods.iter().map(String::as_str).chain(aux_dir) {
         let dir = scene.dir.join(m);
@@ -437,12 +437,13 @@ pub fn evaluate_scene(
     };
     let frames_started = std::time::Instant::now();
     for f in 0..setup.frames {
-        if let Some(done) = renderer.frame(&setup.inputs(f), &request)? {
+        session.play(f)?;
+        if let Some(done) = session.frame(&request, None)? {
             state.process(done)?;
         }
         progress.advance(frame_units, &status(f + 1));
     }
-    for done in renderer.flush()? {
+    for done in session.flush()? {
         state.process(done)?;
     }
     let rows: Vec<MetricRow> = state.jobs.finish()?.into_iter().flatten().collect();
@@ -451,7 +452,7 @@ pub fn evaluate_scene(
     let ms_per_spp = path_trace_ms_per_spp(&state.timings, setup.settings.spp());
     let baseline = timing.baseline.time(|| {
         baseline::measure(
-            &mut renderer,
+            &mut session,
             &setup,
             &scene.references,
             ms_per_spp,
@@ -461,6 +462,7 @@ pub fn evaluate_scene(
             timing,
         )
     })?;
+    let renderer = session.renderer()?;
     timing.add_gpu_ms(renderer.gpu_ms());
     let device = renderer.ctx().info.name.clone();
     crate::profile::write_json(

@@ -72,23 +72,18 @@ impl Explorer {
 
         // Render and present: at 1/k of the view per side while it moves (moving.rs).
         let (vw, vh) = self.view_size();
-        let spec = self.camera.spec();
-        let key = ViewKey {
-            camera: spec,
-            lights: self.model.lights.clone(),
-            tf: self.model.tf.clone(),
+        let Some(view) = self
+            .gfx
+            .as_ref()
+            .and_then(|g| g.session.as_ref())
+            .map(|s| s.view().clone())
+        else {
+            return Ok(());
         };
-        let changed = self.last_view.as_ref().is_some_and(|last| *last != key);
-        self.last_view = Some(key);
+        let changed = self.last_view.as_ref().is_some_and(|last| *last != view);
         let held = self.pointer.drag.is_some() || self.ui.tf_editor.dragging.is_some();
         let divisor = self.moving.next(changed, held);
         let (rw, rh) = moving::reduced((vw, vh), divisor);
-        let inputs = inputs_for(
-            &spec.camera(),
-            vw as f32 / vh as f32,
-            &self.model.lights,
-            &self.model.tf.lut(),
-        );
         let want_shot = self.shots.contains(&self.frame);
         let readback_hdr = want_shot || self.recorder.is_some();
         let split = (self.denoiser_list().len() == 2)
@@ -97,18 +92,22 @@ impl Explorer {
         let Some(gfx) = self.gfx.as_mut() else {
             return Ok(());
         };
-        let (Some(renderer), Some(overlay)) = (gfx.renderer.as_mut(), gfx.overlay.as_ref()) else {
+        let (Some(session), Some(overlay)) = (gfx.session.as_mut(), gfx.overlay.as_ref()) else {
             return Ok(());
+        };
+        let shown = Extent {
+            width: vw,
+            height: vh,
         };
         let rendered = Extent {
             width: rw,
             height: rh,
         };
-        let finished = renderer.resize(rendered)?;
+        let finished = session.resize(shown, rendered)?;
         self.ui.stats.render_size = (rw, rh);
         self.ui.stats.divisor = divisor;
         self.ui.stats.view = (vw, vh);
-        self.ui.stats.volume = renderer.volume_residency().to_string();
+        self.ui.stats.volume = session.renderer()?.volume_residency().to_string();
         let Some(image) = gfx.swapchain.acquire()? else {
             gfx.recreate_swapchain(size)?;
             return Ok(());
@@ -134,7 +133,7 @@ impl Explorer {
             aux: false,
             features: false,
         };
-        let result = renderer.frame_presented(&inputs, &request, Some(&target))?;
+        let result = session.frame(&request, Some(&target))?;
         self.in_flight.push_back((divisor, (rw, rh)));
         if !gfx.swapchain.present(&gfx.ctx, &image)? {
             self.resized = true;
@@ -146,8 +145,9 @@ impl Explorer {
             }
         }
         if let Some(rec) = self.recorder.as_mut() {
-            rec.push(spec, &self.model.lights, &self.model.tf, &self.model.left)?;
+            rec.push(view.camera, &view.lights, &view.tf.a, &self.model.left)?;
         }
+        self.last_view = Some(view);
         self.frame += 1;
         for r in finished.into_iter().chain(result) {
             self.completed(r)?;
@@ -221,7 +221,7 @@ impl Explorer {
             self.gfx = None;
             return Err(e);
         }
-        let flushed = match self.gfx.as_mut().and_then(|g| g.renderer.as_mut()) {
+        let flushed = match self.gfx.as_mut().and_then(|g| g.session.as_mut()) {
             Some(r) => r.flush()?,
             None => Vec::new(),
         };
@@ -247,7 +247,7 @@ impl Explorer {
             println!("explore: wrote {}", path.display());
         }
         if let Some(rec) = &self.recorder {
-            if let Some(path) = rec.finish(&self.setup.scene, self.args.render.volume_size)? {
+            if let Some(path) = rec.finish(&self.scene, self.args.render.volume_size)? {
                 println!(
                     "explore: recorded {} frames; replay with: dvr capture --scene {} --size {}x{} \
                      --volume-size {} --motion {} --denoiser {}",

@@ -15,9 +15,9 @@
 //!
 //! e.g. `--script "orbit:30,0@10;zoom:2@20"`.
 
-use super::camera::OrbitCamera;
 use anyhow::{bail, Context, Result};
 use dvr_engine::scene::transfer_ref::is_path;
+use dvr_engine::session::Edit;
 use dvr_engine::transfer::TransferFunction;
 use winit::event::MouseButton;
 use winit::keyboard::{Key as WinitKey, NamedKey};
@@ -98,22 +98,16 @@ pub enum Command {
     Tf(Box<TransferFunction>),
 }
 
-/// Applies a camera command; returns false for commands that are not the camera's.
-pub fn apply_to_camera(
-    camera: &mut OrbitCamera,
-    command: &Command,
-    viewport_height: f64,
-    fit: impl FnOnce(&mut OrbitCamera),
-) -> bool {
-    match *command {
-        Command::Drag(DragKind::Orbit, dx, dy) => camera.orbit(dx, dy),
-        Command::Drag(DragKind::Pan, dx, dy) => camera.pan(dx, dy, viewport_height),
-        Command::Zoom(steps) => camera.zoom(steps),
-        Command::Key(Key::Reset) => camera.reset(),
-        Command::Key(Key::Fit) => fit(camera),
-        _ => return false,
-    }
-    true
+/// The session edit a camera command is; `None` for commands that are not the camera's.
+pub fn camera_edit(command: &Command) -> Option<Edit> {
+    Some(match *command {
+        Command::Drag(DragKind::Orbit, dx, dy) => Edit::Orbit { dx, dy },
+        Command::Drag(DragKind::Pan, dx, dy) => Edit::Pan { dx, dy },
+        Command::Zoom(steps) => Edit::Zoom { steps },
+        Command::Key(Key::Reset) => Edit::ResetCamera,
+        Command::Key(Key::Fit) => Edit::FitCamera,
+        _ => return None,
+    })
 }
 
 /// The pointer as the camera sees it: which drag is under way and where it was.
@@ -221,7 +215,6 @@ impl Script {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use dvr_engine::scene::CameraSpec;
 
     #[test]
     fn parses_every_command_and_sorts_by_frame() {
@@ -279,20 +272,20 @@ mod tests {
     }
 
     #[test]
-    fn scripted_drag_moves_the_camera_like_a_mouse_drag() {
-        let mut a = OrbitCamera::from_spec(&CameraSpec::default());
-        let mut b = a;
-        let cmd = Script::parse("orbit:30,0@10").expect("parses");
-        for c in cmd.at(10) {
-            assert!(apply_to_camera(&mut a, c, 256.0, |_| {}));
-        }
-        b.orbit(30.0, 0.0);
-        assert_eq!(a, b);
-        assert!(!apply_to_camera(
-            &mut a,
-            &Command::Key(Key::Help),
-            256.0,
-            |_| {}
-        ));
+    fn camera_commands_are_the_sessions_mouse_edits() {
+        let cmd = Script::parse("orbit:30,0@10;pan:-2,3@10;zoom:1.5@10;key:r@10;key:f@10")
+            .expect("parses");
+        let edits: Vec<Option<Edit>> = cmd.at(10).map(camera_edit).collect();
+        assert_eq!(
+            edits,
+            vec![
+                Some(Edit::Orbit { dx: 30.0, dy: 0.0 }),
+                Some(Edit::Pan { dx: -2.0, dy: 3.0 }),
+                Some(Edit::Zoom { steps: 1.5 }),
+                Some(Edit::ResetCamera),
+                Some(Edit::FitCamera),
+            ]
+        );
+        assert_eq!(camera_edit(&Command::Key(Key::Help)), None);
     }
 }

@@ -2,22 +2,27 @@
 //! renderer presents to every frame: path trace → denoise → tone map into the swapchain
 //! image → the egui panel on top, all in the renderer's one render graph.
 //!
+//! The explorer is a client of the engine's live [`Session`], as `dvr capture`, `dvr eval`
+//! and the Python package are: mouse drags, keys and `--script` commands become session
+//! edits (orbit, pan, zoom, reset, fit), and the panel's model (TF, lights, settings,
+//! denoisers) is sent as edits where it differs from the session's state.
+//!
 //! The loop, once per frame ([`Explorer::frame`]): scripted commands due → the UI (egui)
-//! edits the [`ui::Model`] → model changes go to the renderer (denoisers, settings; a
-//! pipeline-specialising change rebuilds it) → acquire a swapchain image → the frame's
-//! inputs from the camera, lights and TF through `scene_setup::inputs_for` (the same path
-//! `dvr capture` takes) → `Renderer::frame_presented` → present → handle
-//! the results of the frame that finished (timings, screenshots, recorded frames).
+//! edits the [`ui::Model`] → model changes go to the session as edits (a
+//! pipeline-specialising setting makes it build a new renderer) → acquire a swapchain
+//! image → `Session::frame` (the frame's inputs from the session's view, the path
+//! scripted frames take) → present → handle the results of the frame that finished
+//! (timings, screenshots, recorded frames).
 //!
 //! Mouse and keys: see [`input::SHORTCUTS`]; `--script` plays the same commands at given
 //! frames (see [`input`]).
 //!
 //! Here: the arguments and the explorer's state. `window.rs` the window, its device and
-//! swapchain, and winit's events; `model.rs` model application; `frame.rs` the frame and
+//! swapchain, the session, and winit's events; `model.rs` model application and
+//! commands as edits; `frame.rs` the frame and
 //! what happens to its results; `moving.rs` the rendered size while the view moves;
 //! `ui.rs` the panel that edits the model.
 
-mod camera;
 mod frame;
 mod input;
 mod model;
@@ -31,18 +36,16 @@ mod window;
 use crate::setup;
 use anyhow::{bail, Context, Result};
 use ash::vk;
-use camera::OrbitCamera;
 use dvr_engine::denoise::registry;
 use dvr_engine::gpu::{ContextOptions, GpuContext, Swapchain};
 use dvr_engine::graph::Extent;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png, PNG_EXPOSURE};
 use dvr_engine::passes::present::PresentLayout;
-use dvr_engine::renderer::scene_setup::{inputs_for, load_volume, on_demand, SceneSetup};
-use dvr_engine::renderer::{
-    FrameRequest, FrameResult, PresentTarget, Renderer, Screenshot, SettingsChange,
-};
-use dvr_engine::scene::VolumeSource;
-use input::{apply_to_camera, Command, DragKind, Key, Pointer, Script};
+use dvr_engine::renderer::scene_setup::{load_volume, on_demand, SceneSetup};
+use dvr_engine::renderer::{FrameRequest, FrameResult, PresentTarget, Screenshot};
+use dvr_engine::scene::{Scene, TfState, View, VolumeSource};
+use dvr_engine::session::{Edit, Session};
+use input::{camera_edit, Command, DragKind, Key, Pointer, Script};
 use moving::MovingScale;
 use overlay::EguiOverlay;
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
@@ -170,22 +173,16 @@ pub fn run(args: ExploreArgs) -> Result<()> {
     app.finish()
 }
 
-/// What the view shows: a change of it is a motion (see [`moving`]).
-#[derive(Clone, PartialEq)]
-struct ViewKey {
-    camera: dvr_engine::scene::CameraSpec,
-    lights: Vec<dvr_engine::scene::Light>,
-    tf: dvr_engine::transfer::TransferFunction,
-}
-
 struct Explorer {
     args: ExploreArgs,
-    setup: SceneSetup,
+    /// The scene as opened (the window's title, the recorded session's base).
+    scene: Scene,
+    /// What the session is made from when the window (and its device) opens.
+    setup: Option<SceneSetup>,
     script: Script,
     model: Model,
-    /// The model the renderer currently reflects.
+    /// The model the session currently reflects.
     applied: Model,
-    camera: OrbitCamera,
     ui: UiState,
     pointer: Pointer,
     egui_ctx: egui::Context,
@@ -199,7 +196,7 @@ struct Explorer {
     /// Fewer pixels while the view moves (`--moving-ms`).
     moving: MovingScale,
     /// Last frame's camera, lights and TF: what a change is measured against.
-    last_view: Option<ViewKey>,
+    last_view: Option<View>,
     /// (divisor, rendered size) of each submitted frame whose results have not come
     /// back, oldest first (results arrive in submission order).
     in_flight: VecDeque<(u32, (u32, u32))>,
@@ -229,11 +226,10 @@ impl Explorer {
         script: Script,
         names: &[String],
     ) -> Result<Self> {
-        let state = setup.scene.frame_state(0);
-        let camera = OrbitCamera::from_spec(&setup.scene.camera_at(0));
+        let view = setup.scene.view_at(0);
         let model = Model {
-            tf: setup.scene.tf_a.clone(),
-            lights: state.lights,
+            tf: view.tf.a,
+            lights: view.lights,
             render: setup.settings,
             exposure: PNG_EXPOSURE,
             vsync: !args.no_vsync,
@@ -259,11 +255,11 @@ impl Explorer {
         });
         Ok(Self {
             args,
-            setup,
+            scene: setup.scene.clone(),
+            setup: Some(setup),
             script,
             applied: model.clone(),
             model,
-            camera,
             ui,
             pointer: Pointer::default(),
             egui_ctx,

@@ -1,5 +1,5 @@
-//! Model application: what the UI and the script edit reaches the renderer (denoisers,
-//! render settings, a new renderer when the specialisation changes) and the swapchain.
+//! Model application: what the UI and the script edit reaches the session as edits
+//! (denoisers, render settings, TF, lights) and the swapchain.
 
 use super::*;
 
@@ -18,7 +18,8 @@ impl Explorer {
         v
     }
 
-    /// Brings the renderer and swapchain in line with the model.
+    /// Brings the session and swapchain in line with the model: each difference is an
+    /// edit (settings the session refuses are reported and taken back in the panel).
     pub(super) fn apply_model(&mut self) -> Result<Vec<FrameResult>> {
         let mut done = Vec::new();
         if self.model == self.applied {
@@ -28,30 +29,36 @@ impl Explorer {
         let Some(gfx) = self.gfx.as_mut() else {
             return Ok(done);
         };
-        let Some(renderer) = gfx.renderer.as_mut() else {
+        let Some(session) = gfx.session.as_mut() else {
             return Ok(done);
         };
-        // The renderer checks the settings and restarts every history when they change.
-        match renderer.set_settings(&self.model.render) {
-            Ok(SettingsChange::NeedsNewRenderer) => {
-                // Specialisation constants change: a new renderer (same device and window).
-                done.extend(renderer.flush()?);
-                gfx.renderer = None;
-                self.setup.settings = self.model.render;
-                let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
-                let renderer = self.setup.renderer(Arc::clone(&gfx.ctx), &names)?;
-                self.ui.max_spp = renderer.samples_per_dispatch();
-                gfx.renderer = Some(renderer);
-            }
-            Ok(SettingsChange::Applied | SettingsChange::Unchanged) => {
-                if renderer.denoiser_names() != denoisers {
-                    let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
-                    done.extend(renderer.set_denoisers(&names)?);
+        if self.model.render != *session.settings() {
+            match session.edit(Edit::Settings(self.model.render)) {
+                Ok(finished) => done.extend(finished),
+                Err(e) => {
+                    self.ui.set_status(e.to_string());
+                    self.model.render = *session.settings();
                 }
             }
-            Err(e) => {
+            self.ui.max_spp = session.renderer()?.samples_per_dispatch();
+        }
+        if session.denoisers() != denoisers.as_slice() {
+            done.extend(session.edit(Edit::Denoisers(denoisers))?);
+        }
+        if self.model.tf != self.applied.tf {
+            let tf = TfState::single(self.model.tf.clone());
+            if let Err(e) = session.edit(Edit::Tf(tf)) {
                 self.ui.set_status(e.to_string());
-                self.model.render = *renderer.settings();
+                self.model.tf = session.view().tf.a.clone();
+            }
+        }
+        if self.model.lights != session.view().lights {
+            match session.edit(Edit::Lights(self.model.lights.clone())) {
+                Ok(finished) => done.extend(finished),
+                Err(e) => {
+                    self.ui.set_status(e.to_string());
+                    self.model.lights = session.view().lights.clone();
+                }
             }
         }
         if self.model.vsync != self.applied.vsync {
@@ -63,12 +70,14 @@ impl Explorer {
         Ok(done)
     }
 
-    /// A key or a UI-independent command (from the keyboard or the script).
+    /// A key or a UI-independent command (from the keyboard, the mouse or the script):
+    /// camera commands are session edits, the rest edit the model or the UI.
     pub(super) fn command(&mut self, c: &Command) {
-        let (w, h) = self.view_size();
-        let aspect = w as f64 / h.max(1) as f64;
-        let half = glam::Vec3::from(self.setup.volume.world_size).as_dvec3() * 0.5;
-        if apply_to_camera(&mut self.camera, c, h as f64, |cam| cam.fit(half, aspect)) {
+        if let Some(edit) = camera_edit(c) {
+            let session = self.gfx.as_mut().and_then(|g| g.session.as_mut());
+            if let Some(Err(e)) = session.map(|s| s.edit(edit)) {
+                self.ui.set_status(e.to_string());
+            }
             return;
         }
         match c {

@@ -1,12 +1,12 @@
 //! The window and what lives as long as it does: the device, its swapchain, the UI
-//! renderer and the renderer ([`Gfx`]), and winit's events.
+//! renderer and the live session ([`Gfx`]), and winit's events.
 
 use super::*;
 
-/// GPU state that exists while the window does. Torn down in order: renderer, UI
+/// GPU state that exists while the window does. Torn down in order: session, UI
 /// renderer, swapchain (and surface), then the device when the last handle goes.
 pub(super) struct Gfx {
-    pub renderer: Option<Renderer>,
+    pub session: Option<Session>,
     pub overlay: Option<EguiOverlay>,
     pub swapchain: Swapchain,
     pub ctx: Arc<GpuContext>,
@@ -31,7 +31,7 @@ impl Gfx {
 impl Drop for Gfx {
     fn drop(&mut self) {
         let _ = self.ctx.wait_idle();
-        self.renderer.take();
+        self.session.take();
         self.overlay.take();
         self.swapchain.destroy(&self.ctx);
     }
@@ -51,7 +51,7 @@ impl Explorer {
         let ppp = self.egui_ctx.pixels_per_point();
         let (w, h) = self.args.size;
         let attributes = Window::default_attributes()
-            .with_title(format!("dvr explore — {}", self.setup.scene.name))
+            .with_title(format!("dvr explore — {}", self.scene.name))
             .with_inner_size(PhysicalSize::new(w + (PANEL_WIDTH * ppp).round() as u32, h));
         let window = Arc::new(
             event_loop
@@ -88,10 +88,12 @@ impl Explorer {
             self.model.vsync,
         )?;
         let overlay = EguiOverlay::new(&ctx, swapchain.format)?;
-        let renderer = self
+        let setup = self
             .setup
-            .renderer(Arc::clone(&ctx), &self.denoiser_list())?;
-        self.ui.max_spp = renderer.samples_per_dispatch();
+            .take()
+            .context("the window opened twice (the session is made once)")?;
+        let session = Session::new(setup, Arc::clone(&ctx), &self.denoiser_list())?;
+        self.ui.max_spp = session.renderer()?.samples_per_dispatch();
         self.ui.stats.device = ctx.info.name.clone();
         self.ui.stats.present_mode = format!("{:?}", swapchain.present_mode);
         let max_texture_side = 4096;
@@ -104,7 +106,7 @@ impl Explorer {
             Some(max_texture_side),
         ));
         self.gfx = Some(Gfx {
-            renderer: Some(renderer),
+            session: Some(session),
             overlay: Some(overlay),
             swapchain,
             ctx,

@@ -40,6 +40,11 @@ impl Extent {
     pub fn pixels(&self) -> u64 {
         u64::from(self.width) * u64::from(self.height)
     }
+
+    /// Width over height (a zero height counts as 1).
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height.max(1) as f32
+    }
 }
 
 /// The two sides of a history resource for this frame.

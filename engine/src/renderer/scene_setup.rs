@@ -1,7 +1,7 @@
 //! From a scene (engine/src/scene) to what the renderer takes: the volume as a texture
 //! upload with its brick ranges, the render settings the scene asks for (what the path
 //! tracer is specialised for), the environment map, and per frame the camera, the lights
-//! as GPU structs and the transfer function as LUTs. The CLI, the explorer and the tests
+//! as GPU structs and the transfer function as LUTs, from a [`View`]. The CLI, the explorer and the tests
 //! all go through here.
 
 use super::scene_gpu::{EnvironmentUpload, LutUpload, VolumeUpload};
@@ -11,7 +11,7 @@ use crate::gpu::GpuContext;
 use crate::graph::Extent;
 use crate::image_io::ImageIoError;
 use crate::scene::BuiltinVolume;
-use crate::scene::{Camera, EnvSource, Light, RenderSettings, Scene, VolumeSource};
+use crate::scene::{Camera, EnvSource, Light, RenderSettings, Scene, View, VolumeSource};
 use crate::shaders::frame::{self, GpuLight};
 use crate::transfer::{TfLut, LUT_SIZE};
 use crate::volume::blocks::VoxelBlocks;
@@ -33,16 +33,16 @@ pub enum SetupError {
     Setting(#[from] EngineError),
 }
 
-/// A scene made ready for rendering.
+/// A scene made ready for rendering. Cloning it shares the loaded volume and
+/// environment map.
+#[derive(Clone)]
 pub struct SceneSetup {
     pub scene: Scene,
     /// The scene's render settings, with the spp override applied.
     pub settings: RenderSettings,
     pub config: RendererConfig,
     pub volume: Arc<VolumeUpload>,
-    pub environment: Option<EnvironmentUpload>,
-    lut_a: TfLut,
-    lut_b: Option<TfLut>,
+    pub environment: Option<Arc<EnvironmentUpload>>,
 }
 
 impl SceneSetup {
@@ -83,17 +83,13 @@ impl SceneSetup {
             settings.set_spp(spp)?;
         }
         let config = renderer_config(&scene, size);
-        let environment = load_environment(&scene.lights)?;
-        let lut_a = scene.tf_a.lut();
-        let lut_b = scene.tf_b.as_ref().map(|b| b.lut());
+        let environment = load_environment(&scene.lights)?.map(Arc::new);
         Ok(Self {
             volume: Arc::new(volume),
             settings,
             config,
             environment,
             scene,
-            lut_a,
-            lut_b,
         })
     }
 
@@ -109,39 +105,29 @@ impl SceneSetup {
             self.settings,
             self.config.clone(),
             self.volume.clone(),
-            self.environment.as_ref(),
+            self.environment.as_deref(),
             denoisers,
             LUT_SIZE as u32,
         )
     }
 
-    /// The renderer's inputs for animation frame `f`.
+    /// The renderer's inputs for animation frame `f`: the scene's view at `f`
+    /// ([`Scene::view_at`]) through [`inputs_for_view`], the path a live session's view
+    /// takes too.
     pub fn frame_inputs(&self, f: u32) -> FrameInputs {
-        let state = self.scene.frame_state(f);
-        let size = self.config.size;
-        let aspect = size.width as f32 / size.height.max(1) as f32;
-        let blended;
-        let lut = match &self.lut_b {
-            Some(b) if state.tf_blend > 0.0 => {
-                blended = TfLut::lerp(&self.lut_a, b, state.tf_blend);
-                &blended
-            }
-            _ => &self.lut_a,
-        };
-        if state.tf_shift != 0.0 {
-            return inputs_for(
-                &state.camera,
-                aspect,
-                &state.lights,
-                &lut.shifted(state.tf_shift),
-            );
-        }
-        inputs_for(&state.camera, aspect, &state.lights, lut)
+        let view = self.scene.view_at(f);
+        inputs_for_view(&view, self.config.size.aspect(), &view.tf.lut())
     }
 }
 
+/// The renderer's inputs for a view whose TF state gives `lut` ([`crate::scene::TfState::lut`],
+/// passed in so a session computes it once per TF edit), at `aspect` (width / height).
+pub fn inputs_for_view(view: &View, aspect: f32, lut: &TfLut) -> FrameInputs {
+    inputs_for(&view.camera.camera(), aspect, &view.lights, lut)
+}
+
 /// The renderer's inputs for a camera, lights and a TF: the one place scene state
-/// becomes [`FrameInputs`] (a scene's frames and the explorer's edits alike).
+/// becomes [`FrameInputs`].
 pub fn inputs_for(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -> FrameInputs {
     let c = camera;
     FrameInputs {

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use super::animation::AnimationFile;
 use super::camera::CameraSpec;
 use super::error::{Ctx, SceneError};
-use super::light::{Light, LightFile};
+use super::light::LightFile;
 use super::render::RenderSettings;
 use super::transfer_ref::TransferSpec;
 use super::volume::VolumeFile;
@@ -49,12 +49,7 @@ pub(crate) fn parse(text: &str, origin: &str, base: Option<&Path>) -> Result<Sce
     })?;
     let volume = file.volume.into_spec(&ctx)?;
     let (transfer, tf_a, tf_b) = file.transfer.resolve(&ctx)?;
-    let lights = file
-        .lights
-        .into_iter()
-        .enumerate()
-        .map(|(i, l)| l.into_light(&ctx, i))
-        .collect::<Result<Vec<Light>, _>>()?;
+    let lights = LightFile::into_lights(file.lights, &ctx)?;
     let (frames, animation) = file.animation.split();
     animation.check_unique_frames(&ctx)?;
     let scene = Scene {

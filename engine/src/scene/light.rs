@@ -313,6 +313,15 @@ pub(crate) struct LightFile {
 }
 
 impl LightFile {
+    /// Every `[[light]]` of a file, in order.
+    pub fn into_lights(files: Vec<Self>, ctx: &Ctx) -> Result<Vec<Light>, SceneError> {
+        files
+            .into_iter()
+            .enumerate()
+            .map(|(i, l)| l.into_light(ctx, i))
+            .collect()
+    }
+
     /// Structure only (which fields a kind needs and allows); values are checked by
     /// [`Light::check`].
     pub fn into_light(self, ctx: &Ctx, index: usize) -> Result<Light, SceneError> {
@@ -478,6 +487,41 @@ impl LightFile {
         }
         f
     }
+}
+
+/// A scene's lights as a whole: at least one unless the TF emits, at most
+/// [`MAX_LIGHTS`], at most one environment, each light checked. Scene files and a live
+/// session's light edits are checked by this one function.
+pub(crate) fn check_lights(ctx: &Ctx, lights: &[Light], emission: bool) -> Result<(), SceneError> {
+    if lights.is_empty() && !emission {
+        return Err(ctx.invalid(
+            "light",
+            "a scene needs at least one [[light]] (or render.emission = true)",
+        ));
+    }
+    if lights.len() > MAX_LIGHTS {
+        return Err(ctx.invalid(
+            "light",
+            format!(
+                "{} lights; the path tracer takes at most {MAX_LIGHTS} (remove or merge some)",
+                lights.len(),
+            ),
+        ));
+    }
+    let mut environments = 0;
+    for (i, light) in lights.iter().enumerate() {
+        light.check(ctx, i)?;
+        if matches!(light, Light::Environment(_)) {
+            environments += 1;
+            if environments > 1 {
+                return Err(ctx.invalid(
+                    format!("light[{i}].kind"),
+                    "a scene has at most one environment light",
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

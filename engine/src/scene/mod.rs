@@ -44,6 +44,7 @@ pub mod frame;
 pub mod light;
 pub mod render;
 pub mod transfer_ref;
+pub mod view;
 pub mod volume;
 
 #[cfg(test)]
@@ -53,7 +54,7 @@ use std::path::Path;
 
 pub use crate::bytes::parse_memory_size;
 pub use animation::{Animation, CameraKey, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES};
-pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR};
+pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR, MAX_CAMERA_DISTANCE};
 pub use error::SceneError;
 pub use frame::{changed, Change, FrameState};
 pub use light::{
@@ -61,6 +62,7 @@ pub use light::{
 };
 pub use render::{parse_gpu_memory, Estimator, Phase, PipelineKey, RenderSettings, MAX_BOUNCES};
 pub use transfer_ref::TransferSpec;
+pub use view::{TfState, View, ViewSections};
 pub use volume::{BuiltinVolume, RawLayout, VolumeSource, VolumeSpec};
 
 use crate::transfer::{TfLut, TransferFunction};
@@ -211,35 +213,7 @@ impl Scene {
             b.validate().map_err(tf_err("transfer.b"))?;
         }
         self.camera.check(ctx, "camera")?;
-        if self.lights.is_empty() && !self.render.emission() {
-            return Err(ctx.invalid(
-                "light",
-                "a scene needs at least one [[light]] (or render.emission = true)",
-            ));
-        }
-        if self.lights.len() > light::MAX_LIGHTS {
-            return Err(ctx.invalid(
-                "light",
-                format!(
-                    "{} lights; the path tracer takes at most {} (remove or merge some)",
-                    self.lights.len(),
-                    light::MAX_LIGHTS
-                ),
-            ));
-        }
-        let mut environments = 0;
-        for (i, light) in self.lights.iter().enumerate() {
-            light.check(ctx, i)?;
-            if matches!(light, Light::Environment(_)) {
-                environments += 1;
-                if environments > 1 {
-                    return Err(ctx.invalid(
-                        format!("light[{i}].kind"),
-                        "a scene has at most one environment light",
-                    ));
-                }
-            }
-        }
+        light::check_lights(ctx, &self.lights, self.render.emission())?;
         self.render.check(ctx)?;
         self.animation.check(
             ctx,

@@ -1,11 +1,13 @@
-//! The explorer's camera: orbit about a target, pan, zoom, reset and fly-to-fit.
+//! The mouse's camera: orbit about a target, pan, zoom, reset and fly-to-fit, with the
+//! explorer's semantics (a session's `Orbit`, `Pan` and `Zoom` edits, from the explorer's
+//! mouse, its `--script`, Python's `orbit`/`pan`/`zoom` and the notebook viewer alike).
 //!
 //! The state is a target, a distance and two angles about the scene's `up` axis (yaw
 //! around it, pitch above the plane normal to it), kept in f64 like a scene file's
 //! `[camera]`, so [`OrbitCamera::spec`] is exactly what a recorded session writes and
 //! replays (`dvr capture` then renders the same matrices).
 
-use dvr_engine::scene::CameraSpec;
+use crate::scene::{CameraSpec, MAX_CAMERA_DISTANCE};
 use glam::DVec3;
 
 /// Radians of orbit per pixel dragged.
@@ -15,7 +17,9 @@ pub const ZOOM_PER_STEP: f64 = 1.1;
 /// Pitch stays this far from the poles (the view must not become parallel to `up`).
 const PITCH_LIMIT: f64 = 89.0 * std::f64::consts::PI / 180.0;
 const MIN_DISTANCE: f64 = 0.02;
-const MAX_DISTANCE: f64 = 100.0;
+/// Short of the farthest a camera may be from the volume's centre, so zooming out
+/// leaves room to pan.
+const MAX_DISTANCE: f64 = 0.8 * MAX_CAMERA_DISTANCE;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrbitCamera {
@@ -67,6 +71,14 @@ impl OrbitCamera {
             up,
             home,
         }
+    }
+
+    /// Moves to `spec` (a camera set outright), keeping where [`OrbitCamera::reset`]
+    /// returns to.
+    pub fn set_spec(&mut self, spec: &CameraSpec) {
+        let home = self.home;
+        *self = Self::from_spec(spec);
+        self.home = home;
     }
 
     pub fn position(&self) -> DVec3 {

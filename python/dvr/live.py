@@ -1,0 +1,193 @@
+"""Live views of view state: the camera, the lights and the render settings of a
+:class:`dvr.Renderer` (edits of its session) or of a :class:`dvr.Scene` (edits of its
+dict).
+
+Every object handed out is either a live view or immutable. Assigning an attribute of a
+view applies at once (``r.camera.position = (0, 2, 0)`` is an edit the next render
+reprojects); the values a view returns are tuples and numbers, so assigning into one
+(``r.camera.position[0] = 1``) raises ``TypeError`` instead of being silently lost.
+"""
+
+from collections.abc import Sequence
+
+import numpy as np
+
+__all__ = ["CameraView", "LightView", "LightsView", "SettingsView"]
+
+
+def _frozen(value):
+    """A section value as returned to the user: lists become tuples, recursively."""
+    if isinstance(value, list):
+        return tuple(_frozen(v) for v in value)
+    if isinstance(value, dict):
+        return {k: _frozen(v) for k, v in value.items()}
+    return value
+
+
+def _plain(value):
+    """A value as the engine takes it: arrays and tuples become lists of floats."""
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, (tuple, list)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _as_dict(obj, what):
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if hasattr(obj, "to_dict"):
+        return obj.to_dict()
+    raise TypeError(f"{what}: expected a {what} object or a dict, got {type(obj).__name__}")
+
+
+class _Section:
+    """A dict-valued section behind a getter and a setter; attribute writes replace one
+    key and hand the whole section to the setter (which checks it)."""
+
+    _fields: tuple = ()
+
+    def __init__(self, get, put, what):
+        object.__setattr__(self, "_get", get)
+        object.__setattr__(self, "_put", put)
+        object.__setattr__(self, "_what", what)
+
+    def to_dict(self) -> dict:
+        """A copy of the section as a plain dict."""
+        return dict(self._get())
+
+    def update(self, **fields):
+        """Sets several fields in one edit."""
+        d = dict(self._get())
+        for k, v in fields.items():
+            self._check_field(k)
+            d[k] = _plain(v)
+        self._put(d)
+
+    def _check_field(self, name):
+        if self._fields and name not in self._fields:
+            raise AttributeError(f"{self._what} has no field {name!r} (fields: {', '.join(self._fields)})")
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        d = self._get()
+        if name in d:
+            return _frozen(d[name])
+        if name in self._fields:
+            return None
+        raise AttributeError(f"{self._what} has no field {name!r} (it has: {', '.join(d)})")
+
+    def __setattr__(self, name, value):
+        self.update(**{name: value})
+
+    def __eq__(self, other):
+        if isinstance(other, _Section):
+            return self._get() == other._get()
+        if isinstance(other, dict):
+            return self._get() == other
+        return NotImplemented
+
+    def __repr__(self):
+        fields = ", ".join(f"{k}={_frozen(v)!r}" for k, v in self._get().items())
+        return f"{type(self).__name__}({fields})"
+
+
+class CameraView(_Section):
+    """The camera, live: ``position``, ``target``, ``up`` (world units; the volume's
+    longest side spans 1, centred on the origin) and ``fov_y_degrees``."""
+
+    _fields = ("position", "target", "up", "fov_y_degrees")
+
+
+class SettingsView(_Section):
+    """The render settings (a scene file's ``[render]``), live: ``spp``,
+    ``max_bounces``, ``estimator``, ``phase``, ``hg_g``, ``russian_roulette_depth``,
+    ``step_size``, ``emission``, ``seed``, ``filter_sigma``, ``feature_threshold``;
+    also as items (``settings["spp"] = 2``). A change restarts every history;
+    ``estimator``, ``phase`` and ``emission`` build a new renderer."""
+
+    def __getitem__(self, key):
+        return self.__getattr__(key)
+
+    def __setitem__(self, key, value):
+        self.update(**{key: value})
+
+    def keys(self):
+        return self._get().keys()
+
+
+class LightView(_Section):
+    """One light, live (``kind`` and that kind's fields: ``position``, ``colour``,
+    ``intensity``; an area light's ``target``, ``normal``, ``size``; an environment's
+    ``mode``, ``top``, ``bottom``, ``map``)."""
+
+    def update(self, **fields):
+        if "color" in fields:
+            fields["colour"] = fields.pop("color")
+        d = dict(self._get())
+        d.update({k: _plain(v) for k, v in fields.items()})
+        self._put(d)
+
+    def __getattr__(self, name):
+        if name == "color":
+            name = "colour"
+        return super().__getattr__(name)
+
+
+class LightsView(Sequence):
+    """The lights, live: ``lights[i]`` is a :class:`LightView`; ``lights[i] = light``
+    replaces one, ``append`` adds one, ``del lights[i]`` removes one."""
+
+    def __init__(self, get, put, what="lights"):
+        self._get, self._put, self._what = get, put, what
+
+    def __len__(self):
+        return len(self._get())
+
+    def __getitem__(self, i):
+        n = len(self)
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(n))]
+        if not isinstance(i, (int, np.integer)) or not -n <= i < n:
+            raise IndexError(f"{self._what}[{i!r}]: there are {n} light(s)")
+        i = int(i) % n
+
+        def get():
+            return self._get()[i]
+
+        def put(d):
+            lights = [dict(l) for l in self._get()]
+            lights[i] = d
+            self._put(lights)
+
+        return LightView(get, put, f"{self._what}[{i}]")
+
+    def __setitem__(self, i, light):
+        lights = [dict(l) for l in self._get()]
+        lights[i] = _as_dict(light, "light")
+        self._put(lights)
+
+    def __delitem__(self, i):
+        lights = [dict(l) for l in self._get()]
+        del lights[i]
+        self._put(lights)
+
+    def append(self, light):
+        self._put([dict(l) for l in self._get()] + [_as_dict(light, "light")])
+
+    def to_list(self) -> list:
+        """A copy of the lights as plain dicts."""
+        return [dict(l) for l in self._get()]
+
+    def __eq__(self, other):
+        if isinstance(other, LightsView):
+            return self._get() == other._get()
+        if isinstance(other, list):
+            return self._get() == other
+        return NotImplemented
+
+    def __repr__(self):
+        return f"LightsView({self._get()!r})"
