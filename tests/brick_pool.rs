@@ -13,7 +13,8 @@ mod common;
 
 use common::*;
 use dvr_engine::renderer::scene_gpu::{LutUpload, VolumeUpload};
-use dvr_engine::renderer::{FrameRequest, Renderer, VolumeResidency};
+use dvr_engine::renderer::{FrameInputs, FrameRequest, Renderer, VolumeResidency};
+use dvr_engine::scene::{ClipPlane, Cut};
 use dvr_engine::volume::{Volume, VolumeData};
 use glam::Vec3;
 use std::sync::Arc;
@@ -78,6 +79,11 @@ fn make(volume: &VolumeUpload, budget: Option<u64>, denoisers: &[&str]) -> Rende
 
 /// Renders one frame per TF in `tfs`; returns each frame's outputs by method name.
 fn run(r: &mut Renderer, tfs: &[LutUpload]) -> Vec<Vec<(String, Vec<[f32; 4]>)>> {
+    run_cut(r, tfs, &Cut::default())
+}
+
+/// [`run`] under a cut.
+fn run_cut(r: &mut Renderer, tfs: &[LutUpload], cut: &Cut) -> Vec<Vec<(String, Vec<[f32; 4]>)>> {
     let camera = front_camera(2.2, 40.0);
     let lights = vec![point_light(Vec3::new(0.8, 1.0, 1.5), 6.0), environment(0.3)];
     let request = FrameRequest {
@@ -86,7 +92,10 @@ fn run(r: &mut Renderer, tfs: &[LutUpload]) -> Vec<Vec<(String, Vec<[f32; 4]>)>>
     };
     let mut results = Vec::new();
     for lut in tfs {
-        let i = inputs(camera, lights.clone(), lut.clone());
+        let i = FrameInputs {
+            cut: cut.clone(),
+            ..inputs(camera, lights.clone(), lut.clone())
+        };
         results.extend(r.frame(&i, &request).expect("frame"));
     }
     results.extend(r.flush().expect("flush"));
@@ -146,6 +155,7 @@ fn pooled_frames_equal_the_dense_path() {
             visible,
             resident,
             pending,
+            ..
         } => {
             assert_eq!(layout.grid, [3, 3, 3]);
             assert_eq!(
@@ -162,6 +172,49 @@ fn pooled_frames_equal_the_dense_path() {
             assert_same(&format!("frame {f} {name}"), a, b);
         }
     }
+    assert_validation_clean();
+}
+
+#[test]
+fn bricks_a_cut_removes_are_never_uploaded() {
+    let volume = two_blobs();
+    let show = step_tf(0.1);
+    // The faint blob's pool brick spans voxels 0 to 32 along x (world x up to -1/6, a
+    // voxel more for its apron): the plane keeps x >= -0.15 and removes it whole; the
+    // dense blob (x within ±0.14) stays.
+    let cut = Cut {
+        planes: vec![ClipPlane {
+            point: glam::DVec3::new(-0.15, 0.0, 0.0),
+            normal: glam::DVec3::X,
+            enabled: true,
+        }],
+        crop: None,
+    };
+    let residency = |r: &Renderer| match r.volume_residency() {
+        VolumeResidency::Pool {
+            visible, uploaded, ..
+        } => (visible, uploaded),
+        VolumeResidency::Dense => panic!("pooled"),
+    };
+    let mut r = make(&volume, Some(BUDGET), &["none"]);
+    let cut_frames = run_cut(&mut r, &[show.clone(), show.clone(), show.clone()], &cut);
+    assert_eq!(residency(&r), (1, 1), "one brick visible, one uploaded");
+    // The same frames with the cut switched off: the faint brick shows, and only then
+    // is it uploaded.
+    let off = Cut {
+        planes: vec![ClipPlane {
+            enabled: false,
+            ..cut.planes[0]
+        }],
+        crop: None,
+    };
+    let open = run_cut(&mut r, &[show.clone(), show], &off);
+    assert_eq!(residency(&r), (2, 2));
+    let (psnr, _) = compare(&cut_frames[2][0].1, &open[1][0].1);
+    assert!(
+        psnr < 40.0,
+        "the cut must hide the faint blob: {psnr:.1} dB"
+    );
     assert_validation_clean();
 }
 

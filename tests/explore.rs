@@ -253,6 +253,30 @@ fn window_shows_the_volume_and_the_panel_and_a_scripted_drag_turns_it() {
 }
 
 #[test]
+fn a_clip_plane_and_a_crop_box_cut_into_the_view_and_c_switches_them_off() {
+    let Some(x) = xvfb() else { return };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let plain = explore_shot(&x, dir.path(), "plain.png", &[]);
+    // A plane facing the view is added, dragged back by script, and a crop box closes
+    // in from the top: the near half of the phantom goes, its inside shows.
+    let script =
+        "clip:add@3;clip:offset:0.05@6;clip:offset:0.05@9;crop:on@12;crop:max:0.5,0.5,0.2@13";
+    let cut = explore_shot(&x, dir.path(), "cut.png", &["--script", script]);
+    let d_cut = mean_abs_diff(&plain, &cut, SIZE, SIZE);
+    // C switches every cut off: the view returns to the plain one (up to the noise of
+    // histories restarted by the switch).
+    let off_script = format!("{script};key:c@16");
+    let off = explore_shot(&x, dir.path(), "off.png", &["--script", &off_script]);
+    let d_off = mean_abs_diff(&plain, &off, SIZE, SIZE);
+    eprintln!("mean |Δ| plain vs cut {d_cut:.2}, plain vs switched off {d_off:.2}");
+    assert!(d_cut > 8.0, "the cut barely changed the view ({d_cut:.2})");
+    assert!(
+        d_off < 0.5 * d_cut,
+        "C did not switch the cut off ({d_off:.2})"
+    );
+}
+
+#[test]
 fn a_recorded_session_replays_to_the_same_frames() {
     let Some(x) = xvfb() else { return };
     let dir = tempfile::tempdir().expect("temp dir");

@@ -23,6 +23,8 @@ from ._native import Volume
 from .scene import (
     AreaLight,
     Camera,
+    ClipPlane,
+    CropBox,
     EnvironmentLight,
     PointLight,
     Scene,
@@ -36,6 +38,8 @@ __all__ = [
     "AreaLight",
     "Camera",
     "CameraView",
+    "ClipPlane",
+    "CropBox",
     "EnvironmentLight",
     "LightView",
     "LightsView",

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["CameraView", "LightView", "LightsView", "SettingsView"]
+__all__ = ["CameraView", "ClipView", "ClipsView", "CropView", "LightView", "LightsView", "SettingsView"]
 
 
 def _frozen(value):
@@ -137,11 +137,45 @@ class LightView(_Section):
         return super().__getattr__(name)
 
 
-class LightsView(Sequence):
-    """The lights, live: ``lights[i]`` is a :class:`LightView`; ``lights[i] = light``
-    replaces one, ``append`` adds one, ``del lights[i]`` removes one."""
+class ClipView(_Section):
+    """One clip plane, live: ``point`` (world units), ``normal`` (the half-space behind
+    it is removed) and ``enabled``."""
 
-    def __init__(self, get, put, what="lights"):
+    _fields = ("point", "normal", "enabled")
+
+    def __getattr__(self, name):
+        if name == "enabled":
+            return self._get().get("enabled", True)
+        return super().__getattr__(name)
+
+    def flip(self):
+        """Keeps what was removed and removes what was kept."""
+        self.normal = tuple(-x for x in self.normal)
+
+
+class CropView(_Section):
+    """The crop box, live: ``min`` and ``max`` corners (in the volume's frame, -0.5 to
+    0.5 per axis, or voxel indices with ``units = "voxels"``) and ``enabled``."""
+
+    _fields = ("min", "max", "units", "enabled")
+
+    def __getattr__(self, name):
+        if name == "enabled":
+            return self._get().get("enabled", True)
+        if name == "units":
+            return self._get().get("units", "box")
+        return super().__getattr__(name)
+
+
+class _ListView(Sequence):
+    """A live list of dict-valued items: ``view[i]`` is a live item view;
+    ``view[i] = item`` replaces one, ``append`` adds one, ``del view[i]`` removes
+    one."""
+
+    _item = None
+    _noun = "item"
+
+    def __init__(self, get, put, what):
         self._get, self._put, self._what = get, put, what
 
     def __len__(self):
@@ -152,42 +186,68 @@ class LightsView(Sequence):
         if isinstance(i, slice):
             return [self[k] for k in range(*i.indices(n))]
         if not isinstance(i, (int, np.integer)) or not -n <= i < n:
-            raise IndexError(f"{self._what}[{i!r}]: there are {n} light(s)")
+            raise IndexError(f"{self._what}[{i!r}]: there are {n} {self._noun}(s)")
         i = int(i) % n
 
         def get():
             return self._get()[i]
 
         def put(d):
-            lights = [dict(l) for l in self._get()]
-            lights[i] = d
-            self._put(lights)
+            items = [dict(x) for x in self._get()]
+            items[i] = d
+            self._put(items)
 
-        return LightView(get, put, f"{self._what}[{i}]")
+        return self._item(get, put, f"{self._what}[{i}]")
 
-    def __setitem__(self, i, light):
-        lights = [dict(l) for l in self._get()]
-        lights[i] = _as_dict(light, "light")
-        self._put(lights)
+    def __setitem__(self, i, item):
+        items = [dict(x) for x in self._get()]
+        items[i] = _as_dict(item, self._noun)
+        self._put(items)
 
     def __delitem__(self, i):
-        lights = [dict(l) for l in self._get()]
-        del lights[i]
-        self._put(lights)
+        items = [dict(x) for x in self._get()]
+        del items[i]
+        self._put(items)
 
-    def append(self, light):
-        self._put([dict(l) for l in self._get()] + [_as_dict(light, "light")])
+    def append(self, item):
+        self._put([dict(x) for x in self._get()] + [_as_dict(item, self._noun)])
+
+    def clear(self):
+        self._put([])
 
     def to_list(self) -> list:
-        """A copy of the lights as plain dicts."""
-        return [dict(l) for l in self._get()]
+        """A copy as plain dicts."""
+        return [dict(x) for x in self._get()]
 
     def __eq__(self, other):
-        if isinstance(other, LightsView):
+        if isinstance(other, _ListView):
             return self._get() == other._get()
         if isinstance(other, list):
             return self._get() == other
         return NotImplemented
 
     def __repr__(self):
-        return f"LightsView({self._get()!r})"
+        return f"{type(self).__name__}({self._get()!r})"
+
+
+class LightsView(_ListView):
+    """The lights, live: ``lights[i]`` is a :class:`LightView`; ``lights[i] = light``
+    replaces one, ``append`` adds one, ``del lights[i]`` removes one."""
+
+    _item = LightView
+    _noun = "light"
+
+    def __init__(self, get, put, what="lights"):
+        super().__init__(get, put, what)
+
+
+class ClipsView(_ListView):
+    """The clip planes, live (at most 6): ``clip[i]`` is a :class:`ClipView`;
+    ``clip.append(dvr.ClipPlane(point, normal))`` adds one, ``del clip[i]`` removes
+    one."""
+
+    _item = ClipView
+    _noun = "clip plane"
+
+    def __init__(self, get, put, what="clip"):
+        super().__init__(get, put, what)

@@ -5,7 +5,7 @@ import threading
 import numpy as np
 
 from . import _native
-from .live import CameraView, LightsView, SettingsView, _as_dict, _plain
+from .live import CameraView, ClipsView, CropView, LightsView, SettingsView, _as_dict, _plain
 from .scene import Scene, TransferFunction
 
 __all__ = ["Renderer", "denoisers"]
@@ -110,6 +110,29 @@ class Renderer:
     @lights.setter
     def lights(self, lights):
         self._put("light", [_as_dict(l, "light") for l in lights])
+
+    @property
+    def clip(self) -> ClipsView:
+        """The clip planes, live (at most 6; each removes the half-space behind its
+        normal): ``r.clip.append(dvr.ClipPlane((0, 0, 0.05), (0, 0, 1)))``,
+        ``r.clip[0].point = (...)``, ``r.clip[0].enabled = False``, ``r.clip = []``."""
+        return ClipsView(lambda: self._r.view().get("clip", []), lambda l: self._put("clip", l))
+
+    @clip.setter
+    def clip(self, planes):
+        self._put("clip", [_as_dict(p, "clip plane") for p in planes])
+
+    @property
+    def crop(self):
+        """The crop box, live (a :class:`dvr.live.CropView`), or None; assign a
+        :class:`dvr.CropBox`, a dict or None."""
+        if self._r.view().get("crop") is None:
+            return None
+        return CropView(lambda: self._r.view()["crop"], lambda d: self._put("crop", d), "crop")
+
+    @crop.setter
+    def crop(self, crop):
+        self._put("crop", None if crop is None else _as_dict(crop, "crop box"))
 
     @property
     def settings(self) -> SettingsView:
@@ -224,7 +247,10 @@ class Renderer:
     def _put(self, section, value):
         with self._edit:
             view = self._r.view()
-            view[section] = _plain(value)
+            if value is None:
+                view.pop(section, None)
+            else:
+                view[section] = _plain(value)
             self._r.set_view(view)
 
     def __repr__(self):

@@ -8,11 +8,13 @@ import types
 import numpy as np
 
 from . import _native
-from .live import CameraView, LightsView, _as_dict
+from .live import CameraView, ClipsView, CropView, LightsView, _as_dict
 
 __all__ = [
     "AreaLight",
     "Camera",
+    "ClipPlane",
+    "CropBox",
     "EnvironmentLight",
     "PointLight",
     "Scene",
@@ -200,6 +202,40 @@ class EnvironmentLight:
         return {"kind": "environment", "mode": "constant", "colour": self.colour, "intensity": self.intensity}
 
 
+class ClipPlane:
+    """A clip plane through ``point`` (world units) that removes the half-space behind
+    ``normal``; switchable with ``enabled``."""
+
+    def __init__(self, point, normal, enabled=True):
+        self.point = _vec(point, 3, "clip plane point")
+        self.normal = _vec(normal, 3, "clip plane normal")
+        self.enabled = bool(enabled)
+
+    def to_dict(self):
+        return {"point": self.point, "normal": self.normal, "enabled": self.enabled}
+
+    def __repr__(self):
+        return f"ClipPlane(point={self.point}, normal={self.normal}, enabled={self.enabled})"
+
+
+class CropBox:
+    """A crop box: what is outside ``min``..``max`` is removed. Corners in the volume's
+    frame (-0.5 to 0.5 along each axis, ``units="box"``) or in voxel indices
+    (``units="voxels"``)."""
+
+    def __init__(self, min=(-0.5, -0.5, -0.5), max=(0.5, 0.5, 0.5), units="box", enabled=True):
+        self.min = _vec(min, 3, "crop min")
+        self.max = _vec(max, 3, "crop max")
+        self.units = str(units)
+        self.enabled = bool(enabled)
+
+    def to_dict(self):
+        return {"min": self.min, "max": self.max, "units": self.units, "enabled": self.enabled}
+
+    def __repr__(self):
+        return f"CropBox(min={self.min}, max={self.max}, units={self.units!r}, enabled={self.enabled})"
+
+
 def _light_dict(light):
     return light.to_dict() if hasattr(light, "to_dict") else dict(light)
 
@@ -302,6 +338,38 @@ class Scene:
     @lights.setter
     def lights(self, lights):
         self.data["light"] = [_light_dict(l) for l in lights]
+
+    @property
+    def clip(self) -> ClipsView:
+        """The clip planes at rest, live (assign a list of :class:`ClipPlane` or dicts)."""
+
+        def put(planes):
+            self.data["clip"] = [dict(p) for p in planes]
+
+        return ClipsView(lambda: self.data.get("clip", []), put)
+
+    @clip.setter
+    def clip(self, planes):
+        self.data["clip"] = [_as_dict(p, "clip plane") for p in planes]
+
+    @property
+    def crop(self):
+        """The crop box at rest, live, or None (assign a :class:`CropBox`, a dict or
+        None)."""
+        if self.data.get("crop") is None:
+            return None
+
+        def put(d):
+            self.data["crop"] = dict(d)
+
+        return CropView(lambda: self.data["crop"], put, "crop")
+
+    @crop.setter
+    def crop(self, crop):
+        if crop is None:
+            self.data.pop("crop", None)
+        else:
+            self.data["crop"] = _as_dict(crop, "crop box")
 
     @property
     def render_settings(self) -> dict:

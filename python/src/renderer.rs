@@ -268,9 +268,9 @@ impl Renderer {
         Ok(image_out(py, size.width, size.height, &pixels, 3))
     }
 
-    /// The view's camera, lights and render settings as the dict a scene file's
-    /// `[camera]`, `[[light]]` and `[render]` sections hold (`camera`, `light`,
-    /// `render`).
+    /// The view's camera, lights, render settings and cut as the dict a scene file's
+    /// `[camera]`, `[[light]]`, `[render]`, `[[clip]]` and `[crop]` sections hold
+    /// (`camera`, `light`, `render`, `clip`, `crop`).
     fn view<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let text = self.locked(py, |me| {
             let s = &me.session;
@@ -278,6 +278,7 @@ impl Renderer {
                 camera: s.view().camera,
                 lights: s.view().lights.clone(),
                 render: *s.settings(),
+                cut: s.view().cut.clone(),
             };
             sections.to_toml().map_err(value_error)
         })?;
@@ -301,6 +302,9 @@ impl Renderer {
             }
             if new.camera != s.view().camera {
                 s.edit(Edit::Camera(new.camera)).map_err(session_error)?;
+            }
+            if new.cut != s.view().cut {
+                s.edit(Edit::Cut(new.cut)).map_err(session_error)?;
             }
             Ok(())
         })

@@ -37,6 +37,8 @@ def test_a_still_view_only_gets_better_over_200_frames():
 CAMERA = [(0.45, 1.5, 0.35), (0.55, 1.45, 0.36), (0.7, 1.38, 0.4), (0.7, 1.38, 0.4), (0.7, 1.38, 0.4), (0.6, 1.42, 0.3)]
 LIGHT = [((-0.9, 1.1, 1.0), 20.0)] * 3 + [((-0.5, 1.2, 0.9), 24.0)] * 2 + [((-0.4, 1.0, 1.1), 18.0)]
 TF_B_FROM = 4
+# A clip plane switched on at frame 2 and moved on frames 3 and 5.
+CLIP = [(0.3, False), (0.3, False), (0.3, True), (0.1, True), (0.1, True), (0.0, True)]
 
 
 def scripted_scene(path):
@@ -48,12 +50,18 @@ def scripted_scene(path):
             f"[[animation.light]]\nindex = 0\nframe = {f}\nposition = [{pos[0]!r}, {pos[1]!r}, {pos[2]!r}]\n"
             f"intensity = {k!r}\n"
         )
+    for f, (z, on) in enumerate(CLIP):
+        keys.append(
+            f"[[animation.clip]]\nindex = 0\nframe = {f}\npoint = [0.0, 0.0, {z!r}]\n"
+            f"enabled = {'true' if on else 'false'}\n"
+        )
     keys.append('[[animation.tf]]\nframe = 0\nblend = 0.0\ninterpolation = "step"\n')
     keys.append(f"[[animation.tf]]\nframe = {TF_B_FROM}\nblend = 1.0\n")
     path.write_text(
         'name = "live-vs-scripted"\n[volume]\nbuiltin = "phantom"\nsize = 48\ndensity_scale = 150.0\n'
         '[transfer]\na = "phantom-opaque"\nb = "phantom-layered"\n'
         "[camera]\nposition = [0.45, 1.5, 0.35]\n"
+        "[[clip]]\npoint = [0.0, 0.0, 0.3]\nnormal = [0.0, 0.0, -1.0]\nenabled = false\n"
         '[[light]]\nkind = "point"\nposition = [-0.9, 1.1, 1.0]\ncolour = [1.0, 0.95, 0.9]\nintensity = 20.0\n'
         '[[light]]\nkind = "environment"\nmode = "constant"\ncolour = [0.6, 0.7, 0.8]\nintensity = 0.2\n'
         f"[animation]\nframes = {len(CAMERA)}\n" + "".join(keys)
@@ -79,10 +87,51 @@ def test_live_edits_render_the_frames_of_the_same_changes_scripted(method, dvr_b
             r.lights[0].update(position=pos, intensity=k)
         if f == TF_B_FROM:
             r.tf = "phantom-layered"
+        z, on = CLIP[f]
+        if (r.clip[0].point[2], r.clip[0].enabled) != (z, on):
+            r.clip[0].update(point=(0.0, 0.0, z), enabled=on)
         got = r.render()
         for name, key in (("none", "noisy"), (method, method)):
             want = read_exr(out / name / f"{f:04d}.exr")
             assert np.array_equal(got[key], want), f"{name} frame {f}: differs by {np.abs(got[key] - want).max()}"
+
+
+def test_clip_planes_and_the_crop_box_are_live_state():
+    r = dvr.Renderer(dvr.Scene.builtin("phantom/orbit"), size=(16, 16), denoisers=["taa"])
+    plain = r.render()["noisy"]
+    assert len(r.clip) == 0 and r.crop is None
+    r.clip.append(dvr.ClipPlane((0.0, 0.0, 0.0), (0.0, 0.0, -1.0)))  # removes the top half
+    assert r.clip[0].normal == (0.0, 0.0, -1.0) and r.clip[0].enabled
+    cut = r.render()["noisy"]
+    assert np.abs(cut - plain).mean() > 0.01
+    r.clip[0].flip()
+    assert r.clip[0].normal == (0.0, 0.0, 1.0)
+    r.clip[0].enabled = False
+    r.crop = dvr.CropBox(min=(-0.5, -0.5, -0.5), max=(0.5, 0.0, 0.5))
+    assert r.crop.max == (0.5, 0.0, 0.5) and r.crop.units == "box"
+    r.crop.enabled = False
+    assert not r.crop.enabled
+    r.crop = None
+    assert r.crop is None
+    with pytest.raises(TypeError):
+        r.clip[0].point[0] = 1.0
+    # Bad cuts name the field and change nothing.
+    before = (r.clip.to_list(), r.crop)
+    for edit, needle in [
+        (lambda: setattr(r.clip[0], "normal", (0, 0, 0)), r"clip\[0\].normal"),
+        (lambda: setattr(r.clip[0], "point", (np.nan, 0, 0)), r"clip\[0\].point"),
+        (lambda: setattr(r, "crop", dvr.CropBox(min=(0.2, 0, 0), max=(0.1, 0.3, 0.3))), "crop.min"),
+        (lambda: setattr(r, "clip", [dvr.ClipPlane((0, 0, 0), (0, 0, 1))] * 7), "at most 6"),
+    ]:
+        with pytest.raises(ValueError, match=needle):
+            edit()
+    assert (r.clip.to_list(), r.crop) == before
+    # A scene's cut: the same live views over its dict.
+    scene = dvr.Scene.builtin("phantom/orbit")
+    scene.clip = [dvr.ClipPlane((0.0, 0.0, 0.1), (0.0, 0.0, 1.0))]
+    scene.clip[0].point = (0.0, 0.0, 0.2)
+    scene.crop = dvr.CropBox(max=(0.5, 0.5, 0.3))
+    assert scene.check()["clip"][0]["point"] == [0.0, 0.0, 0.2] and scene.check()["crop"]["max"][2] == 0.3
 
 
 def test_render_frame_k_plays_the_animation_and_leaves_its_view():

@@ -38,7 +38,9 @@ void main() {
     vec4 far_h = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
     vec3 o = frame.camera_pos.xyz;
     vec3 d = normalize(far_h.xyz / far_h.w - o);
-    vec2 span = intersect_box(o, d);
+    vec3 cut_normal;
+    vec2 span = intersect_medium(o, d, cut_normal);
+    bool cut_entry = any(notEqual(cut_normal, vec3(0.0)));
     float voxel = min(box_size().x / float(frame.dims.x),
                       min(box_size().y / float(frame.dims.y), box_size().z / float(frame.dims.z)));
     float base_step = voxel * pc.step_voxels;
@@ -66,6 +68,7 @@ void main() {
                     if (GUIDE_NORMALS) {
                         vec3 g = density_gradient(p);
                         vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
+                        if (cut_entry && t - span.x < CUT_FACE_STEPS * base_step) n = cut_normal;
                         if (dot(n, d) > 0.0) n = -n;
                         normal += weight * n;
                     }

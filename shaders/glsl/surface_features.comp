@@ -8,7 +8,9 @@
 // of the first-collision depth distribution μ(t)T(t), from the same compositing weights.
 // It is what the paper's per-sample first collisions average to, without their noise, so
 // reprojection through semi-transparent layers gets a stable depth. Normal and albedo stay
-// invalid there (edge-stopping only trusts threshold surfaces).
+// invalid there (edge-stopping only trusts threshold surfaces). Where the ray enters the
+// medium through a cut and meets the threshold at once, the surface is the cut face and
+// its normal the cut's.
 #include "common.glsl"
 #include "frame.glsl"
 #include "volume.glsl"
@@ -36,7 +38,9 @@ void main() {
     vec4 far_h = frame.inv_view_proj * vec4(ndc, 1.0, 1.0);
     vec3 o = frame.camera_pos.xyz;
     vec3 d = normalize(far_h.xyz / far_h.w - o);
-    vec2 span = intersect_box(o, d);
+    vec3 cut_normal;
+    vec2 span = intersect_medium(o, d, cut_normal);
+    bool cut_entry = any(notEqual(cut_normal, vec3(0.0)));
     float voxel = min(box_size().x / float(frame.dims.x),
                       min(box_size().y / float(frame.dims.y), box_size().z / float(frame.dims.z)));
     float base_step = voxel * pc.step_voxels;
@@ -74,6 +78,7 @@ void main() {
                         float density = density_at(ph);
                         vec3 g = density_gradient(ph);
                         vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
+                        if (cut_entry && th - span.x < CUT_FACE_STEPS * base_step) n = cut_normal;
                         if (dot(n, d) > 0.0) n = -n;
                         pos = vec4(ph, 1.0);
                         nrm = vec4(n, th);

@@ -34,7 +34,8 @@ impl Explorer {
             self.command(c);
         }
 
-        // The UI edits the model.
+        // The UI edits the model; it outlines the cut over the view it shows.
+        self.ui.view = self.view_geometry();
         let Some(egui_state) = self.egui_state.as_mut() else {
             return Ok(());
         };
@@ -145,7 +146,13 @@ impl Explorer {
             }
         }
         if let Some(rec) = self.recorder.as_mut() {
-            rec.push(view.camera, &view.lights, &view.tf.a, &self.model.left)?;
+            rec.push(
+                view.camera,
+                &view.lights,
+                &view.cut,
+                &view.tf.a,
+                &self.model.left,
+            )?;
         }
         self.last_view = Some(view);
         self.frame += 1;
@@ -156,6 +163,24 @@ impl Explorer {
             event_loop.exit();
         }
         Ok(())
+    }
+
+    /// The camera and rectangle of the view shown this frame, for the cut's outline.
+    fn view_geometry(&self) -> Option<cut_panel::ViewGeometry> {
+        let session = self.gfx.as_ref()?.session.as_ref()?;
+        let (vw, vh) = self.view_size();
+        let ppp = self.egui_ctx.pixels_per_point();
+        let camera = session.view().camera.camera();
+        let half = glam::Vec3::from(session.setup().volume.world_size).as_dvec3() * 0.5;
+        Some(cut_panel::ViewGeometry {
+            view_proj: camera.view_proj(vw as f32 / vh as f32),
+            forward: camera.forward().as_dvec3(),
+            half,
+            rect: egui::Rect::from_min_size(
+                egui::Pos2::ZERO,
+                egui::vec2(vw as f32 / ppp, vh as f32 / ppp),
+            ),
+        })
     }
 
     /// Handles the results of a finished frame: timings, screenshots, recorded frames.

@@ -8,17 +8,24 @@
 //! | `orbit:DX,DY@F` | a left-drag of (DX, DY) pixels at frame F |
 //! | `pan:DX,DY@F` | a right-drag of (DX, DY) pixels |
 //! | `zoom:STEPS@F` | wheel steps (positive zooms in) |
-//! | `key:NAME@F` | a key: `r` (reset), `f` (fit), `h` (help), `f12` (screenshot), `tab` (UI) |
+//! | `key:NAME@F` | a key: `r` (reset), `f` (fit), `c` (cuts off/on), `h` (help), `f12` (screenshot), `tab` (UI) |
 //! | `denoiser:NAME@F` | show denoiser NAME |
 //! | `split:NAME@F` | split view with NAME on the right (`split:off` ends it) |
 //! | `tf:NAME@F` | the transfer function: a preset name, or a TF file path (as the panel's presets and load) |
+//! | `clip:add@F` | a clip plane through the centre, facing the view (as the panel's "add plane") |
+//! | `clip:offset:D@F` | moves the last plane D world units along its normal |
+//! | `clip:flip@F` | flips the last plane |
+//! | `crop:on@F`, `crop:off@F` | switches the crop box (on: the whole volume the first time) |
+//! | `crop:min:X,Y,Z@F`, `crop:max:X,Y,Z@F` | a corner of the crop box, in the volume's frame |
 //!
 //! e.g. `--script "orbit:30,0@10;zoom:2@20"`.
 
 use anyhow::{bail, Context, Result};
 use dvr_engine::scene::transfer_ref::is_path;
+use dvr_engine::scene::{Cut, MAX_CLIP_PLANES};
 use dvr_engine::session::Edit;
 use dvr_engine::transfer::TransferFunction;
+use glam::DVec3;
 use winit::event::MouseButton;
 use winit::keyboard::{Key as WinitKey, NamedKey};
 
@@ -27,6 +34,8 @@ use winit::keyboard::{Key as WinitKey, NamedKey};
 pub enum Key {
     Reset,
     Fit,
+    /// Every cut off, or back on.
+    Cut,
     Help,
     Screenshot,
     ToggleUi,
@@ -39,6 +48,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("wheel", "zoom"),
     ("R", "reset the camera"),
     ("F", "fly to fit the volume"),
+    ("C", "cuts (clip planes, crop box) off / on"),
     ("H / F1", "this help"),
     ("F12", "screenshot (PNG of the window, EXR of the frame)"),
     ("Tab", "hide / show the panel"),
@@ -60,6 +70,7 @@ impl Key {
         match name.to_ascii_lowercase().as_str() {
             "r" => Some(Key::Reset),
             "f" => Some(Key::Fit),
+            "c" => Some(Key::Cut),
             "h" | "f1" => Some(Key::Help),
             "f12" => Some(Key::Screenshot),
             "tab" => Some(Key::ToggleUi),
@@ -96,6 +107,54 @@ pub enum Command {
     Split(Option<String>),
     /// A transfer function in place of the current one.
     Tf(Box<TransferFunction>),
+    /// An edit of the clip planes or the crop box.
+    Clip(ClipCommand),
+}
+
+/// What a `clip:`/`crop:` script command does (the panel's buttons and sliders).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ClipCommand {
+    AddPlane,
+    Offset(f64),
+    Flip,
+    Crop(bool),
+    CropMin(DVec3),
+    CropMax(DVec3),
+}
+
+impl ClipCommand {
+    /// Applies the command to `cut`; `forward` is where the view looks.
+    pub fn apply(&self, cut: &mut Cut, forward: DVec3) {
+        match *self {
+            ClipCommand::AddPlane if cut.planes.len() < MAX_CLIP_PLANES => {
+                cut.planes.push(super::cut_panel::plane_facing(forward));
+            }
+            ClipCommand::AddPlane => {}
+            ClipCommand::Offset(d) => {
+                if let Some(p) = cut.planes.last_mut() {
+                    p.point += p.normal.normalize_or(DVec3::Z) * d;
+                }
+            }
+            ClipCommand::Flip => {
+                if let Some(p) = cut.planes.last_mut() {
+                    *p = p.flipped();
+                }
+            }
+            ClipCommand::Crop(on) => match &mut cut.crop {
+                Some(c) => c.enabled = on,
+                None if on => cut.crop = Some(super::cut_panel::full_box()),
+                None => {}
+            },
+            ClipCommand::CropMin(v) | ClipCommand::CropMax(v) => {
+                let c = cut.crop.get_or_insert_with(super::cut_panel::full_box);
+                if matches!(self, ClipCommand::CropMin(_)) {
+                    c.min = v.clamp(DVec3::splat(-0.5), c.max);
+                } else {
+                    c.max = v.clamp(c.min, DVec3::splat(0.5));
+                }
+            }
+        }
+    }
 }
 
 /// The session edit a camera command is; `None` for commands that are not the camera's.
@@ -174,8 +233,42 @@ impl Script {
                         .with_context(|| format!("script command {part:?}: bad STEPS"))?,
                 ),
                 "key" => Command::Key(Key::from_name(args.trim()).with_context(|| {
-                    format!("script command {part:?}: unknown key (r, f, h, f12, tab)")
+                    format!("script command {part:?}: unknown key (r, f, c, h, f12, tab)")
                 })?),
+                "clip" => Command::Clip(match args.trim().split_once(':') {
+                    None if args.trim() == "add" => ClipCommand::AddPlane,
+                    None if args.trim() == "flip" => ClipCommand::Flip,
+                    Some(("offset", d)) => ClipCommand::Offset(
+                        d.trim()
+                            .parse()
+                            .ok()
+                            .filter(|d: &f64| d.is_finite())
+                            .with_context(|| format!("script command {part:?}: bad offset"))?,
+                    ),
+                    _ => bail!("script command {part:?}: clip:add, clip:flip or clip:offset:D"),
+                }),
+                "crop" => Command::Clip(match args.trim().split_once(':') {
+                    None if args.trim() == "on" => ClipCommand::Crop(true),
+                    None if args.trim() == "off" => ClipCommand::Crop(false),
+                    Some((corner @ ("min" | "max"), xyz)) => {
+                        let v: Vec<f64> = xyz
+                            .split(',')
+                            .map(|c| c.trim().parse::<f64>())
+                            .collect::<Result<_, _>>()
+                            .ok()
+                            .filter(|v: &Vec<f64>| v.len() == 3 && v.iter().all(|c| c.is_finite()))
+                            .with_context(|| format!("script command {part:?}: needs X,Y,Z"))?;
+                        let v = DVec3::new(v[0], v[1], v[2]);
+                        if corner == "min" {
+                            ClipCommand::CropMin(v)
+                        } else {
+                            ClipCommand::CropMax(v)
+                        }
+                    }
+                    _ => bail!(
+                        "script command {part:?}: crop:on, crop:off, crop:min:X,Y,Z or crop:max:X,Y,Z"
+                    ),
+                }),
                 "denoiser" => Command::Denoiser(args.trim().to_string()),
                 "split" => match args.trim() {
                     "off" | "" => Command::Split(None),
@@ -194,7 +287,7 @@ impl Script {
                 }
                 other => bail!(
                     "script command {part:?}: unknown action {other:?} \
-                     (orbit, pan, zoom, key, denoiser, split, tf)"
+                     (orbit, pan, zoom, key, denoiser, split, tf, clip, crop)"
                 ),
             };
             events.push((frame, command));

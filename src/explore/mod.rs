@@ -23,6 +23,7 @@
 //! what happens to its results; `moving.rs` the rendered size while the view moves;
 //! `ui.rs` the panel that edits the model.
 
+mod cut_panel;
 mod frame;
 mod input;
 mod model;
@@ -204,6 +205,9 @@ struct Explorer {
     /// Frame indices whose results should be saved as F12 screenshots.
     shots: Vec<u64>,
     shot_count: u32,
+    /// Which planes (and whether the crop box) were on when C switched the cuts off.
+    cuts_off: Vec<bool>,
+    crop_off: bool,
     last_screenshot: Option<Screenshot>,
     frame_started: Option<Instant>,
     /// CPU frame intervals, ms, with the divisor each frame was rendered at.
@@ -230,6 +234,7 @@ impl Explorer {
         let model = Model {
             tf: view.tf.a,
             lights: view.lights,
+            cut: view.cut,
             render: setup.settings,
             exposure: PNG_EXPOSURE,
             vsync: !args.no_vsync,
@@ -274,6 +279,8 @@ impl Explorer {
             resized: false,
             shots: Vec::new(),
             shot_count: 0,
+            cuts_off: Vec::new(),
+            crop_off: false,
             last_screenshot: None,
             frame_started: None,
             frame_ms: Vec::new(),

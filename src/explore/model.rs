@@ -52,6 +52,12 @@ impl Explorer {
                 self.model.tf = session.view().tf.a.clone();
             }
         }
+        if self.model.cut != self.applied.cut {
+            if let Err(e) = session.edit(Edit::Cut(self.model.cut.clone())) {
+                self.ui.set_status(e.to_string());
+                self.model.cut = session.view().cut.clone();
+            }
+        }
         if self.model.lights != session.view().lights {
             match session.edit(Edit::Lights(self.model.lights.clone())) {
                 Ok(finished) => done.extend(finished),
@@ -68,6 +74,28 @@ impl Explorer {
         }
         self.applied = self.model.clone();
         Ok(done)
+    }
+
+    /// C: every cut off, or back on (the ones that were on, all when none was).
+    fn toggle_cuts(&mut self) {
+        let cut = &mut self.model.cut;
+        if cut.active() {
+            self.cuts_off = cut.planes.iter().map(|p| p.enabled).collect();
+            self.crop_off = cut.crop.is_some_and(|c| c.enabled);
+            cut.planes.iter_mut().for_each(|p| p.enabled = false);
+            if let Some(c) = &mut cut.crop {
+                c.enabled = false;
+            }
+        } else {
+            let saved = std::mem::take(&mut self.cuts_off);
+            let any = saved.iter().any(|&e| e) || self.crop_off;
+            for (i, p) in cut.planes.iter_mut().enumerate() {
+                p.enabled = !any || saved.get(i).copied().unwrap_or(true);
+            }
+            if let Some(c) = &mut cut.crop {
+                c.enabled = !any || self.crop_off;
+            }
+        }
     }
 
     /// A key or a UI-independent command (from the keyboard, the mouse or the script):
@@ -93,6 +121,11 @@ impl Explorer {
                 self.model.tf = (**tf).clone();
                 self.ui.tf_editor.selected = None;
                 self.ui.tf_editor.dragging = None;
+            }
+            Command::Key(Key::Cut) => self.toggle_cuts(),
+            Command::Clip(c) => {
+                let forward = self.ui.view.map_or(glam::DVec3::Z, |v| v.forward);
+                c.apply(&mut self.model.cut, forward);
             }
             _ => {}
         }

@@ -16,8 +16,8 @@
 use anyhow::{Context, Result};
 use dvr_engine::files::{write_atomic, Durability::Renamed};
 use dvr_engine::scene::{
-    self, BuiltinVolume, CameraKey, CameraSpec, Interpolation, Light, LightKey, Scene, TfKey,
-    TransferSpec, VolumeSource,
+    self, BuiltinVolume, CameraKey, CameraSpec, ClipKey, CropKey, Cut, Interpolation, Light,
+    LightKey, Scene, TfKey, TransferSpec, VolumeSource,
 };
 use dvr_engine::transfer::TransferFunction;
 use std::io::Write;
@@ -28,6 +28,7 @@ use std::path::{Path, PathBuf};
 pub struct FrameState {
     pub camera: CameraSpec,
     pub lights: Vec<Light>,
+    pub cut: Cut,
     /// Index into the recorder's distinct TFs.
     pub tf: usize,
 }
@@ -70,6 +71,7 @@ impl Recorder {
         &mut self,
         camera: CameraSpec,
         lights: &[Light],
+        cut: &Cut,
         tf: &TransferFunction,
         denoiser: &str,
     ) -> Result<()> {
@@ -101,6 +103,16 @@ impl Recorder {
                 "fov_y_degrees": camera.fov_y_degrees,
             },
             "lights": light_json,
+            "clip": cut.planes.iter().map(|p| serde_json::json!({
+                "point": p.point.to_array(),
+                "normal": p.normal.to_array(),
+                "enabled": p.enabled,
+            })).collect::<Vec<_>>(),
+            "crop": cut.crop.map(|c| serde_json::json!({
+                "min": c.min.to_array(),
+                "max": c.max.to_array(),
+                "enabled": c.enabled,
+            })),
             "tf": Self::tf_name(tf_index),
             "denoiser": denoiser,
         });
@@ -108,6 +120,7 @@ impl Recorder {
         self.frames.push(FrameState {
             camera,
             lights: lights.to_vec(),
+            cut: cut.clone(),
             tf: tf_index,
         });
         Ok(())
@@ -151,6 +164,18 @@ pub fn session_scene(
     s.frames = frames.len() as u32;
     s.camera = first.camera;
     s.lights = first.lights.clone();
+    // A crop box that appears during the session is there from the start, switched off
+    // (a scene cannot add one); the plane count is locked while recording.
+    s.cut = first.cut.clone();
+    if s.cut.crop.is_none() {
+        s.cut.crop = frames
+            .iter()
+            .find_map(|f| f.cut.crop)
+            .map(|c| scene::CropBox {
+                enabled: false,
+                ..c
+            });
+    }
     // Pin what the replay must not take from elsewhere: the procedural size and
     // absolute volume paths (the scene lives in another folder).
     if let VolumeSource::Builtin { dataset, size } = &mut s.volume.source {
@@ -181,6 +206,25 @@ pub fn session_scene(
         fov_y_degrees: Some(first.camera.fov_y_degrees),
         interpolation: step,
     });
+    for (index, p) in s.cut.planes.iter().enumerate() {
+        animation.clip.push(ClipKey {
+            index,
+            frame: 0,
+            point: Some(p.point),
+            normal: Some(p.normal),
+            enabled: Some(p.enabled),
+            interpolation: step,
+        });
+    }
+    if let Some(c) = s.cut.crop {
+        animation.crop.push(CropKey {
+            frame: 0,
+            min: Some(c.min),
+            max: Some(c.max),
+            enabled: Some(c.enabled),
+            interpolation: step,
+        });
+    }
     for (index, l) in first.lights.iter().enumerate() {
         animation.light.push(LightKey {
             index,
@@ -217,6 +261,27 @@ pub fn session_scene(
             if key.position.is_some() || key.colour.is_some() || key.intensity.is_some() {
                 animation.light.push(key);
             }
+        }
+        for (index, (a, b)) in prev.cut.planes.iter().zip(&cur.cut.planes).enumerate() {
+            if a != b {
+                animation.clip.push(ClipKey {
+                    index,
+                    frame,
+                    point: Some(b.point),
+                    normal: Some(b.normal),
+                    enabled: Some(b.enabled),
+                    interpolation: step,
+                });
+            }
+        }
+        if let (Some(b), true) = (cur.cut.crop, prev.cut.crop != cur.cut.crop) {
+            animation.crop.push(CropKey {
+                frame,
+                min: Some(b.min),
+                max: Some(b.max),
+                enabled: Some(b.enabled),
+                interpolation: step,
+            });
         }
     }
     // TF: blend 0 until the first edit, 1 from the last.
@@ -262,7 +327,27 @@ mod tests {
         let mut frames = Vec::new();
         let mut cam = cam0;
         let mut lights = b.lights.clone();
+        let mut cut = Cut {
+            planes: vec![scene::ClipPlane {
+                point: DVec3::ZERO,
+                normal: DVec3::Z,
+                enabled: false,
+            }],
+            crop: None,
+        };
         for f in 0..12 {
+            if f == 7 {
+                cut.planes[0].enabled = true;
+            }
+            if f == 8 {
+                cut.planes[0].point.z = 0.1;
+                cut.crop = Some(scene::CropBox {
+                    min: DVec3::splat(-0.4),
+                    max: DVec3::splat(0.3),
+                    units: scene::CropUnits::Box,
+                    enabled: true,
+                });
+            }
             if f == 3 || f == 4 || f == 9 {
                 cam.position += DVec3::new(0.013, -0.02, 0.007);
                 cam.target += DVec3::new(0.001, 0.0, 0.0);
@@ -274,6 +359,7 @@ mod tests {
             frames.push(FrameState {
                 camera: cam,
                 lights: lights.clone(),
+                cut: cut.clone(),
                 tf: 0,
             });
         }
@@ -292,6 +378,14 @@ mod tests {
             let got = s.frame_state(f as u32);
             assert_eq!(got.camera, want.camera.camera(), "camera at frame {f}");
             assert_eq!(got.lights, want.lights, "lights at frame {f}");
+            let cut = s.cut_at(f as u32);
+            assert_eq!(cut.planes, want.cut.planes, "planes at frame {f}");
+            // The crop box appears at frame 8: before, it is there switched off.
+            assert_eq!(
+                cut.crop.filter(|c| c.enabled),
+                want.cut.crop,
+                "crop at frame {f}"
+            );
         }
     }
 
@@ -304,7 +398,8 @@ mod tests {
         let mut rec = Recorder::new(dir.path()).expect("recorder");
         for f in 0..6 {
             let tf = if f < 4 { &b.tf_a } else { &edited };
-            rec.push(b.camera, &b.lights, tf, "ours").expect("push");
+            rec.push(b.camera, &b.lights, &b.cut, tf, "ours")
+                .expect("push");
         }
         let path = rec.finish(&b, 64).expect("finish").expect("a scene");
         let loaded = Scene::load(&path).expect("session.toml loads");

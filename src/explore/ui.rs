@@ -4,6 +4,7 @@
 //! The UI edits a [`Model`]; the frame loop compares it with last frame's copy and turns
 //! differences into renderer inputs (see `mod.rs`). Nothing here touches the GPU.
 
+use super::cut_panel;
 use super::input::SHORTCUTS;
 use super::tf_editor::{self, TfEditor};
 use dvr_engine::denoise::DENOISERS;
@@ -27,6 +28,8 @@ const HISTORY: usize = 120;
 pub struct Model {
     pub tf: TransferFunction,
     pub lights: Vec<Light>,
+    /// The clip planes and crop box.
+    pub cut: scene::Cut,
     pub render: scene::RenderSettings,
     /// Linear scale before the tone map.
     pub exposure: f32,
@@ -99,6 +102,8 @@ pub struct UiState {
     pub recording: bool,
     /// Most samples per pixel the renderer takes in one frame on this device.
     pub max_spp: u32,
+    /// The shown view's camera and rectangle this frame (the cut's outline and "align").
+    pub view: Option<cut_panel::ViewGeometry>,
 }
 
 /// What the UI asks the frame loop to do besides editing the model.
@@ -118,6 +123,7 @@ impl UiState {
             status: None,
             recording: false,
             max_spp: 1,
+            view: None,
         }
     }
 
@@ -159,6 +165,9 @@ pub fn draw(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model) -> UiRequ
                     panel(ui, state, model, &mut requests);
                 });
             });
+    }
+    if let Some(view) = &state.view {
+        cut_panel::draw_outline(ui.ctx(), &model.cut, view);
     }
     if state.show_help {
         help(ui.ctx(), &mut state.show_help);
@@ -219,6 +228,11 @@ fn panel(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model, requests: &m
     egui::CollapsingHeader::new("Lights")
         .default_open(true)
         .show(ui, |ui| lights(ui, state, &mut model.lights));
+    egui::CollapsingHeader::new("Cuts")
+        .default_open(true)
+        .show(ui, |ui| {
+            cut_panel::show(ui, &mut model.cut, state.view.as_ref(), state.recording)
+        });
     egui::CollapsingHeader::new("Render")
         .default_open(true)
         .show(ui, |ui| render_controls(ui, state, model));

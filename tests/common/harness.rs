@@ -152,6 +152,7 @@ impl Harness {
                 camera: self.frame == 0,
                 lights: false,
                 transfer_function: false,
+                cut: false,
             },
             retrace: None,
         };

@@ -133,6 +133,7 @@ pub fn inputs(camera: CameraMatrices, lights: Vec<GpuLight>, lut: LutUpload) -> 
         camera,
         lights,
         lut,
+        cut: Default::default(),
     }
 }
 

@@ -147,11 +147,13 @@ pub struct Changes {
     pub camera: bool,
     pub lights: bool,
     pub transfer_function: bool,
+    /// The clip planes or the crop box.
+    pub cut: bool,
 }
 
 impl Changes {
     pub fn any(&self) -> bool {
-        self.camera || self.lights || self.transfer_function
+        self.camera || self.lights || self.transfer_function || self.cut
     }
 }
 

@@ -300,6 +300,8 @@ pub struct Residency {
     pending: Vec<u32>,
     /// Bricks the current TF makes visible, and how many of them have a slot.
     pub visible_count: usize,
+    /// Bricks uploaded into slots since the pool was made.
+    uploaded: u64,
 }
 
 impl Residency {
@@ -312,6 +314,7 @@ impl Residency {
             visible: Vec::new(),
             pending: Vec::new(),
             visible_count: 0,
+            uploaded: 0,
             layout,
             ranges,
         }
@@ -377,7 +380,14 @@ impl Residency {
             self.brick_in[s as usize] = Some(b);
             self.slot_of[b as usize] = Some(s);
         }
+        self.uploaded += out.len() as u64;
         out
+    }
+
+    /// Bricks uploaded into slots since the pool was made (a brick uploaded again after
+    /// losing its slot counts again).
+    pub fn uploaded(&self) -> u64 {
+        self.uploaded
     }
 
     /// Visible bricks still waiting for a slot's upload.

@@ -3,6 +3,7 @@
 use super::scene_gpu::LutUpload;
 use super::Screenshot;
 use crate::gpu::timestamps::PassTiming;
+use crate::scene::Cut;
 use crate::shaders::frame::GpuLight;
 use glam::{Mat4, Vec3, Vec4};
 
@@ -50,6 +51,8 @@ pub struct FrameInputs {
     pub lights: Vec<GpuLight>,
     /// The transfer function this frame (uploaded only when it differs from the last).
     pub lut: LutUpload,
+    /// The clip planes and crop box.
+    pub cut: Cut,
 }
 
 /// What one frame should produce.

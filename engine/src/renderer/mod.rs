@@ -33,7 +33,7 @@ use crate::scene::RenderSettings;
 use crate::shaders::frame::{FrameBlock, FrameParams, SampleStream, MAX_LIGHTS};
 use ash::vk;
 use brick_pool::{Residency, VolumePath};
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 pub use present::{Overlay, PresentTarget, Screenshot};
 use scene_gpu::{EnvironmentUpload, LutUpload, SceneImages, VolumeUpload};
@@ -88,6 +88,8 @@ pub enum VolumeResidency {
         visible: usize,
         resident: usize,
         pending: usize,
+        /// Bricks uploaded into slots since the renderer was made.
+        uploaded: u64,
     },
 }
 
@@ -168,6 +170,8 @@ pub struct Renderer {
     world_size: [f32; 3],
     lut_size: u32,
     current_lut: Option<LutUpload>,
+    /// The cut the majorants were masked with.
+    current_cut: Option<crate::scene::Cut>,
     /// The largest extinction under `current_lut`.
     majorant_max: f32,
     last_inputs: Option<FrameInputs>,
@@ -289,6 +293,7 @@ impl Renderer {
             over_budget: false,
             lut_size,
             current_lut: None,
+            current_cut: None,
             majorant_max: 0.0,
             last_inputs: None,
             slots,
@@ -387,6 +392,7 @@ impl Renderer {
             .unwrap_or(view_proj);
         let world = Vec3::from(self.world_size);
         let voxel = (world / Vec3::from(self.volume_dims.map(|d| d as f32))).min_element();
+        let (crop, clip) = cut_uniforms(&inputs.cut, world, self.volume_dims);
         FrameBlock::new(&FrameParams {
             view_proj,
             prev_view_proj,
@@ -405,6 +411,8 @@ impl Renderer {
             feature_threshold: s.feature_threshold() as f32,
             filter_sigma: s.filter_sigma() as f32,
             seed: s.seed(),
+            crop,
+            clip: &clip,
         })
     }
 
@@ -446,7 +454,7 @@ impl Renderer {
         let mut frame = Frame::new();
 
         // Scene state: the TF (only when it changed) and this frame's uniforms.
-        let majorant_max = self.upload_transfer_function(&mut frame, slot, &inputs.lut, true)?;
+        let majorant_max = self.upload_transfer_function(&mut frame, slot, inputs, true)?;
         let block = self.frame_block(inputs, majorant_max, SampleStream::Frame(self.frame_index));
         let scene = self.write_uniforms(slot, &block)?;
         let (ctx, graph, passes, size) =
@@ -488,7 +496,7 @@ impl Renderer {
         let retrace = match &self.last_inputs {
             Some(last)
                 if noisy.radiance_history.valid
-                    && (changes.lights || changes.transfer_function) =>
+                    && (changes.lights || changes.transfer_function || changes.cut) =>
             {
                 Some(Retrace {
                     scene,
@@ -572,18 +580,20 @@ impl Renderer {
         Ok(completed)
     }
 
-    /// Adds uploads of the TF LUTs and the majorant grid when the TF differs from the one
-    /// on the device, and on the pool path the bricks it makes visible and the brick
-    /// table; returns the largest extinction (the global majorant). `stream`: a frame
-    /// uploads at most [`brick_pool::STREAM_PER_FRAME`] bricks after the first frame; a
-    /// reference (`false`) waits for them all.
+    /// Adds uploads of the TF LUTs and the majorant grid when the TF or the cut differs
+    /// from the one on the device (bricks a cut removes whole get majorant 0), and on
+    /// the pool path the bricks they make visible and the brick table; returns the
+    /// largest extinction (the global majorant). `stream`: a frame uploads at most
+    /// [`brick_pool::STREAM_PER_FRAME`] bricks after the first frame; a reference
+    /// (`false`) waits for them all.
     fn upload_transfer_function(
         &mut self,
         frame: &mut Frame,
         slot: usize,
-        lut: &LutUpload,
+        inputs: &FrameInputs,
         stream: bool,
     ) -> Result<f32> {
+        let (lut, cut) = (&inputs.lut, &inputs.cut);
         if lut.diffuse_opacity.len() != self.lut_size as usize {
             return Err(EngineError::Resource {
                 resource: "transfer function".into(),
@@ -595,10 +605,12 @@ impl Renderer {
             });
         }
         let first = self.current_lut.is_none();
-        if self.current_lut.as_ref() != Some(lut) {
+        if self.current_lut.as_ref() != Some(lut) || self.current_cut.as_ref() != Some(cut) {
             let opacity: Vec<f32> = lut.diffuse_opacity.iter().map(|c| c[3]).collect();
             let scale = self.config.density_scale;
-            let majorants = scene_gpu::majorants(&self.bricks, &opacity, scale);
+            let (dims, world) = (self.volume_dims, self.world_size);
+            let mut majorants = scene_gpu::majorants(&self.bricks, &opacity, scale);
+            scene_gpu::mask_cut(&mut majorants, &self.bricks, dims, world, cut);
             self.majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
             let (ctx, graph) = (&self.ctx, &mut self.graph);
             let [a, b, c] = self.scene.tf;
@@ -623,7 +635,8 @@ impl Renderer {
                 scene_gpu::add_frame_upload(ctx, graph, frame, name, slot, image, bytes)?;
             }
             if let Some(r) = &mut self.residency {
-                let pool_majorants = scene_gpu::majorants(r.ranges(), &opacity, scale);
+                let mut pool_majorants = scene_gpu::majorants(r.ranges(), &opacity, scale);
+                scene_gpu::mask_cut(&mut pool_majorants, r.ranges(), dims, world, cut);
                 self.table_dirty |= r.set_transfer_function(&pool_majorants);
                 let slots = r.layout.slot_count();
                 // Said once each time the TF goes past the pool (not on every edit while
@@ -640,6 +653,7 @@ impl Renderer {
                 self.over_budget = over;
             }
             self.current_lut = Some(lut.clone());
+            self.current_cut = Some(cut.clone());
         }
         self.upload_bricks(frame, slot, first || !stream)?;
         if first && self.residency.is_some() {
@@ -715,6 +729,7 @@ impl Renderer {
                 visible: r.visible_count,
                 resident: r.resident_visible(),
                 pending: r.pending(),
+                uploaded: r.uploaded(),
             },
         }
     }
@@ -744,11 +759,13 @@ impl Renderer {
                 camera: true,
                 lights: true,
                 transfer_function: true,
+                cut: true,
             },
             Some(last) => Changes {
                 camera: reset || last.camera != inputs.camera,
                 lights: reset || last.lights != inputs.lights,
                 transfer_function: reset || last.lut != inputs.lut,
+                cut: reset || last.cut != inputs.cut,
             },
         }
     }
@@ -791,6 +808,30 @@ impl Renderer {
         out.sort_by_key(|r| r.index);
         Ok(out)
     }
+}
+
+/// The frame block's cut: the crop box in world space, clamped to the volume's box
+/// (which it is when nothing is cropped), and the enabled clip planes as (unit normal,
+/// offset). A crop box equal to the volume's bounds gives the box's own numbers.
+fn cut_uniforms(cut: &crate::scene::Cut, world: Vec3, dims: [u32; 3]) -> ((Vec3, Vec3), Vec<Vec4>) {
+    let half = world * 0.5;
+    let (mut lo, mut hi) = (-half, half);
+    if let Some(c) = cut.crop.filter(|c| c.enabled) {
+        let (min, max) = c.in_box_frame(dims);
+        let w = world.as_dvec3();
+        lo = lo.max((min * w).as_vec3());
+        hi = hi.min((max * w).as_vec3());
+    }
+    let planes = cut
+        .planes
+        .iter()
+        .filter(|p| p.enabled)
+        .map(|p| {
+            let (n, w) = p.equation();
+            n.as_vec3().extend(w as f32)
+        })
+        .collect();
+    ((lo, hi), planes)
 }
 
 /// Samples per pixel one frame of `size` may take on this device: at least 1 (the

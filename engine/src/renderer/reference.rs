@@ -61,7 +61,7 @@ impl Renderer {
         while done < spp {
             let n = batch.min(spp - done);
             let mut frame = Frame::new();
-            let majorant_max = self.upload_transfer_function(&mut frame, 0, &inputs.lut, false)?;
+            let majorant_max = self.upload_transfer_function(&mut frame, 0, inputs, false)?;
             let stream = SampleStream::Reference {
                 after_frames: self.frame_index,
             };

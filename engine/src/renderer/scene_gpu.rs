@@ -461,6 +461,39 @@ pub fn majorants(bricks: &BrickRanges, opacity: &[f32], density_scale: f32) -> V
         .collect()
 }
 
+/// Zeroes the majorant of every brick that one cut removes whole (see
+/// [`Cut::removes`]), for a volume of `dims` voxels spanning `world` units: the majorant
+/// grid then skips it, and the brick pool does not make it resident.
+pub fn mask_cut(
+    majorants: &mut [f32],
+    bricks: &BrickRanges,
+    dims: [u32; 3],
+    world: [f32; 3],
+    cut: &crate::scene::Cut,
+) {
+    if !cut.active() {
+        return;
+    }
+    let world = glam::Vec3::from(world).as_dvec3();
+    let voxel = world / glam::DVec3::from(dims.map(f64::from));
+    let [gx, gy, _] = bricks.grid;
+    let edge = f64::from(bricks.brick);
+    for (i, m) in majorants.iter_mut().enumerate() {
+        let i = i as u32;
+        let cell = glam::DVec3::new(
+            f64::from(i % gx),
+            f64::from((i / gx) % gy),
+            f64::from(i / (gx * gy)),
+        );
+        // The brick's voxels, widened by one for trilinear reads across its faces.
+        let lo = (cell * edge - 1.0) * voxel - world * 0.5;
+        let hi = ((cell + 1.0) * edge + 1.0) * voxel - world * 0.5;
+        if cut.removes(lo, hi, world, dims) {
+            *m = 0.0;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

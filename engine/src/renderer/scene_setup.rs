@@ -123,7 +123,10 @@ impl SceneSetup {
 /// The renderer's inputs for a view whose TF state gives `lut` ([`crate::scene::TfState::lut`],
 /// passed in so a session computes it once per TF edit), at `aspect` (width / height).
 pub fn inputs_for_view(view: &View, aspect: f32, lut: &TfLut) -> FrameInputs {
-    inputs_for(&view.camera.camera(), aspect, &view.lights, lut)
+    FrameInputs {
+        cut: view.cut.clone(),
+        ..inputs_for(&view.camera.camera(), aspect, &view.lights, lut)
+    }
 }
 
 /// The renderer's inputs for a camera, lights and a TF: the one place scene state
@@ -134,6 +137,7 @@ pub fn inputs_for(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -
         camera: CameraMatrices::look_at(c.position, c.target, c.up, c.fov_y, aspect),
         lights: lights.iter().map(gpu_light).collect(),
         lut: LutUpload::from(lut),
+        cut: Default::default(),
     }
 }
 

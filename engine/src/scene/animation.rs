@@ -33,6 +33,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use super::camera::{check_fov, CameraSpec, MAX_CAMERA_DISTANCE};
+use super::cut::{ClipKey, CropKey, Cut};
 use super::error::{Ctx, SceneError};
 use super::light::{check_intensity, check_position, Light};
 
@@ -51,7 +52,7 @@ pub enum Interpolation {
 }
 
 impl Interpolation {
-    fn is_linear(&self) -> bool {
+    pub(crate) fn is_linear(&self) -> bool {
         *self == Self::Linear
     }
 }
@@ -161,6 +162,10 @@ pub struct Animation {
     pub orbit: Option<Orbit>,
     pub light: Vec<LightKey>,
     pub tf: Vec<TfKey>,
+    /// `[[animation.clip]]`: keyframes of the clip planes (see [`super::cut`]).
+    pub clip: Vec<ClipKey>,
+    /// `[[animation.crop]]`: keyframes of the crop box.
+    pub crop: Vec<CropKey>,
 }
 
 /// `[animation]` as written.
@@ -177,6 +182,10 @@ pub(crate) struct AnimationFile {
     light: Vec<LightKey>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     tf: Vec<TfKey>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    clip: Vec<ClipKey>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    crop: Vec<CropKey>,
 }
 
 fn default_frames() -> u32 {
@@ -191,6 +200,8 @@ impl Default for AnimationFile {
             camera: Vec::new(),
             light: Vec::new(),
             tf: Vec::new(),
+            clip: Vec::new(),
+            crop: Vec::new(),
         }
     }
 }
@@ -202,6 +213,8 @@ impl AnimationFile {
             orbit: self.orbit,
             light: self.light,
             tf: self.tf,
+            clip: self.clip,
+            crop: self.crop,
         };
         (self.frames, a)
     }
@@ -213,6 +226,8 @@ impl AnimationFile {
             camera: a.camera.clone(),
             light: a.light.clone(),
             tf: a.tf.clone(),
+            clip: a.clip.clone(),
+            crop: a.crop.clone(),
         }
     }
 }
@@ -237,6 +252,8 @@ impl Animation {
         a.camera.iter_mut().for_each(|k| k.frame = f(k.frame));
         a.light.iter_mut().for_each(|k| k.frame = f(k.frame));
         a.tf.iter_mut().for_each(|k| k.frame = f(k.frame));
+        a.clip.iter_mut().for_each(|k| k.frame = f(k.frame));
+        a.crop.iter_mut().for_each(|k| k.frame = f(k.frame));
         a
     }
 
@@ -278,9 +295,21 @@ impl Animation {
                 return duplicate("tf", i, j, k.frame);
             }
         }
+        for (j, k) in self.clip.iter().enumerate() {
+            let same = |o: &ClipKey| o.frame == k.frame && o.index == k.index;
+            if let Some(i) = self.clip[..j].iter().position(same) {
+                return duplicate("clip", i, j, k.frame);
+            }
+        }
+        for (j, k) in self.crop.iter().enumerate() {
+            if let Some(i) = self.crop[..j].iter().position(|o| o.frame == k.frame) {
+                return duplicate("crop", i, j, k.frame);
+            }
+        }
         Ok(())
     }
 
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn check(
         &self,
         ctx: &Ctx,
@@ -288,6 +317,7 @@ impl Animation {
         camera: &CameraSpec,
         lights: &[Light],
         has_tf_b: bool,
+        cut: &Cut,
     ) -> Result<(), SceneError> {
         if frames == 0 {
             return Err(ctx.invalid("animation.frames", "must be at least 1"));
@@ -438,6 +468,76 @@ impl Animation {
                 }
             }
         }
+        self.check_cut(ctx, &frame_ok, cut)
+    }
+
+    /// The clip and crop keyframes: each names a plane (or the crop box) the scene
+    /// has, its values are checked as the plane's or box's own, and consecutive normals
+    /// of one plane are never opposite (the interpolated normal would pass through
+    /// zero).
+    fn check_cut(
+        &self,
+        ctx: &Ctx,
+        frame_ok: &dyn Fn(String, u32) -> Result<(), SceneError>,
+        cut: &Cut,
+    ) -> Result<(), SceneError> {
+        for (i, k) in self.clip.iter().enumerate() {
+            let field = |name: &str| format!("animation.clip[{i}].{name}");
+            let plane = cut.planes.get(k.index).ok_or_else(|| {
+                ctx.invalid(
+                    field("index"),
+                    format!(
+                        "clip plane {} does not exist (the scene has {} [[clip]])",
+                        k.index,
+                        cut.planes.len()
+                    ),
+                )
+            })?;
+            frame_ok(field("frame"), k.frame)?;
+            super::cut::ClipPlane {
+                point: k.point.unwrap_or(plane.point),
+                normal: k.normal.unwrap_or(plane.normal),
+                enabled: true,
+            }
+            .check(ctx, &format!("animation.clip[{i}]"))?;
+        }
+        for index in 0..cut.planes.len() {
+            let mut normals: Vec<(u32, DVec3)> = std::iter::once((0, cut.planes[index].normal))
+                .chain(
+                    self.clip
+                        .iter()
+                        .filter(|k| k.index == index)
+                        .filter_map(|k| Some((k.frame, k.normal?))),
+                )
+                .collect();
+            normals.sort_by_key(|n| n.0);
+            for w in normals.windows(2) {
+                let (a, b) = (w[0].1.normalize(), w[1].1.normalize());
+                if (a + b).length() < 1e-6 {
+                    return Err(ctx.invalid(
+                        format!("animation.clip (plane {index}, frame {})", w[1].0),
+                        "the normal turns half a circle between two keyframes, through zero \
+                         (add a keyframe in between)",
+                    ));
+                }
+            }
+        }
+        if !self.crop.is_empty() {
+            let Some(crop) = cut.crop else {
+                return Err(
+                    ctx.invalid("animation.crop", "crop keyframes need a [crop] box at rest")
+                );
+            };
+            for (i, k) in self.crop.iter().enumerate() {
+                frame_ok(format!("animation.crop[{i}].frame"), k.frame)?;
+                super::cut::CropBox {
+                    min: k.min.unwrap_or(crop.min),
+                    max: k.max.unwrap_or(crop.max),
+                    ..crop
+                }
+                .check(ctx, &format!("animation.crop[{i}]"))?;
+            }
+        }
         Ok(())
     }
 }
@@ -456,6 +556,17 @@ impl Lerp for f64 {
 impl Lerp for DVec3 {
     fn lerp(a: Self, b: Self, t: f64) -> Self {
         a * (1.0 - t) + b * t
+    }
+}
+
+/// A switch holds its value until the keyframe that changes it.
+impl Lerp for bool {
+    fn lerp(a: Self, b: Self, t: f64) -> Self {
+        if t >= 1.0 {
+            b
+        } else {
+            a
+        }
     }
 }
 

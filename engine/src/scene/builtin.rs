@@ -338,6 +338,7 @@ pub(crate) fn build(name: &str) -> Result<Scene, SceneError> {
                 .map_err(|e| ctx.invalid("render.max_bounces", e.to_string()))?;
             r
         },
+        cut: Default::default(),
         frames: DEFAULT_FRAMES,
         animation,
     };

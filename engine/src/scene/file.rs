@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::animation::AnimationFile;
 use super::camera::CameraSpec;
+use super::cut::{ClipPlane, CropBox, Cut};
 use super::error::{Ctx, SceneError};
 use super::light::LightFile;
 use super::render::RenderSettings;
@@ -35,6 +36,10 @@ struct SceneFile {
     lights: Vec<LightFile>,
     #[serde(default)]
     render: RenderSettings,
+    #[serde(default, rename = "clip", skip_serializing_if = "Vec::is_empty")]
+    clip: Vec<ClipPlane>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    crop: Option<CropBox>,
     #[serde(default)]
     animation: AnimationFile,
 }
@@ -61,6 +66,10 @@ pub(crate) fn parse(text: &str, origin: &str, base: Option<&Path>) -> Result<Sce
         camera: file.camera,
         lights,
         render: file.render,
+        cut: Cut {
+            planes: file.clip,
+            crop: file.crop,
+        },
         frames,
         animation,
     };
@@ -84,6 +93,8 @@ pub(crate) fn write(scene: &Scene) -> Result<String, SceneError> {
         camera: scene.camera,
         lights: scene.lights.iter().map(LightFile::from_light).collect(),
         render: scene.render,
+        clip: scene.cut.planes.clone(),
+        crop: scene.cut.crop,
         animation: AnimationFile::join(scene.frames, &scene.animation),
     };
     let body = toml::to_string(&file).map_err(|source| SceneError::Serialize {

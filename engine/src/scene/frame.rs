@@ -8,6 +8,7 @@
 
 use super::animation::{sample, Interpolation, Lerp};
 use super::camera::{Camera, CameraSpec};
+use super::cut::Cut;
 use super::light::Light;
 use super::Scene;
 
@@ -119,6 +120,50 @@ impl Scene {
             )
             .clamp(-1.0, 1.0) as f32,
         }
+    }
+
+    /// The clip planes and crop box at `frame`, after their keyframes.
+    pub fn cut_at(&self, frame: u32) -> Cut {
+        let f = self.clamp_frame(frame);
+        let anim = &self.animation;
+        let mut cut = self.cut.clone();
+        for (i, plane) in cut.planes.iter_mut().enumerate() {
+            let keys = || anim.clip.iter().filter(move |k| k.index == i);
+            plane.point = track(
+                plane.point,
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.point?))),
+                f,
+            );
+            plane.normal = track(
+                plane.normal,
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.normal?))),
+                f,
+            );
+            plane.enabled = track(
+                plane.enabled,
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.enabled?))),
+                f,
+            );
+        }
+        if let Some(crop) = &mut cut.crop {
+            let keys = || anim.crop.iter();
+            crop.min = track(
+                crop.min,
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.min?))),
+                f,
+            );
+            crop.max = track(
+                crop.max,
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.max?))),
+                f,
+            );
+            crop.enabled = track(
+                crop.enabled,
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.enabled?))),
+                f,
+            );
+        }
+        cut
     }
 
     /// The camera (as written: f64, degrees) at `frame`, after keyframes and orbit.

@@ -38,6 +38,7 @@
 pub mod animation;
 pub mod builtin;
 pub mod camera;
+pub mod cut;
 pub mod error;
 mod file;
 pub mod frame;
@@ -55,6 +56,7 @@ use std::path::Path;
 pub use crate::bytes::parse_memory_size;
 pub use animation::{Animation, CameraKey, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES};
 pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR, MAX_CAMERA_DISTANCE};
+pub use cut::{ClipKey, ClipPlane, CropBox, CropKey, CropUnits, Cut, MAX_CLIP_PLANES};
 pub use error::SceneError;
 pub use frame::{changed, Change, FrameState};
 pub use light::{
@@ -86,6 +88,9 @@ pub struct Scene {
     /// The lights at rest, in file order (animation keys refer to these indices).
     pub lights: Vec<Light>,
     pub render: RenderSettings,
+    /// The clip planes and crop box at rest (`[[clip]]`, `[crop]`); animation may
+    /// override them per frame.
+    pub cut: Cut,
     /// Number of frames in the scripted sequence (>= 1).
     pub frames: u32,
     pub animation: Animation,
@@ -214,6 +219,7 @@ impl Scene {
         }
         self.camera.check(ctx, "camera")?;
         light::check_lights(ctx, &self.lights, self.render.emission())?;
+        self.cut.check(ctx)?;
         self.render.check(ctx)?;
         self.animation.check(
             ctx,
@@ -221,7 +227,15 @@ impl Scene {
             &self.camera,
             &self.lights,
             self.tf_b.is_some(),
+            &self.cut,
         )?;
+        // The crop box where keyframes put it (corners interpolate linearly, so a box
+        // valid at its keyframes is valid between them).
+        for (i, k) in self.animation.crop.iter().enumerate() {
+            if let Some(crop) = self.cut_at(k.frame).crop {
+                crop.check(ctx, &format!("animation.crop[{i}]"))?;
+            }
+        }
         // The camera must be well defined where keyframes put it, and in between.
         for (i, k) in self.animation.camera.iter().enumerate() {
             self.camera_at(k.frame)

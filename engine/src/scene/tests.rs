@@ -272,7 +272,13 @@ fn example_scene_uses_every_section() {
         !s.animation.camera.is_empty()
             && !s.animation.light.is_empty()
             && !s.animation.tf.is_empty()
+            && !s.animation.clip.is_empty()
+            && !s.animation.crop.is_empty()
     );
+    // The clip plane switches on at frame 45; the crop box closes in by the last frame.
+    assert!(!s.cut_at(44).planes[0].enabled);
+    assert!(s.cut_at(45).planes[0].enabled);
+    assert_eq!(s.cut_at(59).crop.map(|c| c.min.y), Some(-0.2));
     // The key light jumps at frame 30 (step keyframe).
     let p = |f| s.frame_state(f).lights[0].position().expect("point");
     assert_eq!(p(29), DVec3::new(-0.9, 1.1, 1.0));
@@ -686,4 +692,101 @@ fn long_names_are_refused_when_the_scene_loads() {
         msg.contains("name") && msg.contains("5000 bytes") && msg.len() < 300,
         "{msg}"
     );
+}
+
+const CUT: &str = r#"
+[[clip]]
+point = [0.0, 0.0, 0.1]
+normal = [0.0, 0.0, 2.0]
+
+[[clip]]
+point = [0.2, 0.0, 0.0]
+normal = [-1.0, 0.0, 0.0]
+enabled = false
+
+[crop]
+min = [-0.5, -0.4, -0.5]
+max = [0.5, 0.4, 0.3]
+
+[[animation.clip]]
+index = 0
+frame = 9
+point = [0.0, 0.0, -0.3]
+normal = [0.0, 1.0, 1.0]
+
+[[animation.clip]]
+index = 1
+frame = 5
+enabled = true
+
+[[animation.crop]]
+frame = 9
+max = [0.5, 0.4, 0.5]
+"#;
+
+#[test]
+fn cuts_read_animate_and_round_trip() {
+    let text = format!("{MINIMAL}{CUT}");
+    let s = Scene::from_toml_str(&text, "cut.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.cut.planes.len(), 2);
+    assert!(s.cut.planes[0].enabled && !s.cut.planes[1].enabled);
+    assert_eq!(s.cut.crop.map(|c| c.units), Some(CropUnits::Box));
+    // Points and corners interpolate; the normal is blended (the renderer normalises
+    // it); enabled switches at its keyframe.
+    let mid = s.cut_at(4);
+    assert!((mid.planes[0].point.z - (0.1 - 0.4 * 4.0 / 9.0)).abs() < 1e-12);
+    assert!(!mid.planes[1].enabled && s.cut_at(5).planes[1].enabled);
+    assert!((s.cut_at(9).crop.expect("crop").max.z - 0.5).abs() < 1e-12);
+    assert_eq!(s.view_at(3).cut, s.cut_at(3));
+    let back = Scene::from_toml_str(&s.to_toml().expect("toml"), "back").expect("reads back");
+    assert_eq!(back.cut, s.cut);
+    assert_eq!(back.animation, s.animation);
+    // Resampled, keyframes move with the rest of the animation.
+    let long = s.with_frames(19).expect("resample");
+    assert_eq!(long.animation.clip[0].frame, 18);
+}
+
+#[test]
+fn bad_cuts_are_errors_naming_the_field() {
+    let plane = |p: &str, n: &str| format!("{MINIMAL}[[clip]]\npoint = {p}\nnormal = {n}\n");
+    for (text, needle) in [
+        (plane("[0.0, 0.0, 0.0]", "[0.0, 0.0, 0.0]"), "clip[0].normal"),
+        (plane("[0.0, nan, 0.0]", "[0.0, 0.0, 1.0]"), "clip[0].point"),
+        (plane("[0.0, 0.0]", "[0.0, 0.0, 1.0]"), "invalid length"),
+        (
+            format!("{MINIMAL}[crop]\nmin = [0.2, 0.0, 0.0]\nmax = [0.1, 0.3, 0.3]\n"),
+            "crop.min",
+        ),
+        (
+            format!("{MINIMAL}[crop]\nmin = [-0.6, 0.0, 0.0]\nmax = [0.1, 0.3, 0.3]\n"),
+            "outside the volume's frame",
+        ),
+        (
+            format!("{MINIMAL}[crop]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\nunits = \"inches\"\n"),
+            "unknown variant",
+        ),
+        (
+            format!("{MINIMAL}{}", "[[clip]]\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n".repeat(7)),
+            "at most 6",
+        ),
+        (
+            format!("{}[[animation.clip]]\nindex = 1\nframe = 3\nenabled = false\n", plane("[0.0, 0.0, 0.0]", "[0.0, 0.0, 1.0]")),
+            "animation.clip[0].index",
+        ),
+        (
+            format!("{MINIMAL}[[animation.crop]]\nframe = 3\nenabled = false\n"),
+            "need a [crop] box",
+        ),
+        (
+            format!("{}[[animation.clip]]\nindex = 0\nframe = 3\nnormal = [0.0, 0.0, -1.0]\n", plane("[0.0, 0.0, 0.0]", "[0.0, 0.0, 1.0]")),
+            "half a circle",
+        ),
+        (
+            format!("{MINIMAL}[crop]\nmin = [0.0, 0.0, 0.0]\nmax = [0.1, 0.3, 0.3]\n[[animation.crop]]\nframe = 4\nmin = [0.2, 0.0, 0.0]\n"),
+            "greater than max.x",
+        ),
+    ] {
+        let e = parse_err(&text);
+        assert!(e.starts_with("bad.toml") && e.contains(needle), "{needle}: {e}");
+    }
 }

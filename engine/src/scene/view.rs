@@ -8,6 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::camera::CameraSpec;
+use super::cut::{ClipPlane, CropBox, Cut};
 use super::error::{Ctx, SceneError};
 use super::light::{check_lights, Light, LightFile};
 use super::render::RenderSettings;
@@ -52,12 +53,14 @@ impl TfState {
     }
 }
 
-/// One view: what the renderer turns into a frame's camera, lights and LUTs.
+/// One view: what the renderer turns into a frame's camera, lights, LUTs and cut.
 #[derive(Debug, Clone, PartialEq)]
 pub struct View {
     pub camera: CameraSpec,
     pub lights: Vec<Light>,
     pub tf: TfState,
+    /// The clip planes and crop box.
+    pub cut: Cut,
 }
 
 impl Scene {
@@ -75,16 +78,18 @@ impl Scene {
                 blend: state.tf_blend,
                 shift: state.tf_shift,
             },
+            cut: self.cut_at(frame),
         }
     }
 }
 
-/// The camera, lights and render settings of one view.
+/// The camera, lights, render settings and cut of one view.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ViewSections {
     pub camera: CameraSpec,
     pub lights: Vec<Light>,
     pub render: RenderSettings,
+    pub cut: Cut,
 }
 
 /// The sections as written.
@@ -96,6 +101,10 @@ struct ViewFile {
     lights: Vec<LightFile>,
     #[serde(default)]
     render: RenderSettings,
+    #[serde(default, rename = "clip", skip_serializing_if = "Vec::is_empty")]
+    clip: Vec<ClipPlane>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    crop: Option<CropBox>,
 }
 
 impl ViewSections {
@@ -113,6 +122,10 @@ impl ViewSections {
             camera: file.camera,
             lights,
             render: file.render,
+            cut: Cut {
+                planes: file.clip,
+                crop: file.crop,
+            },
         };
         view.check(origin)?;
         Ok(view)
@@ -124,6 +137,8 @@ impl ViewSections {
             camera: self.camera,
             lights: self.lights.iter().map(LightFile::from_light).collect(),
             render: self.render,
+            clip: self.cut.planes.clone(),
+            crop: self.cut.crop,
         };
         toml::to_string(&file).map_err(|source| SceneError::Serialize {
             name: "view".into(),
@@ -137,6 +152,7 @@ impl ViewSections {
         let ctx = Ctx { origin, base: None };
         self.camera.check(&ctx, "camera")?;
         check_lights(&ctx, &self.lights, self.render.emission())?;
+        self.cut.check(&ctx)?;
         self.render.check(&ctx)
     }
 }
@@ -149,6 +165,11 @@ pub fn check_camera_spec(camera: &CameraSpec, origin: &str) -> Result<(), SceneE
 /// Lights as `[[light]]` are checked (with or without the TF's emission).
 pub fn check_light_list(lights: &[Light], emission: bool, origin: &str) -> Result<(), SceneError> {
     check_lights(&Ctx { origin, base: None }, lights, emission)
+}
+
+/// Clip planes and a crop box as `[[clip]]` and `[crop]` are checked.
+pub fn check_cut(cut: &Cut, origin: &str) -> Result<(), SceneError> {
+    cut.check(&Ctx { origin, base: None })
 }
 
 /// Render settings as `[render]` is checked.
@@ -168,6 +189,19 @@ mod tests {
             camera: scene.camera,
             lights: scene.lights.clone(),
             render: scene.render,
+            cut: Cut {
+                planes: vec![ClipPlane {
+                    point: glam::DVec3::new(0.0, 0.0, 0.1),
+                    normal: glam::DVec3::new(0.0, 1.0, 1.0),
+                    enabled: false,
+                }],
+                crop: Some(CropBox {
+                    min: glam::DVec3::splat(-0.4),
+                    max: glam::DVec3::splat(0.3),
+                    units: crate::scene::CropUnits::Box,
+                    enabled: true,
+                }),
+            },
         };
         let text = view.to_toml().expect("toml");
         assert_eq!(

@@ -27,9 +27,9 @@ use crate::gpu::GpuContext;
 use crate::graph::Extent;
 use crate::renderer::scene_setup::{inputs_for_view, load_environment, SceneSetup, SetupError};
 use crate::renderer::{FrameRequest, FrameResult, PresentTarget, Renderer, SettingsChange};
-use crate::scene::view::{check_camera_spec, check_light_list, check_render};
+use crate::scene::view::{check_camera_spec, check_cut, check_light_list, check_render};
 use crate::scene::{
-    CameraSpec, EnvSource, Light, RenderSettings, Scene, SceneError, TfState, View,
+    CameraSpec, Cut, EnvSource, Light, RenderSettings, Scene, SceneError, TfState, View,
 };
 use crate::transfer::TfLut;
 use std::path::PathBuf;
@@ -76,6 +76,9 @@ pub enum Edit {
     Lights(Vec<Light>),
     /// The transfer function (a single one: [`TfState::single`]).
     Tf(TfState),
+    /// The clip planes and crop box (the renderer re-traces ours' gradients under the
+    /// change, as for a TF edit).
+    Cut(Cut),
     /// Render settings (checked; every history restarts).
     Settings(RenderSettings),
     /// The denoisers, by registry name (fresh histories).
@@ -206,6 +209,10 @@ impl Session {
                 }
                 self.set_tf(tf);
             }
+            Edit::Cut(cut) => {
+                check_cut(&cut, EDIT_ORIGIN)?;
+                self.view.cut = cut;
+            }
             Edit::Settings(settings) => return self.set_settings(settings),
             Edit::Denoisers(names) => {
                 let names: Vec<&str> = names.iter().map(String::as_str).collect();
@@ -229,6 +236,7 @@ impl Session {
         let view = self.setup.scene.view_at(frame);
         self.orbit.set_spec(&view.camera);
         self.view.camera = view.camera;
+        self.view.cut = view.cut;
         self.set_tf(view.tf);
         // The scene's lights were checked with the scene, every frame's values too.
         self.set_lights(view.lights)

@@ -25,6 +25,8 @@ glsl_defines! {
     "frame.glsl" {
         /// Lights the frame block holds.
         MAX_LIGHTS: usize = 4,
+        /// Clip planes the frame block holds.
+        MAX_CLIP_PLANES: usize = 6,
         /// `GpuLight::position_kind.w`: what the light is.
         LIGHT_POINT: f32 = 0.0,
         LIGHT_AREA: f32 = 1.0,
@@ -75,6 +77,11 @@ gpu_block! {
         pub params: Vec4,
         pub seeds: UVec4,
         pub lights: [GpuLight; MAX_LIGHTS],
+        /// What the cut keeps: the crop box in world space (within the volume's box).
+        pub crop_min: Vec4,
+        pub crop_max: Vec4,
+        /// `counts.z` planes: xyz unit normal, w offset (kept where `n·x + w >= 0`).
+        pub clip: [Vec4; MAX_CLIP_PLANES],
     }
 }
 
@@ -130,6 +137,11 @@ pub struct FrameParams<'a> {
     /// Standard deviation of the Gaussian pixel filter, in pixels.
     pub filter_sigma: f32,
     pub seed: u32,
+    /// The crop box in world space, within the volume's box (the box itself when
+    /// nothing is cropped).
+    pub crop: (Vec3, Vec3),
+    /// Enabled clip planes (xyz unit normal, w offset), at most [`MAX_CLIP_PLANES`].
+    pub clip: &'a [Vec4],
 }
 
 impl FrameBlock {
@@ -141,6 +153,10 @@ impl FrameBlock {
             *dst = *src;
         }
         let [x, y, z] = p.volume_dims.map(|d| d as i32);
+        let mut clip = [Vec4::ZERO; MAX_CLIP_PLANES];
+        for (dst, src) in clip.iter_mut().zip(p.clip) {
+            *dst = *src;
+        }
         Self {
             view_proj: p.view_proj,
             inv_view_proj: p.view_proj.inverse(),
@@ -152,12 +168,15 @@ impl FrameBlock {
             counts: IVec4::new(
                 p.lights.len().min(MAX_LIGHTS) as i32,
                 p.stream.index(),
-                0,
+                p.clip.len().min(MAX_CLIP_PLANES) as i32,
                 p.max_bounces as i32,
             ),
             params: Vec4::new(p.step, p.hg_g, p.feature_threshold, p.filter_sigma),
             seeds: UVec4::new(p.seed, 0, p.rr_depth, 0),
             lights,
+            crop_min: p.crop.0.extend(0.0),
+            crop_max: p.crop.1.extend(0.0),
+            clip,
         }
     }
 }
@@ -166,7 +185,7 @@ impl FrameBlock {
 pub const FRAME_BLOCK: &str = "FrameBlock";
 
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 64);
-const _: () = assert!(<FrameBlock as GpuBlock>::FIELDS.len() == 11);
+const _: () = assert!(<FrameBlock as GpuBlock>::FIELDS.len() == 14);
 
 #[cfg(test)]
 mod tests {
@@ -259,8 +278,13 @@ mod tests {
             feature_threshold: 0.5,
             filter_sigma: 0.5,
             seed: 11,
+            crop: (Vec3::splat(-0.25), Vec3::splat(0.5)),
+            clip: &[Vec4::new(0.0, 0.0, 1.0, -0.1)],
         });
-        assert_eq!(b.counts, IVec4::new(1, 5, 0, 6));
+        assert_eq!(b.counts, IVec4::new(1, 5, 1, 6));
+        assert_eq!(b.crop_min.truncate(), Vec3::splat(-0.25));
+        assert_eq!(b.clip[0], Vec4::new(0.0, 0.0, 1.0, -0.1));
+        assert_eq!(b.clip[1], Vec4::ZERO);
         assert_eq!(b.seeds, UVec4::new(11, 0, 3, 0));
         assert_eq!(b.dims, IVec4::new(8, 9, 10, 4));
         assert_eq!(b.box_min, Vec4::new(-0.5, -0.5, -0.5, 100.0));

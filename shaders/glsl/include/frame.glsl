@@ -4,6 +4,7 @@
 #define DVR_FRAME_GLSL
 
 #define MAX_LIGHTS 4
+#define MAX_CLIP_PLANES 6
 #define LIGHT_POINT 0
 #define LIGHT_AREA 1
 #define LIGHT_ENV 2
@@ -26,10 +27,16 @@ layout(binding = 0, std140) uniform FrameBlock {
     vec4 box_min;        // volume bounds in world space, w = density scale (μt per opacity)
     vec4 box_max;        // w = majorant over the whole volume
     ivec4 dims;          // volume voxels xyz, w = majorant grid brick edge in voxels
-    ivec4 counts;        // x lights, y frame index, z unused, w max bounces
+    ivec4 counts;        // x lights, y frame index, z clip planes, w max bounces
     vec4 params;         // x ray-march step (world), y HG g, z feature opacity threshold, w filter sigma (pixels)
     uvec4 seeds;         // x seed, y sample offset (progressive accumulation), z rr depth, w width
     Light lights[MAX_LIGHTS];
+    // What the cut keeps (scene/cut.rs): the crop box in world space, already within the
+    // volume's box (the box itself without a crop), and counts.z planes (xyz unit normal,
+    // w offset): x is kept where dot(xyz, x) + w >= 0.
+    vec4 crop_min;
+    vec4 crop_max;
+    vec4 clip[MAX_CLIP_PLANES];
 } frame;
 
 #endif

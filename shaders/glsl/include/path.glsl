@@ -29,7 +29,7 @@ vec3 trace_path(vec3 o, vec3 d, inout Rng rng, out float first_t) {
     vec3 result = vec3(0.0);
     int max_bounces = frame.counts.w;
     for (int bounce = 0; bounce <= max_bounces; ++bounce) {
-        vec2 span = intersect_box(o, d);
+        vec2 span = intersect_medium(o, d);
         float t = span.x < span.y ? sample_free_flight(o, d, span.x, span.y, rng) : -1.0;
         if (t < 0.0) {
             if (bounce == 0) result += throughput * escaped_radiance(d);
@@ -71,7 +71,7 @@ vec3 trace_path(vec3 o, vec3 d, inout Rng rng, out float first_t) {
                 f = albedo * INV_4PI;
             }
             if (max(f.r, max(f.g, f.b)) > 0.0) {
-                vec2 sspan = intersect_box(p, ls.dir);
+                vec2 sspan = intersect_medium(p, ls.dir);
                 float t_end = min(sspan.y, ls.dist);
                 float tr = sspan.x < t_end ? transmittance(p, ls.dir, 0.0, t_end, rng) : 1.0;
                 result += throughput * f * ls.radiance * tr;

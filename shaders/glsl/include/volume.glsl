@@ -93,15 +93,60 @@ vec3 density_gradient(vec3 p) {
         density_at(p + vec3(0, 0, h.z)) - density_at(p - vec3(0, 0, h.z)));
 }
 
-// Ray/box intersection; returns (t_enter, t_exit), empty when t_enter >= t_exit.
-vec2 intersect_box(vec3 o, vec3 d) {
+// The interval of the ray o + t d (t >= 0) inside what the cut keeps: the crop box (the
+// volume's box without a crop) and the half-space in front of every clip plane. That
+// region is convex, so one interval; empty when x >= y. `cut_normal` is the outward
+// normal of the cut face where the ray enters, or zero where it enters through the
+// volume's own box (so the features passes can give a cut face the cut's normal).
+vec2 intersect_medium(vec3 o, vec3 d, out vec3 cut_normal) {
     vec3 inv = 1.0 / d;
-    vec3 t0 = (frame.box_min.xyz - o) * inv;
-    vec3 t1 = (frame.box_max.xyz - o) * inv;
+    vec3 t0 = (frame.crop_min.xyz - o) * inv;
+    vec3 t1 = (frame.crop_max.xyz - o) * inv;
     vec3 tmin = min(t0, t1);
     vec3 tmax = max(t0, t1);
-    return vec2(max(max(tmin.x, tmin.y), max(tmin.z, 0.0)), min(min(tmax.x, tmax.y), tmax.z));
+    float enter = max(max(tmin.x, tmin.y), max(tmin.z, 0.0));
+    float exit = min(min(tmax.x, tmax.y), tmax.z);
+    cut_normal = vec3(0.0);
+    // A crop face that is not the volume's own face.
+    for (int a = 0; a < 3; ++a) {
+        if (tmin[a] == enter && enter > 0.0) {
+            bool low = d[a] > 0.0;
+            float face = low ? frame.crop_min[a] : frame.crop_max[a];
+            float box_face = low ? frame.box_min[a] : frame.box_max[a];
+            if (face != box_face) {
+                cut_normal = vec3(0.0);
+                cut_normal[a] = low ? -1.0 : 1.0;
+            }
+        }
+    }
+    for (int i = 0; i < frame.counts.z; ++i) {
+        vec4 p = frame.clip[i];
+        float s = dot(p.xyz, o) + p.w;
+        float dn = dot(p.xyz, d);
+        if (dn > 0.0) {
+            float t = -s / dn;
+            if (t > enter) {
+                enter = t;
+                cut_normal = -p.xyz;
+            }
+        } else if (dn < 0.0) {
+            exit = min(exit, -s / dn);
+        } else if (s < 0.0) {
+            exit = -1.0;  // parallel and behind the plane: nothing is kept
+        }
+    }
+    return vec2(enter, exit);
 }
+
+vec2 intersect_medium(vec3 o, vec3 d) {
+    vec3 unused;
+    return intersect_medium(o, d, unused);
+}
+
+// Where a features pass met the medium within this many march steps of the ray's entry
+// through a cut, what it met is the cut face: it takes the cut's normal, not the
+// density gradient (which belongs to structures the cut passes through).
+const float CUT_FACE_STEPS = 2.0;
 
 // Majorant grid traversal (Amanatides–Woo). Cell c is brick c of the volume: bricks are
 // a whole number of voxels, so when a dimension is not a multiple of the brick the grid
