@@ -426,3 +426,52 @@ fn bad_overrides_fail_before_rendering_and_empty_entries_are_usage_errors() {
         assert_status(&o, 2);
     }
 }
+
+/// Reliability round 3: `DVR_WRLS=atrous_keep=nan dvr capture --denoiser ours` ran, exit
+/// 0, without a word: an override of a method that does not run is said so, naming the
+/// variable and the methods it applies to.
+#[test]
+fn overrides_of_methods_that_do_not_run_are_warnings_naming_them() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("capture");
+    let args = [
+        "capture",
+        "--scene",
+        "cloud/orbit",
+        "--frames",
+        "1",
+        "--size",
+        "8x8",
+        "--denoiser",
+        "taa",
+        "--out",
+        out.to_str().expect("utf-8 path"),
+    ];
+    for (var, value, readers) in [
+        ("DVR_WRLS", "atrous_keep=nan", "wrls-paper"),
+        ("DVR_OURS", "lag_z=3", "ours-no-gradient"),
+        ("DVR_SVGF", "sigma_l=8", "svgf"),
+    ] {
+        let o = wait_within(
+            spawn(&args, &[(var, value)]),
+            std::time::Duration::from_secs(120),
+        );
+        assert_status(&o, 0);
+        let err = stderr(&o);
+        assert!(
+            err.contains(&format!("{var} is set but no method it applies to runs"))
+                && err.contains(readers)
+                && err.contains("running: taa"),
+            "{var}: {err}"
+        );
+    }
+    // A method that reads it runs: no warning.
+    let mut with_svgf = args;
+    with_svgf[8] = "svgf";
+    let o = wait_within(
+        spawn(&with_svgf, &[("DVR_SVGF", "sigma_l=8")]),
+        std::time::Duration::from_secs(120),
+    );
+    assert_status(&o, 0);
+    assert!(!stderr(&o).contains("is set but"), "{}", stderr(&o));
+}

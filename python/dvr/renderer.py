@@ -1,6 +1,7 @@
 """The renderer: a live view of a scene on one Vulkan device, edited between frames."""
 
 import threading
+import warnings
 
 import numpy as np
 
@@ -64,6 +65,7 @@ class Renderer:
             scene._engine_dict(), size, list(denoisers), volume=scene.volume, tf=tf, spp=spp, motion=motion,
             device=device, gpu_memory=None if gpu_memory is None else str(gpu_memory),
         )
+        _warn_unused_overrides(self.denoisers)
 
     # Rendering.
 
@@ -167,6 +169,7 @@ class Renderer:
         if isinstance(names, str):
             names = [names]
         self._r.set_denoisers([str(n) for n in names])
+        _warn_unused_overrides(self.denoisers)
 
     @property
     def size(self) -> tuple:
@@ -255,6 +258,11 @@ class Renderer:
 
     def __repr__(self):
         return f"Renderer({self.scene.name!r}, size={self.size}, denoisers={self.denoisers})"
+
+
+def _warn_unused_overrides(running):
+    for message in _native.unused_overrides(list(running)):
+        warnings.warn(message, RuntimeWarning, stacklevel=3)
 
 
 def _size(size):

@@ -19,6 +19,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<volume::Volume>()?;
     m.add_class::<renderer::Renderer>()?;
     m.add_function(wrap_pyfunction!(renderer::denoiser_names, m)?)?;
+    m.add_function(wrap_pyfunction!(renderer::unused_overrides, m)?)?;
     m.add_function(wrap_pyfunction!(scene::scene_dict, m)?)?;
     m.add_function(wrap_pyfunction!(scene::builtin_scene_names, m)?)?;
     m.add_function(wrap_pyfunction!(scene::check_scene, m)?)?;

@@ -520,6 +520,14 @@ fn frame_dict<'py>(
     Ok(out)
 }
 
+/// A sentence for each parameter override (`DVR_OURS`, `DVR_WRLS`, `DVR_SVGF`) set in
+/// the environment that none of `running` reads.
+#[pyfunction]
+pub fn unused_overrides(running: Vec<String>) -> Vec<String> {
+    let names: Vec<&str> = running.iter().map(String::as_str).collect();
+    dvr_engine::denoise::unused_overrides(&names)
+}
+
 /// Every denoiser name the registry knows, with its one-line description.
 #[pyfunction]
 pub fn denoiser_names() -> Vec<(String, String)> {

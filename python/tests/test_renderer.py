@@ -236,3 +236,34 @@ def test_a_volume_past_its_budget_is_paged_and_renders_the_same_frames():
         dvr.Renderer(scene, size=(8, 8), gpu_memory="lots")
     with pytest.raises(ValueError, match="at least 64K"):
         dvr.Renderer(scene, size=(8, 8), gpu_memory="20K")
+
+
+def test_argument_errors_name_the_argument_and_its_range():
+    r = dvr.Renderer(dvr.Scene.builtin("cloud/orbit"), size=(8, 8), denoisers=["taa"])
+    with pytest.raises(ValueError, match=r"frame=-1: must be 0 to 59"):
+        r.render(frame=-1)
+    with pytest.raises(TypeError, match="frame"):
+        r.render(frame=1.5)
+    with pytest.raises(ValueError, match=r"spp=1000000000000: must be 1 to"):
+        dvr.Renderer(dvr.Scene.builtin("cloud/orbit"), size=(8, 8), spp=10**12)
+    with pytest.raises(ValueError, match=r"size: width must be a whole number of pixels, got 16.5"):
+        dvr.Renderer(dvr.Scene.builtin("cloud/orbit"), size=(16.5, 8))
+    with pytest.raises(ValueError, match=r"size=\(8, 9000\): width and height must be 1 to 8192"):
+        dvr.Renderer(dvr.Scene.builtin("cloud/orbit"), size=(8, 9000))
+    with pytest.raises(ValueError, match=r"spp=0: must be 1 to"):
+        r.reference(spp=0)
+    with pytest.raises(ValueError, match=r"frame=60: must be 0 to 59"):
+        r.reference(frame=60, spp=1)
+
+
+def test_an_override_of_a_method_that_does_not_run_is_a_warning(monkeypatch):
+    monkeypatch.setenv("DVR_OURS", "lag_z=3")
+    with pytest.warns(RuntimeWarning, match=r"DVR_OURS is set but no method it applies to runs \(ours, "):
+        r = dvr.Renderer(dvr.Scene.builtin("cloud/orbit"), size=(8, 8), denoisers=["taa"])
+    with pytest.warns(RuntimeWarning, match="DVR_OURS"):
+        r.denoisers = ["svgf"]
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r.denoisers = ["ours"]

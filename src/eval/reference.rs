@@ -691,6 +691,15 @@ mod tests {
         // A different procedural volume: same scene text, other voxels.
         let k32 = ReferenceKey::new(&scene(), (8, 8), 16, 32).unwrap();
         assert_ne!(key(16).content_hash, k32.content_hash);
+        // A cut is part of the scene: references of a cut view are not the uncut ones.
+        let mut cut = scene();
+        cut.cut.planes.push(dvr_engine::scene::ClipPlane {
+            point: glam::DVec3::ZERO,
+            normal: glam::DVec3::Z,
+            enabled: true,
+        });
+        let kc = ReferenceKey::new(&cut, (8, 8), 16, 16).unwrap();
+        assert_ne!(key(16).scene_hash, kc.scene_hash);
     }
 
     /// Defect: editing a TF file or replacing the volume file a scene names kept the

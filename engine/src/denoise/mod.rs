@@ -31,13 +31,33 @@ use crate::passes::SceneBindings;
 /// goes.
 pub type Overridable<P> = (&'static str, f32, f32, fn(&mut P, f32));
 
-/// `params` with the `name=value` pairs of `spec` (comma-separated, e.g. from the
-/// environment variable `variable`) applied, for parameter studies with `dvr eval`. An
-/// unknown name lists the known ones; a value outside its range (or not finite) is an
-/// error naming the range.
 /// The environment variables that override denoiser parameters (`ours`, the paper's
 /// family, svgf): what a method computes depends on them.
 pub const OVERRIDE_VARIABLES: [&str; 3] = ["DVR_OURS", "DVR_WRLS", "DVR_SVGF"];
+
+/// A sentence for each override variable set in the environment that none of the
+/// `running` methods reads, naming the variable and the methods it applies to: a user
+/// who set one expects it to act, or to be told that it does not.
+pub fn unused_overrides(running: &[&str]) -> Vec<String> {
+    OVERRIDE_VARIABLES
+        .iter()
+        .filter(|v| std::env::var(v).is_ok_and(|s| !s.trim().is_empty()))
+        .filter_map(|&v| {
+            let readers: Vec<&str> = registry::DENOISERS
+                .iter()
+                .filter(|d| d.override_variable() == Some(v))
+                .map(|d| d.name)
+                .collect();
+            (!running.iter().any(|r| readers.contains(r))).then(|| {
+                format!(
+                    "{v} is set but no method it applies to runs ({} read it; running: {})",
+                    readers.join(", "),
+                    running.join(", ")
+                )
+            })
+        })
+        .collect()
+}
 
 /// Checks the parameter overrides in the environment (`DVR_OURS`, `DVR_WRLS`,
 /// `DVR_SVGF`) as the denoisers will read them, so a command can refuse a bad value
@@ -50,6 +70,10 @@ pub fn check_env_overrides() -> Result<()> {
     Ok(())
 }
 
+/// `params` with the `name=value` pairs of `spec` (comma-separated, e.g. from the
+/// environment variable `variable`) applied, for parameter studies with `dvr eval`. An
+/// unknown name lists the known ones; a value outside its range (or not finite) is an
+/// error naming the range.
 pub fn with_overrides<P>(
     mut params: P,
     variable: &'static str,

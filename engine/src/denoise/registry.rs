@@ -225,6 +225,17 @@ impl DenoiserInfo {
         }
     }
 
+    /// The environment variable that overrides its parameters (see
+    /// [`super::OVERRIDE_VARIABLES`]), if it has one.
+    pub fn override_variable(&self) -> Option<&'static str> {
+        match self.kind {
+            Kind::Ours(_) => Some("DVR_OURS"),
+            Kind::Wrls(_) => Some("DVR_WRLS"),
+            Kind::Svgf => Some("DVR_SVGF"),
+            _ => None,
+        }
+    }
+
     /// Whether it reads the guide albedo composited along the ray
     /// ([`DenoiseInputs::guides`](super::DenoiseInputs::guides)): SVGF demodulates by it.
     pub fn guides(&self) -> bool {
