@@ -49,7 +49,11 @@ pub fn to_toml(v: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
         return Ok(toml::Value::Boolean(v.extract()?));
     }
     if v.is_instance_of::<PyInt>() {
-        return Ok(toml::Value::Integer(v.extract()?));
+        return v.extract().map(toml::Value::Integer).map_err(|_| {
+            value_error(format!(
+                "{path}: {v} is out of range (whole numbers here fit in 64 bits)"
+            ))
+        });
     }
     if v.is_instance_of::<PyFloat>() {
         return Ok(toml::Value::Float(v.extract()?));
