@@ -255,3 +255,60 @@ fn an_image_used_a_new_way_keeps_its_contents() {
     graph.destroy(&ctx);
     assert_validation_clean();
 }
+
+/// A denoiser switched off gives its images back after the next frame, and a smaller
+/// view gives back the larger one's: a long session that switches and resizes holds the
+/// memory of what it renders now, not of everything it ever rendered. A method switched
+/// back on starts from cleared histories and renders the frames a fresh one does.
+#[test]
+fn images_no_frame_uses_any_more_are_released() {
+    let volume = constant_volume(16, 0.7);
+    let view = || {
+        inputs(
+            front_camera(2.5, 40.0),
+            vec![
+                point_light(glam::Vec3::new(1.0, 1.0, 2.0), 4.0),
+                environment(0.2),
+            ],
+            constant_lut(0.6, 0.8),
+        )
+    };
+    let request = dvr_engine::renderer::FrameRequest {
+        readback: true,
+        ..Default::default()
+    };
+    let mut r = renderer(
+        context(),
+        settings(32, 1),
+        &volume,
+        &["none", "ours", "svgf"],
+    );
+    for _ in 0..2 {
+        r.frame(&view(), &request).expect("frame");
+    }
+    r.flush().expect("flush");
+    let both = r.ctx().memory_in_use().allocated;
+    r.set_denoisers(&["none", "taa"]).expect("switch");
+    for _ in 0..2 {
+        r.frame(&view(), &request).expect("frame");
+    }
+    r.flush().expect("flush");
+    let taa = r.ctx().memory_in_use().allocated;
+    assert!(
+        taa < both,
+        "switching ours and svgf off kept their images: {taa} >= {both} bytes"
+    );
+    r.resize(dvr_engine::graph::Extent {
+        width: 16,
+        height: 16,
+    })
+    .expect("resize");
+    r.frame(&view(), &request).expect("frame");
+    r.flush().expect("flush");
+    let small = r.ctx().memory_in_use().allocated;
+    assert!(
+        small < taa,
+        "a smaller view kept the larger images: {small} >= {taa} bytes"
+    );
+    assert_validation_clean();
+}

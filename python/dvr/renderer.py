@@ -209,6 +209,13 @@ class Renderer:
         (what a TF editor draws behind its curve)."""
         return np.asarray(self._r.histogram(), dtype=np.int64)
 
+    def gpu_memory(self) -> dict:
+        """Device memory this renderer holds, bytes: ``{"allocated": ..., "reserved":
+        ...}`` (live allocations; the allocator's memory blocks, free room included). A
+        long session whose figures keep growing leaks device memory."""
+        allocated, reserved = self._r.gpu_memory()
+        return {"allocated": allocated, "reserved": reserved}
+
     def close(self):
         """Frees the device memory now; the renderer is unusable after."""
         self._r.close()

@@ -418,6 +418,15 @@ impl Renderer {
         Ok(out)
     }
 
+    /// Device memory the renderer's context holds, bytes: `(allocated, reserved)` (live
+    /// allocations; memory blocks, free room included).
+    fn gpu_memory(&self, py: Python<'_>) -> PyResult<(u64, u64)> {
+        self.locked(py, |me| {
+            let m = me.session.ctx().memory_in_use();
+            Ok((m.allocated, m.reserved))
+        })
+    }
+
     /// Counts of the volume's normalised densities in 256 equal bins over [0, 1].
     fn histogram(&self, py: Python<'_>) -> PyResult<Vec<u32>> {
         self.locked(py, |me| Ok(me.histogram.clone()))

@@ -6,6 +6,10 @@ use super::*;
 /// Frames left out of the frame-rate summary (pipeline compilation on first use).
 const WARMUP_FRAMES: usize = 5;
 
+/// The frame after which device memory is sampled for the summary (every image the
+/// frame uses exists by then), beside the figure at the end.
+const MEMORY_WARMUP_FRAMES: u64 = 20;
+
 impl Explorer {
     /// One frame: see the module docs.
     pub(super) fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
@@ -223,6 +227,9 @@ impl Explorer {
         if r.screenshot.is_some() {
             self.last_screenshot = r.screenshot;
         }
+        if r.index == MEMORY_WARMUP_FRAMES {
+            self.gpu_memory_warm = self.gfx.as_ref().map(|g| g.ctx.memory_in_use());
+        }
         if r.index >= WARMUP_FRAMES as u64 {
             self.gpu_spans.push(ui::gpu_span_ms(&r.timings));
             for t in &r.timings {
@@ -259,6 +266,7 @@ impl Explorer {
                 format!("{:?}", g.swapchain.present_mode),
             )
         });
+        let memory_end = self.gfx.as_ref().map(|g| g.ctx.memory_in_use());
         self.gfx = None;
         if let Some(path) = &self.args.screenshot {
             let shot = self.last_screenshot.as_ref().with_context(|| {
@@ -285,6 +293,17 @@ impl Explorer {
                     self.model.left,
                 );
             }
+        }
+        if let (Some(warm), Some(end)) = (self.gpu_memory_warm, memory_end) {
+            let mib = |b: u64| b as f64 / (1 << 20) as f64;
+            println!(
+                "explore: GPU memory {:.1} MiB allocated ({:.1} MiB reserved) after frame \
+                 {MEMORY_WARMUP_FRAMES}, {:.1} MiB ({:.1} MiB) at the end",
+                mib(warm.allocated),
+                mib(warm.reserved),
+                mib(end.allocated),
+                mib(end.reserved)
+            );
         }
         let timed: Vec<(f32, u32)> = self.frame_ms.iter().skip(WARMUP_FRAMES).copied().collect();
         if let (Some((device, mode)), false) = (summary, timed.is_empty()) {

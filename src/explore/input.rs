@@ -12,6 +12,7 @@
 //! | `denoiser:NAME@F` | show denoiser NAME |
 //! | `split:NAME@F` | split view with NAME on the right (`split:off` ends it) |
 //! | `tf:NAME@F` | the transfer function: a preset name, or a TF file path (as the panel's presets and load) |
+//! | `size:WxH@F` | resizes the window so the view is W×H pixels |
 //! | `clip:add@F` | a clip plane through the centre, facing the view (as the panel's "add plane") |
 //! | `clip:offset:D@F` | moves the last plane D world units along its normal |
 //! | `clip:flip@F` | flips the last plane |
@@ -109,6 +110,8 @@ pub enum Command {
     Tf(Box<TransferFunction>),
     /// An edit of the clip planes or the crop box.
     Clip(ClipCommand),
+    /// Resize the window so the view is (width, height) pixels.
+    Resize(u32, u32),
 }
 
 /// What a `clip:`/`crop:` script command does (the panel's buttons and sliders).
@@ -235,6 +238,15 @@ impl Script {
                 "key" => Command::Key(Key::from_name(args.trim()).with_context(|| {
                     format!("script command {part:?}: unknown key (r, f, c, h, f12, tab)")
                 })?),
+                "size" => {
+                    let (w, h) = args
+                        .trim()
+                        .split_once('x')
+                        .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)))
+                        .filter(|&(w, h): &(u32, u32)| (16..=8192).contains(&w) && (16..=8192).contains(&h))
+                        .with_context(|| format!("script command {part:?}: needs WxH, 16 to 8192 each"))?;
+                    Command::Resize(w, h)
+                }
                 "clip" => Command::Clip(match args.trim().split_once(':') {
                     None if args.trim() == "add" => ClipCommand::AddPlane,
                     None if args.trim() == "flip" => ClipCommand::Flip,
@@ -287,7 +299,7 @@ impl Script {
                 }
                 other => bail!(
                     "script command {part:?}: unknown action {other:?} \
-                     (orbit, pan, zoom, key, denoiser, split, tf, clip, crop)"
+                     (orbit, pan, zoom, key, denoiser, split, tf, size, clip, crop)"
                 ),
             };
             events.push((frame, command));

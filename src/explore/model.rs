@@ -123,6 +123,12 @@ impl Explorer {
                 self.ui.tf_editor.dragging = None;
             }
             Command::Key(Key::Cut) => self.toggle_cuts(),
+            Command::Resize(w, h) => {
+                if let Some(window) = &self.window {
+                    let panel = self.panel_pixels();
+                    let _ = window.request_inner_size(PhysicalSize::new(w + panel, *h));
+                }
+            }
             Command::Clip(c) => {
                 let forward = self.ui.view.map_or(glam::DVec3::Z, |v| v.forward);
                 c.apply(&mut self.model.cut, forward);

@@ -33,6 +33,15 @@ pub struct DeviceInfo {
     pub storage_write_without_format: bool,
 }
 
+/// Device memory in use (see [`GpuContext::memory_in_use`]), bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuMemory {
+    /// Used by live allocations.
+    pub allocated: u64,
+    /// Held in memory blocks (allocated and free).
+    pub reserved: u64,
+}
+
 /// Instance, device, queue and allocator: everything that lives as long as the program.
 pub struct GpuContext {
     pub entry: ash::Entry,
@@ -232,6 +241,21 @@ impl GpuContext {
             one_shot_pool,
             pipelines: Default::default(),
         })
+    }
+
+    /// Device memory this context's allocator holds: what its live allocations use, and
+    /// what its memory blocks reserve (the allocations plus free room in the blocks).
+    /// A long session whose figures keep growing leaks device memory.
+    pub fn memory_in_use(&self) -> GpuMemory {
+        let report = self
+            .allocator
+            .lock()
+            .map(|a| a.generate_report())
+            .unwrap_or_else(|p| p.into_inner().generate_report());
+        GpuMemory {
+            allocated: report.total_allocated_bytes,
+            reserved: report.total_capacity_bytes,
+        }
     }
 
     /// Headless context with options from the environment (`DVR_DEVICE`, `DVR_VALIDATION`).

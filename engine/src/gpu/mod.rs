@@ -9,7 +9,7 @@ pub mod swapchain;
 pub mod timestamps;
 pub mod validation;
 
-pub use context::{ContextOptions, DeviceInfo, GpuContext};
+pub use context::{ContextOptions, DeviceInfo, GpuContext, GpuMemory};
 pub use pipeline::{ComputePipeline, Pipeline, SpecValue};
 pub use resources::{GpuBuffer, GpuImage, ImageDesc};
 pub use swapchain::{AcquiredImage, Swapchain};

@@ -101,6 +101,7 @@ impl RenderGraph {
             image: GpuImage::unallocated(desc),
             state: ResourceState::default(),
             needs_clear: true,
+            used_in: self.frames_ended,
         });
         self.image_names.insert(name.to_string(), h);
         Ok(h)
@@ -140,6 +141,7 @@ impl RenderGraph {
             image: imported,
             state,
             needs_clear: false,
+            used_in: self.frames_ended,
         });
         self.image_names.insert(name.to_string(), h);
         Ok(h)
@@ -337,6 +339,13 @@ impl RenderGraph {
         self.validate(&frame)?;
         self.release_retired(ctx);
         self.allocate_images(ctx, cmd, &frame)?;
+        for pass in &frame.passes {
+            for &(r, _) in &pass.accesses {
+                if let Res::Image(h) = r {
+                    self.images[h.0 as usize].used_in = self.frames_ended;
+                }
+            }
+        }
         let mut timestamps = timestamps;
         for mut pass in frame.passes {
             self.clear_new_resources(ctx, cmd, &pass.accesses);
@@ -487,6 +496,32 @@ impl RenderGraph {
             }
             !done
         });
+    }
+
+    /// Releases the memory of every image the last ended frame did not declare (a removed
+    /// denoiser's, another size's): call it only when no frame before that one is still
+    /// in flight. A released image keeps its name and shape and is allocated and cleared
+    /// again when a frame uses it; a history with a released side restarts.
+    pub fn release_unused(&mut self, ctx: &GpuContext) {
+        let Some(last) = self.frames_ended.checked_sub(1) else {
+            return;
+        };
+        let mut released = Vec::new();
+        for (i, slot) in self.images.iter_mut().enumerate() {
+            if slot.used_in < last && !slot.image.is_external() && slot.image.is_allocated() {
+                let desc = slot.image.desc;
+                slot.image.destroy(ctx);
+                slot.image = GpuImage::unallocated(desc);
+                slot.state = ResourceState::default();
+                slot.needs_clear = true;
+                released.push(ImageHandle(i as u32));
+            }
+        }
+        for h in self.histories.values_mut() {
+            if h.images.iter().any(|i| released.contains(i)) {
+                h.valid = false;
+            }
+        }
     }
 
     /// Ends the frame: histories used this frame swap and become valid.

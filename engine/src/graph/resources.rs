@@ -62,6 +62,8 @@ pub(crate) struct ImageSlot {
     pub image: GpuImage,
     pub state: ResourceState,
     pub needs_clear: bool,
+    /// The frame (the graph's count of ended frames) that last declared it.
+    pub used_in: u64,
 }
 
 pub(crate) struct BufferSlot {

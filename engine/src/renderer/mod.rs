@@ -153,6 +153,9 @@ pub struct Renderer {
     features: PathTraceFeatures,
     /// Restart every history on the next frame (the live settings changed).
     pending_reset: bool,
+    /// After the next frame, release the graph's images it did not use (the denoisers or
+    /// the size changed, and nothing older is in flight).
+    release_unused: bool,
     graph: RenderGraph,
     passes: Passes,
     denoisers: Vec<Method>,
@@ -274,6 +277,7 @@ impl Renderer {
             config,
             features,
             pending_reset: false,
+            release_unused: false,
             graph,
             passes,
             denoisers,
@@ -349,6 +353,7 @@ impl Renderer {
         check_spp(&self.ctx, self.settings.spp(), size)?;
         let done = self.flush()?;
         self.config.size = size;
+        self.release_unused = true;
         Ok(done)
     }
 
@@ -373,6 +378,7 @@ impl Renderer {
         let new = create_methods(&self.ctx, &self.config, self.features, names)?;
         self.denoisers = new;
         self.graph.reset_history("");
+        self.release_unused = true;
         Ok(done)
     }
 
@@ -575,6 +581,10 @@ impl Renderer {
         self.slots[slot].pending = Some((self.frame_index, readbacks));
         self.slots[slot].pending_screenshot = screenshot;
         self.graph.end_frame();
+        if std::mem::take(&mut self.release_unused) {
+            // The frame before this one was waited for when the change was made.
+            self.graph.release_unused(&self.ctx);
+        }
         self.last_inputs = Some(inputs.clone());
         self.frame_index += 1;
         Ok(completed)
