@@ -396,6 +396,44 @@ def b_fuzz():
     ])
 
 
+def b_rae_training():
+    import glob
+    files = sorted(glob.glob(os.path.join(ROOT, "assets", "rae", "*.json")))
+    if not files:
+        raise Missing("assets/rae/*.json")
+    body = []
+    for f in files:
+        with open(f) as fh:
+            m = json.load(fh)
+        if not m.get("trained"):
+            continue
+        pre = m.get("initialised_from") or {}
+        pt = pre.get("training") or {}
+        t = m["training"]
+        curve = [c["validation"] for c in m.get("validation_curve", []) if c.get("validation") is not None]
+        bestv = min(curve) if curve else None
+        start = curve[0] if curve else None
+        data = m["training_data"]
+        body.append([
+            f"`{m['name']}`", f"{m['parameters']:,}",
+            (f"{pt['iterations']} it. in {pt['seconds']:.0f} s, {pt.get('crop')}² crops"
+             if pt else ""),
+            f"{t['iterations']} it. in {t['seconds']:.0f} s, {t.get('crop')}² crops",
+            f"{fmt(start, 4)} → {fmt(bestv, 4)}",
+            f"{fmt(t.get('final_validation_parts_l1_log_temporal', [None])[0], 4)} / "
+            f"{fmt(t.get('validation_l1_of_noisy_input'), 4)}",
+            f"{data['clips_train']} + {data['clips_validation']}",
+        ])
+    return "\n".join([
+        table(["network", "parameters", "pre-training", "fine-tuning",
+               "validation loss, start → best", "validation L1 (log space), network / noisy input",
+               "clips: training + validation"], body),
+        "",
+        "Source: `assets/rae/<net>.json`, the manifests `tools/rae/train.py` writes beside "
+        "the weights (settings, data hashes and the whole validation curve of each stage).",
+    ])
+
+
 BLOCKS = {
     "headline": (b_headline, ["suite/summary.csv"]),
     "suite-means": (b_suite_means, ["suite/summary.csv"]),
@@ -408,6 +446,7 @@ BLOCKS = {
     "paper": (b_paper, ["paper/spp{1,2,4}/summary.csv"]),
     "cost": (b_cost, ["cost/*.json"]),
     "fuzz": (b_fuzz, ["fuzz/runs.csv"]),
+    "rae-training": (b_rae_training, ["../rae/*.json"]),
 }
 
 
