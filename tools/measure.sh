@@ -36,7 +36,7 @@ for f in sorted(glob.glob(f"{out}/*/result.json")) + sorted(glob.glob(f"{out}/*.
         d = json.load(open(f))
     except Exception:
         continue
-    device = d.get("device") or (d.get("device_info") or {}).get("name") or ""
+    device = d.get("device") or (d.get("result") or {}).get("device") or ""
     if device:
         break
 meta = {
@@ -46,6 +46,9 @@ meta = {
     "date": datetime.date.today().isoformat(),
     "machine": machine + (f"; Vulkan device: {device}" if device else ""),
     "wall_s": round(float(secs), 1),
+    # What else ran: the 1-, 5- and 15-minute load averages as the run ended (a wall
+    # time from a busy machine is not one from an idle one).
+    "load_average_at_end": [float(x) for x in open("/proc/loadavg").read().split()[:3]],
 }
 json.dump(meta, open(f"assets/results/{set_}/meta.json", "w"), indent=2, ensure_ascii=False)
 open(f"assets/results/{set_}/meta.json", "a").write("\n")

@@ -139,8 +139,11 @@ def bold_if(text, cond):
 def source(set_, files):
     meta = read_json(set_, "meta.json")
     names = ", ".join(f"`assets/results/{set_}/{f}`" for f in files)
+    load = meta.get("load_average_at_end")
+    busy = (f" Load average (1, 5, 15 min) as the run ended: "
+            f"{', '.join(f'{x:.1f}' for x in load)}." if load else "")
     return (f"Source: {names}, made by `{meta['command']}` at commit {meta['commit']} "
-            f"({meta['date']}) on {meta['machine']}.")
+            f"({meta['date']}) on {meta['machine']}.{busy}")
 
 
 def means_table(set_, rows, methods, metrics=("psnr", "ssim", "flip", "temporal_error", "gpu_ms")):
@@ -348,34 +351,39 @@ def b_paper():
 
 def b_cost():
     body = []
+    sources = []
     for name in ("mri-point-light", "phantom-orbit"):
         try:
             prof = read_json("cost", f"{name}.json")
         except Missing:
             continue
-        own = {}
-        shared = {}
+        sources.append(f"{name}.json")
+        own, shared = {}, {}
         for p in prof["passes"]:
-            owner = p.get("owner") or "shared"
-            med = num(p.get("median_ms"))
-            if owner in ("ours", "svgf"):
-                own[owner] = own.get(owner, 0.0) + (med or 0.0)
-            elif owner == "shared":
-                shared[p["name"]] = med
+            owner = p.get("owner")
+            method = owner.get("method") if isinstance(owner, dict) else None
+            med = num(p.get("median_ms")) or 0.0
+            # The guides composited along the ray are shared: charged to the first method
+            # listed that reads them, they count for neither sum here.
+            if method and p["pass"] != "aux_features":
+                own[method] = own.get(method, 0.0) + med
+            else:
+                shared[p["pass"]] = shared.get(p["pass"], 0.0) + med
         if "ours" in own and "svgf" in own:
-            body.append([name.replace("-", "/", 1), fmt(own["ours"], 1), fmt(own["svgf"], 1),
+            body.append([prof.get("scene", name), fmt(own["ours"], 1), fmt(own["svgf"], 1),
                          f"{own['ours'] / own['svgf']:.2f}×",
-                         fmt(shared.get("aux_features"), 1), fmt(shared.get("path_trace"), 1)])
+                         fmt(shared.get("surface_features"), 1), fmt(shared.get("aux_features"), 1),
+                         fmt(shared.get("path_trace"), 1)])
     if not body:
         raise Missing("assets/results/cost/*.json")
     return "\n".join([
-        "Medians of each method's own passes, summed, ms per frame at 256×256 "
-        "(the shared passes are not in either sum):",
+        "Medians over the frames of each method's own passes, summed, in ms per frame at "
+        "256×256; the shared passes, which neither sum includes, beside them:",
         "",
-        table(["scene", "`ours`", "`svgf`", "ours / svgf", "`aux_features` (shared)",
-               "`path_trace` (shared)"], body),
+        table(["scene", "`ours`", "`svgf`", "ours / svgf", "`surface_features`",
+               "`aux_features`", "`path_trace`"], body),
         "",
-        source("cost", ["mri-point-light.json", "phantom-orbit.json"]),
+        source("cost", sources),
     ])
 
 
