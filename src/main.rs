@@ -102,7 +102,7 @@ impl Default for RenderArgs {
 enum Command {
     /// The main job (tools/run.sh): a small eval of the default scene sized for the
     /// device (a discrete GPU: 1280x720 with 1024-spp references; otherwise 128x128 with
-    /// 256-spp references, about a minute on a 2-core CPU), with videos; opens nothing,
+    /// 256-spp references, sized for a 2-core CPU), with videos; opens nothing,
     /// prints the page's path.
     Demo(demo::DemoArgs),
     /// Open a window: the path tracer and a denoiser live, with an orbit camera, a

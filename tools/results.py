@@ -211,7 +211,6 @@ def b_suite_means():
 def b_suite_scenes():
     rows = read_csv("suite", "summary.csv")
     methods = present(rows, ["none", "taa", "svgf", "ours", "rae", "oidn", "oidn-aux"])
-    m = means(rows)
     lead = sum(
         1 for s in scenes_of(rows)
         if (lambda vals: vals.get("ours") is not None and
@@ -497,7 +496,6 @@ def main():
             if args.check:
                 stale += [m.group("name") for m, n in zip(BLOCK.finditer(text), BLOCK.finditer(new))
                           if m.group(0) != n.group(0)]
-                stale_pages = rel
                 print(f"results: {rel} is stale against its CSVs "
                       f"(blocks: {', '.join(sorted(set(stale)))}); run tools/results.py",
                       file=sys.stderr)
