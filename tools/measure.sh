@@ -5,7 +5,7 @@
 # book's results pages and README's headline table from those files.
 #
 #   tools/measure.sh SET [SET ...]     SET: demo static development validation paper
-#                                           suite cost
+#                                           suite cost rae
 #
 # Needs a release build (cargo build --release). The eval sets also add Intel OIDN with
 # tools/oidn_eval.py, which needs a Python with the dvr package, pyoidn, numpy, OpenEXR
@@ -113,6 +113,15 @@ for set in "$@"; do
       keep suite "$out"
       meta suite "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
+    rae)
+      # The networks against the temporal filters on short clips (12 frames, at the
+      # networks' training size), where a network is not behind filters still converging.
+      args=(--scene suite --frames 12 --size 64x64 --spp 2 --ref-spp 1024
+        --denoiser none,svgf,ours,rae,rae-phantom,rae-mri,rae-fp16)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      keep rae "$out"
+      meta rae "$out" "$secs" "dvr eval ${args[*]} --out $out"
+      ;;
     paper)
       # One reference folder for the three noise levels: references do not depend on --spp.
       total=0
@@ -137,7 +146,7 @@ for set in "$@"; do
       meta cost "$out" "$secs" "dvr profile --scene S --frames 30 --size 256x256 --denoiser ours,svgf --json out/cost/S.json, S = mri/point-light, phantom/orbit"
       ;;
     *)
-      echo "measure: unknown set '$set' (demo static development validation paper suite cost)" >&2
+      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae)" >&2
       exit 2
       ;;
   esac

@@ -413,6 +413,33 @@ def b_cost():
     ])
 
 
+def b_rae():
+    rows = read_csv("rae", "summary.csv")
+    methods = present(rows, ["svgf", "ours", "rae-phantom", "rae-mri"])
+    body = []
+    for sc in scenes_of(rows):
+        vals = {r["method"]: r for r in rows if r["scene"] == sc}
+        bp = best({x: num(vals[x]["psnr"]) for x in methods if x in vals}, True)
+        bf = best({x: num(vals[x]["flip"]) for x in methods if x in vals}, False)
+        cells = [sc]
+        for x in methods:
+            p, f = num(vals[x]["psnr"]), num(vals[x]["flip"])
+            cells.append(f"{bold_if(fmt(p, 2), fmt(p, 2) == fmt(bp, 2))} / "
+                         f"{bold_if(fmt(f, 3), fmt(f, 3) == fmt(bf, 3))}")
+        body.append(cells)
+    return "\n".join([
+        "PSNR / FLIP per scene (`cloud` is in neither network's training data):",
+        "",
+        table(["scene"] + [f"`{x}`" for x in methods], body),
+        "",
+        "Means over the scenes:",
+        "",
+        means_table("rae", rows, None, ("psnr", "flip", "temporal_error", "gpu_ms")),
+        "",
+        source("rae", ["summary.csv"]),
+    ])
+
+
 def b_fuzz():
     rows = read_csv("fuzz", "runs.csv")
     body = []
@@ -479,6 +506,7 @@ BLOCKS = {
     "static": (b_static, ["static/metrics.csv", "static/summary.csv"]),
     "paper": (b_paper, ["paper/spp{1,2,4}/summary.csv"]),
     "cost": (b_cost, ["cost/*.json"]),
+    "rae": (b_rae, ["rae/summary.csv"]),
     "fuzz": (b_fuzz, ["fuzz/runs.csv"]),
     "rae-training": (b_rae_training, ["../rae/*.json"]),
 }
