@@ -4,8 +4,8 @@
 //! reference beside every method with their numbers, plots and videos.
 //!
 //! How big it is depends on the device: on a discrete GPU it renders 1280×720 with
-//! 1024-spp references; anywhere else (lavapipe on a CPU) it is sized to finish in
-//! about three minutes on two cores ([`CPU_PRESET`]). The page says which was chosen.
+//! 1024-spp references; anywhere else (lavapipe on a CPU) it is sized for a 2-core
+//! CPU ([`CPU_PRESET`]). The page says which was chosen.
 
 use crate::eval::{self, EvalArgs};
 use crate::setup::{parse_size, DEFAULT_SCENE};
@@ -48,11 +48,10 @@ pub struct Preset {
     pub ref_spp: u32,
 }
 
-/// Without a discrete GPU: the whole job (references, five methods, scores, the
-/// accumulation baseline, videos) measured 146 s of CPU time on lavapipe, so it stays
-/// under three minutes on two idle cores even if nothing ran in parallel. The
-/// references are 85 % of it; 256 spp keeps their noise about 21 dB below the 2-spp
-/// input's, well under the errors of the methods compared.
+/// Without a discrete GPU: sized so that the whole job (references, five methods,
+/// scores, the accumulation baseline, videos) stays short on two cores with lavapipe
+/// (the measured time is in the book's results, from assets/results/demo/meta.json). The references are most of it; 256 spp keeps their
+/// noise well below the 2-spp input's and the errors of the methods compared.
 pub const CPU_PRESET: Preset = Preset {
     size: (128, 128),
     frames: 16,
@@ -96,8 +95,8 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         format!("{device} is a discrete GPU, so the main job runs at the paper's size.")
     } else {
         format!(
-            "No discrete GPU ({device}), so the main job is sized to finish in about three \
-             minutes on a 2-core CPU (its GPU ms are lavapipe's, i.e. the CPU's); on a \
+            "No discrete GPU ({device}), so the main job is sized for a 2-core CPU \
+             (its GPU ms are lavapipe's, i.e. the CPU's); on a \
              discrete GPU it runs {}.",
             describe(&GPU_PRESET)
         )

@@ -64,10 +64,9 @@ pub struct RenderArgs {
           value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Position the temporal denoisers reproject with: `features` (opacity-threshold
-    /// surface, or the expected first collision through semi-transparent layers; on the
-    /// suite 0.4–0.7 dB better for every temporal method) or `first-hit` (the closest first real
-    /// collision among the frame's samples, the paper's choice). References do not
-    /// depend on it.
+    /// surface, or the expected first collision through semi-transparent layers) or
+    /// `first-hit` (the closest first real collision among the frame's samples, the
+    /// paper's choice). References do not depend on it.
     #[arg(long, default_value_t = RenderArgs::default().motion)]
     pub motion: dvr_engine::denoise::MotionSource,
     /// Bytes the volume may take on the device, e.g. `512M`, `2G` (default: the scene's
@@ -102,8 +101,9 @@ impl Default for RenderArgs {
 #[derive(Subcommand)]
 enum Command {
     /// The main job (tools/run.sh): a small eval of the default scene sized for the
-    /// device (a discrete GPU: 1280x720 with 1024-spp references; otherwise about three
-    /// minutes on a 2-core CPU), with videos; opens nothing, prints the page's path.
+    /// device (a discrete GPU: 1280x720 with 1024-spp references; otherwise 128x128 with
+    /// 256-spp references, sized for a 2-core CPU), with videos; opens nothing,
+    /// prints the page's path.
     Demo(demo::DemoArgs),
     /// Open a window: the path tracer and a denoiser live, with an orbit camera, a
     /// transfer-function editor, light and render controls and per-pass GPU timing.

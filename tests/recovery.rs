@@ -29,7 +29,7 @@ use dvr_engine::scene::Scene;
 /// 2.41 dB (24²), light-jump from 0.16 to 2.10 (56²); at 40² 0.55 and 0.59. So 40² is one
 /// of the sizes where the bound holds: the test guards against a regression there, it does
 /// not show recovery within 1 dB at every size. The cause (a bias the lag test does not
-/// correct in the still frames after a jump) and a candidate fix: docs/experiments.md.
+/// correct in the still frames after a jump) and a candidate fix: docs/src/experiments.md.
 const SIZE: u32 = 40;
 const FRAMES: u32 = 30;
 const REFERENCE_SPP: u32 = 128;

@@ -1,4 +1,4 @@
-//! The `dvr` binary against the failures of issue 14, each reproduced as a user met it:
+//! The `dvr` binary against failures a user can meet, each reproduced as a user would:
 //! stale or corrupt cached references reused, a panic on `--ref-spp 0`, lights dropped,
 //! warnings never shown, nonsense accepted with exit 0, script in a scene name running
 //! in the capture page, and exit statuses that meant two things. Small: 32×24, a few

@@ -6,7 +6,9 @@
 # page headless, ffmpeg, which encodes the videos of `--video` and the main job, and
 # Python 3 with venv, for the Python package (`python/`) and its tests, and iproute2 and
 # util-linux (`ip`, `unshare`), in which the Ray runner's test keeps its cluster on a
-# loopback-only network namespace.
+# loopback-only network namespace. Last, mdBook (the book in docs/, built by
+# tools/test.sh), from crates.io with `cargo install`, without its search index and
+# server: Debian 12 does not package it.
 # Idempotent: it installs only what is missing, so the README's commands can call it
 # every time.
 set -euo pipefail
@@ -36,4 +38,11 @@ fi
 if ! command -v cargo >/dev/null 2>&1; then
   echo "setup: cargo not found; install Rust from https://rustup.rs" >&2
   exit 1
+fi
+
+# The book's builder. --no-default-features leaves out the search index, the file
+# watcher and the HTTP server (`mdbook serve`): `mdbook build` needs none of them.
+if ! command -v mdbook >/dev/null 2>&1; then
+  echo "setup: installing mdbook (cargo install; a few minutes)"
+  cargo install mdbook --locked --no-default-features --version "^0.4" --quiet
 fi

@@ -1,15 +1,25 @@
 #!/usr/bin/env bash
 # The test command: installs what is missing, then checks formatting and lints, and runs
 # every test on the Vulkan device (lavapipe on a machine without a GPU) with the
-# validation layer on. Any validation message fails the test that caused it. Last, the
-# Python package: its wheel built and installed into a virtual environment
-# (target/py), and python/tests run against the installed wheel.
+# validation layer on. Any validation message fails the test that caused it. Then the
+# docs: every generated results table against the CSVs it comes from
+# (tools/results.py --check), the book built by mdBook, and its links, README's and
+# OVERVIEW.md's checked offline (tools/check_docs.py); the book's command-line page is
+# checked against `dvr --help` by cargo test (tests/cli_doc.rs). Last, the Python
+# package: its wheel built and installed into a virtual environment (target/py), and
+# python/tests run against the installed wheel.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --quiet -- -D warnings
 DVR_VALIDATION=1 cargo test --workspace "$@"
+
+# The docs: the results pages against their CSVs, the book, its links.
+python3 tools/results.py --check
+rm -rf docs/book
+mdbook build docs >/dev/null
+python3 tools/check_docs.py
 
 py=target/py/bin/python
 [ -x "$py" ] || python3 -m venv target/py

@@ -90,7 +90,7 @@ struct EvalRecord<'a> {
     ref_spp: u32,
     frames: Option<u32>,
     timing: crate::eval::timing::Outcome,
-    /// The goal: eval wall time at most 1.5x the GPU time it spends.
+    /// Eval wall time over the GPU time it spends (the goal is at most 1.5).
     wall_over_gpu: f64,
 }
 

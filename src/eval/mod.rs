@@ -8,7 +8,7 @@
 //! (exposure [`EXPOSURE`]) and scored against the tone-mapped reference (PSNR, SSIM,
 //! FLIP, temporal error), and its GPU time is the shared passes plus its own. A plain
 //! accumulation baseline at 1, 2, 4, … spp on a few frames gives the speed-vs-accuracy
-//! curve. Outputs (see the README's "Evaluation" section):
+//! curve. Outputs (see the book's evaluation page):
 //!
 //! ```text
 //! DIR/metrics.csv                 scene,method,frame,psnr,ssim,flip,temporal_error,gpu_ms

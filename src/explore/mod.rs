@@ -77,8 +77,8 @@ pub struct ExploreArgs {
     /// lights, TF and render settings at frame 0 are the starting point.
     #[arg(long, default_value = setup::DEFAULT_SCENE)]
     pub scene: String,
-    /// A volume file (NRRD, NIfTI, DICOM folder, raw with sidecar) to explore instead of
-    /// the scene's.
+    /// A volume file (NRRD, NIfTI, DICOM folder, raw with sidecar, OME-Zarr image,
+    /// OME-TIFF stack) to explore instead of the scene's.
     #[arg(long)]
     pub volume: Option<PathBuf>,
     /// Size of the rendered view, WIDTHxHEIGHT (the window adds the panel's width).
@@ -100,7 +100,7 @@ pub struct ExploreArgs {
     /// Present without vsync (MAILBOX, else IMMEDIATE).
     #[arg(long)]
     pub no_vsync: bool,
-    /// Scripted input, e.g. "orbit:30,0@10;zoom:2@20" (see README, Explorer).
+    /// Scripted input, e.g. "orbit:30,0@10;zoom:2@20" (see the book's explorer page).
     #[arg(long)]
     pub script: Option<String>,
     /// GPU ms per frame to aim for while the view moves: a still frame slower than this

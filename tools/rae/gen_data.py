@@ -10,7 +10,7 @@ ref: (clips, frames, 3, H, W) float32) with a content hash.
     nice -n 10 /opt/rae-venv/bin/python tools/rae/gen_data.py --dataset phantom --clips 24
 
 (the venv needs the package: `pip install ./python`). The defaults (64x64 clips,
-256-spp references) make the cheap pre-training set; the issue's setting (7-frame
+256-spp references) make the cheap pre-training set; the training setting (7-frame
 128x128 clips with 1024-spp references, about 7 min per clip on lavapipe with two
 rendering at once on this 2-core machine) is --size 128x128 --ref-spp 1024
 (pipeline.sh runs both). Clips already rendered with the same settings are reused, so a

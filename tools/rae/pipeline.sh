@@ -2,7 +2,7 @@
 # The whole RAE training run as shipped, per dataset (phantom, mri):
 #  1. pre-training data: 24 clips of 7 frames at 64x64 with 256-spp references (cheap:
 #     ~10 min per dataset on lavapipe), and a network trained on it from scratch;
-#  2. the data: 7-frame 128x128 clips at 2 spp with 1024-spp references
+#  2. the training data proper: 7-frame 128x128 clips at 2 spp with 1024-spp references
 #     (~6 min per clip on this 2-core machine, so fewer clips), and the network
 #     fine-tuned on it (--init), validated on held-out 128x128 clips.
 # Needs a Python with tools/rae/requirements.txt and the dvr package (`pip install ./python`

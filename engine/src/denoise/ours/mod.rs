@@ -50,7 +50,7 @@ use lag::OursLagPush;
 use prior::PriorPipelines;
 use update::{OursNoisePush, OursUpdatePush};
 
-/// Ours' tunables, each with what it buys (README, "ours").
+/// Ours' tunables, each with what it is (the book's denoisers page, "ours").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OursParams {
     /// Edge of the temporal-gradient strata in pixels: one pixel in S×S is re-traced.
@@ -126,7 +126,7 @@ pub struct OursVariant {
     /// The à-trous spatial filter (without it the estimate is the output).
     pub atrous: bool,
     /// The spatial prior: each estimate combined with a local linear model of its
-    /// neighbours' on the guide albedo and position, by their variances (without it the
+    /// neighbours' on the guide albedo and normal, by their variances (without it the
     /// à-trous filters the estimates as they are).
     pub prior: bool,
 }
@@ -161,8 +161,8 @@ pub struct Ours {
 const LAG_RADIUS: i32 = 2;
 
 /// À-trous levels (steps 1, 2: up to 9×9 pixels). Fixed, not tuned: a third level (step
-/// 4) bought 0.02 dB on the development suite for 2.9 ms of ours' 40 at 256² on lavapipe,
-/// and ours' cost bound (0.6× svgf) needs those (docs/experiments.md).
+/// 4) bought little on the development suite for a large share of ours' cost (the
+/// experiments page of the book, docs/src/experiments.md).
 pub const ATROUS_LEVELS: u32 = 2;
 
 impl Ours {

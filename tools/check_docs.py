@@ -1,0 +1,176 @@
+#!/usr/bin/env python3
+"""Offline checks of the documentation (Python standard library only; tools/test.sh runs it).
+
+1. The built book (docs/book, from `mdbook build docs`): every relative link and image in
+   every page points at a file that exists, and every #anchor at an id in that file.
+   Pages link to the repository's files as ../../<path>, which resolves from both
+   docs/src/ (where the Markdown is read) and docs/book/ (where the HTML is).
+2. The Markdown outside the book (README.md, OVERVIEW.md, CHANGELOG.md, python/README.md):
+   the same for their relative links, anchors by GitHub's heading slugs.
+3. OVERVIEW.md names every tracked source file (by path or file name), so the walk
+   through the code stays whole.
+4. README.md stays the front door: at most 200 lines.
+
+    tools/check_docs.py [--book docs/book] [--no-book]
+
+Exits 1 naming every broken link, missing anchor and unnamed file.
+"""
+
+import argparse
+import html.parser
+import os
+import re
+import subprocess
+import sys
+import urllib.parse
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+MARKDOWN = ["README.md", "OVERVIEW.md", "CHANGELOG.md", "python/README.md"]
+# Tracked files OVERVIEW.md must name: source, shaders, tests, tools, the Python package.
+SOURCE_DIRS = ["src", "engine/src", "engine/tests", "shaders", "tests", "tools", "python/src",
+               "python/dvr", "python/tests", "python/examples", "fuzz/src"]
+SOURCE_EXCLUDE = ["tests/fixtures/"]
+README_LINES = 200
+
+
+class Links(html.parser.HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.links = []
+        self.ids = set()
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        for key in ("id", "name"):
+            if a.get(key):
+                self.ids.add(a[key])
+        for key in ("href", "src"):
+            if a.get(key) is not None and tag in ("a", "img", "link", "script", "source"):
+                self.links.append(a[key])
+
+
+def parse_html(path, cache={}):
+    if path not in cache:
+        p = Links()
+        with open(path, encoding="utf-8") as f:
+            p.feed(f.read())
+        cache[path] = p
+    return cache[path]
+
+
+def external(link):
+    return bool(re.match(r"^[a-zA-Z][a-zA-Z0-9+.-]*:", link)) or link.startswith("//")
+
+
+def check_book(book):
+    errors = []
+    if not os.path.isdir(book):
+        return [f"{os.path.relpath(book, ROOT)}: not built (mdbook build docs)"]
+    pages = []
+    for d, _, files in os.walk(book):
+        pages += [os.path.join(d, f) for f in files if f.endswith(".html")]
+    for page in sorted(pages):
+        rel = os.path.relpath(page, ROOT)
+        for link in parse_html(page).links:
+            if not link or external(link):
+                continue
+            target, _, frag = link.partition("#")
+            target = urllib.parse.unquote(target)
+            path = page if not target else os.path.normpath(os.path.join(os.path.dirname(page), target))
+            if os.path.isdir(path):
+                path = os.path.join(path, "index.html")
+            if not os.path.exists(path):
+                errors.append(f"{rel}: broken link {link}")
+                continue
+            if frag and path.endswith(".html"):
+                if urllib.parse.unquote(frag) not in parse_html(path).ids:
+                    errors.append(f"{rel}: no anchor #{frag} in {os.path.relpath(path, ROOT)}")
+    return errors
+
+
+def slug(heading):
+    """GitHub's anchor for a Markdown heading."""
+    text = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", heading.strip()).lower()
+    text = re.sub(r"[^\w\- ]", "", text)
+    return text.replace(" ", "-")
+
+
+def md_anchors(path, cache={}):
+    if path not in cache:
+        anchors, seen, fence = set(), {}, False
+        with open(path, encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("```"):
+                    fence = not fence
+                m = None if fence else re.match(r"^#{1,6}\s+(.*?)\s*#*\s*$", line)
+                if m:
+                    s = slug(m.group(1))
+                    n = seen.get(s, 0)
+                    seen[s] = n + 1
+                    anchors.add(s if n == 0 else f"{s}-{n}")
+        cache[path] = anchors
+    return cache[path]
+
+
+def check_markdown(rel):
+    errors = []
+    path = os.path.join(ROOT, rel)
+    if not os.path.exists(path):
+        return [f"{rel}: missing"]
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    text = re.sub(r"```.*?```", "", text, flags=re.S)
+    text = re.sub(r"`[^`\n]*`", "", text)
+    links = re.findall(r"\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)", text)
+    links += re.findall(r"(?:href|src)=\"([^\"]+)\"", text)
+    for link in links:
+        if external(link):
+            continue
+        target, _, frag = link.partition("#")
+        tpath = path if not target else os.path.normpath(os.path.join(os.path.dirname(path), target))
+        if not os.path.exists(tpath):
+            errors.append(f"{rel}: broken link {link}")
+            continue
+        if frag and tpath.endswith(".md") and frag not in md_anchors(tpath):
+            errors.append(f"{rel}: no heading for #{frag} in {os.path.relpath(tpath, ROOT)}")
+    return errors
+
+
+def check_overview():
+    try:
+        files = subprocess.run(["git", "ls-files", "--", *SOURCE_DIRS], cwd=ROOT, check=True,
+                               capture_output=True, text=True).stdout.split()
+    except (OSError, subprocess.CalledProcessError):
+        print("check_docs: not a git checkout; OVERVIEW.md's coverage not checked", file=sys.stderr)
+        return []
+    with open(os.path.join(ROOT, "OVERVIEW.md"), encoding="utf-8") as f:
+        overview = f.read()
+    missing = [f for f in files
+               if not any(f.startswith(x) for x in SOURCE_EXCLUDE)
+               and f not in overview and os.path.basename(f) not in overview]
+    return [f"OVERVIEW.md: does not name {f}" for f in missing]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--book", default=os.path.join(ROOT, "docs", "book"))
+    ap.add_argument("--no-book", action="store_true", help="skip the built book")
+    args = ap.parse_args()
+    errors = [] if args.no_book else check_book(args.book)
+    for rel in MARKDOWN:
+        errors += check_markdown(rel)
+    errors += check_overview()
+    with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:
+        lines = len(f.read().splitlines())
+    if lines > README_LINES:
+        errors.append(f"README.md: {lines} lines, over {README_LINES}: move the detail into the book")
+    for e in errors:
+        print(f"check_docs: {e}", file=sys.stderr)
+    if errors:
+        return 1
+    print("check_docs: links, anchors, OVERVIEW.md's file list and README's length are fine")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

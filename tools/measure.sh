@@ -1,0 +1,154 @@
+#!/usr/bin/env bash
+# Runs one measured set and keeps what the run wrote: its CSVs (or the profiler's JSON),
+# not its images, under assets/results/<set>/, with meta.json beside them (the command,
+# the commit, the machine, the date and the wall time). tools/results.py renders the
+# book's results pages and README's headline table from those files.
+#
+#   tools/measure.sh SET [SET ...]     SET: demo static development validation paper
+#                                           suite cost rae
+#
+# Needs a release build (cargo build --release). The eval sets also add Intel OIDN with
+# tools/oidn_eval.py, which needs a Python with the dvr package, pyoidn, numpy, OpenEXR
+# and pillow: PY=/path/to/python (default .venv/bin/python; see the book's evaluation
+# page). References are cached under out/<set>, so a rerun renders only the methods.
+# Long: on a 2-core CPU with lavapipe the validation set's references take over an hour,
+# the suite's about an hour, the paper set's about half an hour.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+dvr=${DVR_BIN:-target/release/dvr}
+py=${PY:-.venv/bin/python}
+[ -x "$dvr" ] || { echo "measure: $dvr is missing: cargo build --release" >&2; exit 1; }
+
+commit=$(git rev-parse --short HEAD)
+[ -z "$(git status --porcelain -- src engine shaders Cargo.lock)" ] || commit="$commit+local"
+machine="$(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p' | head -1), Debian $(cat /etc/debian_version 2>/dev/null || echo '?')"
+
+# meta SET OUTDIR SECONDS COMMAND...: writes assets/results/SET/meta.json.
+meta() {
+  local set=$1 out=$2 secs=$3
+  shift 3
+  python3 - "$set" "$out" "$secs" "$commit" "$machine" "$*" <<'EOF'
+import glob, json, sys, datetime
+set_, out, secs, commit, machine, command = sys.argv[1:]
+device = ""
+for f in sorted(glob.glob(f"{out}/*/result.json")) + sorted(glob.glob(f"{out}/*.json")):
+    try:
+        d = json.load(open(f))
+    except Exception:
+        continue
+    device = d.get("device") or (d.get("result") or {}).get("device") or ""
+    if device:
+        break
+meta = {
+    "set": set_,
+    "command": command,
+    "commit": commit,
+    "date": datetime.date.today().isoformat(),
+    "machine": machine + (f"; Vulkan device: {device}" if device else ""),
+    "wall_s": round(float(secs), 1),
+    # What else ran: the 1-, 5- and 15-minute load averages as the run ended (a wall
+    # time from a busy machine is not one from an idle one).
+    "load_average_at_end": [float(x) for x in open("/proc/loadavg").read().split()[:3]],
+}
+json.dump(meta, open(f"assets/results/{set_}/meta.json", "w"), indent=2, ensure_ascii=False)
+open(f"assets/results/{set_}/meta.json", "a").write("\n")
+EOF
+}
+
+# keep SET OUTDIR [SUBDIR]: copies the eval's CSVs.
+keep() {
+  local dest="assets/results/$1${3:+/$3}"
+  mkdir -p "$dest"
+  cp "$2/summary.csv" "$dest/summary.csv"
+  [ -z "${KEEP_METRICS:-}" ] || cp "$2/metrics.csv" "$dest/metrics.csv"
+}
+
+oidn() { "$py" tools/oidn_eval.py "$1"; }
+
+timed() { # timed CMD...: runs it, leaves its wall seconds in $secs
+  local t0
+  t0=$(date +%s.%N)
+  "$@"
+  secs=$(echo "$(date +%s.%N) - $t0" | bc)
+}
+
+for set in "$@"; do
+  out=out/$set
+  mkdir -p "assets/results/$set"
+  case $set in
+    demo)
+      rm -rf "$out"
+      timed "$dvr" demo --out "$out"
+      KEEP_METRICS=1 keep demo "$out"
+      meta demo "$out" "$secs" "dvr demo --out $out (a fresh folder: references included)"
+      ;;
+    static)
+      args=(--scene static --size 128x128 --ref-spp 256 --aux --denoiser none,taa,svgf,ours,ours-no-prior)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      oidn "$out"
+      KEEP_METRICS=1 keep static "$out"
+      meta static "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
+      ;;
+    development)
+      args=(--scene development --frames 48 --size 64x64 --ref-spp 1024 --aux
+        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,wrls-paper,rae)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      oidn "$out"
+      keep development "$out"
+      meta development "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
+      ;;
+    validation)
+      args=(--scene validation --size 128x128 --ref-spp 256 --aux
+        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,rae)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      oidn "$out"
+      keep validation "$out"
+      meta validation "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
+      ;;
+    suite)
+      args=(--scene suite --frames 48 --size 64x64 --ref-spp 1024 --aux
+        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,wrls-paper,rls-paper,wrls,rls,wrls-nf,rls-nf,rae)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      oidn "$out"
+      keep suite "$out"
+      meta suite "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
+      ;;
+    rae)
+      # The networks against the temporal filters on short clips (12 frames, at the
+      # networks' training size), where a network is not behind filters still converging.
+      args=(--scene suite --frames 12 --size 64x64 --spp 2 --ref-spp 1024
+        --denoiser none,svgf,ours,rae,rae-phantom,rae-mri,rae-fp16)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      keep rae "$out"
+      meta rae "$out" "$secs" "dvr eval ${args[*]} --out $out"
+      ;;
+    paper)
+      # One reference folder for the three noise levels: references do not depend on --spp.
+      total=0
+      for spp in 1 2 4; do
+        args=(--scene paper --size 64x64 --spp $spp
+          --denoiser none,taa,svgf,wrls-paper,rls-paper,wrls,rls,rae,ours)
+        timed "$dvr" eval "${args[@]}" --out "$out"
+        total=$(echo "$total + $secs" | bc)
+        oidn "$out"
+        keep paper "$out" "spp$spp"
+      done
+      meta paper "$out" "$total" "for spp in 1 2 4: dvr eval --scene paper --size 64x64 --spp \$spp --denoiser none,taa,svgf,wrls-paper,rls-paper,wrls,rls,rae,ours --out $out && tools/oidn_eval.py $out"
+      ;;
+    cost)
+      mkdir -p "$out"
+      secs=0
+      for scene in mri/point-light phantom/orbit; do
+        name=${scene/\//-}
+        timed "$dvr" profile --scene "$scene" --frames 30 --size 256x256 --denoiser ours,svgf --json "$out/$name.json"
+        cp "$out/$name.json" "assets/results/cost/$name.json"
+      done
+      meta cost "$out" "$secs" "dvr profile --scene S --frames 30 --size 256x256 --denoiser ours,svgf --json out/cost/S.json, S = mri/point-light, phantom/orbit"
+      ;;
+    *)
+      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae)" >&2
+      exit 2
+      ;;
+  esac
+  echo "measure: $set done in ${secs%.*} s -> assets/results/$set/"
+done

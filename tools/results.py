@@ -1,0 +1,571 @@
+#!/usr/bin/env python3
+"""Render the results tables from the CSVs the runs wrote (Python standard library only).
+
+Every measured number in README.md and the book (docs/src/) comes from a file under
+assets/results/<set>/, written by the run that measured it (tools/measure.sh keeps them,
+with meta.json: the command, commit, machine and date). A page holds a generated block
+between two markers:
+
+    <!-- results:NAME -->
+    ...generated...
+    <!-- /results:NAME -->
+
+and this script rewrites every such block from its CSV:
+
+    tools/results.py            # rewrite the blocks in README.md and docs/src/*.md
+    tools/results.py --check    # exit 1, naming each block that is stale (tools/test.sh)
+    tools/results.py --list     # the block names and the files each reads
+
+A block whose name is unknown, or whose files are missing, is an error: a table is
+either generated from a run's files or not there.
+"""
+
+import argparse
+import csv
+import json
+import math
+import os
+import re
+import sys
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+RESULTS = os.path.join(ROOT, "assets", "results")
+PAGES = ["README.md"] + sorted(
+    os.path.join("docs", "src", f)
+    for f in os.listdir(os.path.join(ROOT, "docs", "src"))
+    if f.endswith(".md")
+)
+BLOCK = re.compile(
+    r"(<!-- results:(?P<name>[a-z0-9-]+) -->\n)(?P<body>.*?)(<!-- /results:(?P=name) -->)",
+    re.S,
+)
+
+# The methods compared (the others are ablations of ours or of the paper's family).
+COMPARED = ["none", "taa", "svgf", "wrls-paper", "rls-paper", "wrls", "rls", "wrls-nf",
+            "rls-nf", "rae", "rae-phantom", "rae-mri", "rae-fp16", "oidn", "oidn-aux", "ours"]
+ORDER = ["none", "accum", "taa", "svgf", "ours", "ours-no-gradient", "ours-no-lag",
+         "ours-no-prior", "ours-no-atrous", "wrls-paper", "rls-paper", "wrls", "rls",
+         "wrls-nf", "rls-nf", "rae", "rae-phantom", "rae-mri", "rae-fp16", "oidn", "oidn-aux"]
+# metric: (column title, digits, higher is better)
+METRICS = {
+    "psnr": ("PSNR dB", 2, True),
+    "ssim": ("SSIM", 3, True),
+    "flip": ("FLIP", 4, False),
+    "temporal_error": ("temporal error", 5, False),
+    "gpu_ms": ("GPU ms", 1, None),
+}
+
+
+class Missing(Exception):
+    pass
+
+
+def path(*parts):
+    return os.path.join(RESULTS, *parts)
+
+
+def read_csv(*parts):
+    p = path(*parts)
+    if not os.path.exists(p):
+        raise Missing(os.path.relpath(p, ROOT))
+    with open(p, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def read_json(*parts):
+    p = path(*parts)
+    if not os.path.exists(p):
+        raise Missing(os.path.relpath(p, ROOT))
+    with open(p) as f:
+        return json.load(f)
+
+
+def num(s):
+    try:
+        v = float(s)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
+def fmt(v, digits):
+    return "" if v is None else f"{v:.{digits}f}"
+
+
+def mean(xs):
+    xs = [x for x in xs if x is not None]
+    return sum(xs) / len(xs) if xs else None
+
+
+def method_order(methods):
+    return sorted(methods, key=lambda m: (ORDER.index(m) if m in ORDER else len(ORDER), m))
+
+
+def scenes_of(rows):
+    seen = []
+    for r in rows:
+        if r["scene"] not in seen:
+            seen.append(r["scene"])
+    return seen
+
+
+def means(rows, methods=None):
+    """Per method, the mean over scenes of each metric in a summary.csv."""
+    out = {}
+    for m in methods or method_order({r["method"] for r in rows}):
+        sel = [r for r in rows if r["method"] == m]
+        if sel:
+            out[m] = {k: mean(num(r[k]) for r in sel) for k in METRICS}
+    return out
+
+
+def best(values, higher):
+    vals = [v for v in values.values() if v is not None]
+    if not vals:
+        return None
+    return max(vals) if higher else min(vals)
+
+
+def table(header, rows):
+    lines = ["| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def bold_if(text, cond):
+    return f"**{text}**" if cond and text else text
+
+
+def source(set_, files):
+    meta = read_json(set_, "meta.json")
+    names = ", ".join(f"`assets/results/{set_}/{f}`" for f in files)
+    load = meta.get("load_average_at_end")
+    busy = (f" Load average (1, 5, 15 min) as the run ended: "
+            f"{', '.join(f'{x:.1f}' for x in load)}." if load else "")
+    return (f"Source: {names}, made by `{meta['command']}` at commit {meta['commit']} "
+            f"({meta['date']}) on {meta['machine']}.{busy}")
+
+
+def means_table(set_, rows, methods, metrics=("psnr", "ssim", "flip", "temporal_error", "gpu_ms")):
+    m = means(rows, methods)
+    bests = {}
+    for k in metrics:
+        hib = METRICS[k][2]
+        if hib is not None:
+            bests[k] = best({x: v[k] for x, v in m.items() if x in COMPARED}, hib)
+    header = ["method"] + [METRICS[k][0] for k in metrics]
+    body = []
+    for x, v in m.items():
+        cells = [f"`{x}`"]
+        for k in metrics:
+            t = fmt(v[k], METRICS[k][1])
+            b = x in COMPARED and k in bests and v[k] is not None and \
+                fmt(v[k], METRICS[k][1]) == fmt(bests[k], METRICS[k][1])
+            cells.append(bold_if(t, b))
+        body.append(cells)
+    return table(header, body)
+
+
+def per_scene_table(rows, methods, metric="psnr", label="scene"):
+    digits = METRICS[metric][1]
+    hib = METRICS[metric][2]
+    body = []
+    for s in scenes_of(rows):
+        vals = {r["method"]: num(r[metric]) for r in rows if r["scene"] == s}
+        b = best({x: vals.get(x) for x in methods if x in COMPARED}, hib)
+        body.append([s] + [bold_if(fmt(vals.get(x), digits),
+                                   x in COMPARED and vals.get(x) is not None and
+                                   fmt(vals.get(x), digits) == fmt(b, digits))
+                           for x in methods])
+    return table([label] + [f"`{x}`" for x in methods], body)
+
+
+def present(rows, methods):
+    have = {r["method"] for r in rows}
+    return [m for m in methods if m in have]
+
+
+# ---------------------------------------------------------------------------- blocks
+
+
+def b_headline():
+    rows = read_csv("suite", "summary.csv")
+    meta = read_json("suite", "meta.json")
+    methods = present(rows, ["ours", "svgf", "taa", "rae", "oidn-aux", "oidn"])
+    n = len(scenes_of(rows))
+    return "\n".join([
+        means_table("suite", rows, methods),
+        "",
+        f"Means over the {n} scenes of the development suite (64×64, 48 frames, 2 spp, "
+        f"1024-spp references), commit {meta['commit']}, on {meta['machine']}. "
+        "OIDN runs on the CPU (no GPU ms); `oidn-aux` is OIDN with the albedo and normal "
+        "guides. Every scene and method: [the results](docs/src/results.md).",
+    ])
+
+
+def b_suite_means():
+    rows = read_csv("suite", "summary.csv")
+    return "\n".join([means_table("suite", rows, None), "", source("suite", ["summary.csv"])])
+
+
+def b_suite_scenes():
+    rows = read_csv("suite", "summary.csv")
+    methods = present(rows, ["none", "taa", "svgf", "ours", "rae", "oidn", "oidn-aux"])
+    lead = sum(
+        1 for s in scenes_of(rows)
+        if (lambda vals: vals.get("ours") is not None and
+            fmt(vals["ours"], 2) == fmt(best({x: vals.get(x) for x in COMPARED if x in vals}, True), 2))(
+            {r["method"]: num(r["psnr"]) for r in rows if r["scene"] == s})
+    )
+    return "\n".join([
+        per_scene_table(rows, methods),
+        "",
+        f"`ours` has the best PSNR of the methods compared on {lead} of the "
+        f"{len(scenes_of(rows))} scenes.",
+        "",
+        source("suite", ["summary.csv"]),
+    ])
+
+
+def b_ablations():
+    rows = read_csv("suite", "summary.csv")
+    m = means(rows)
+    base = m["ours"]
+    body = []
+    for x in ["ours-no-gradient", "ours-no-lag", "ours-no-prior", "ours-no-atrous"]:
+        if x in m:
+            body.append([f"`{x}`", fmt(m[x]["psnr"], 2), f"{base['psnr'] - m[x]['psnr']:+.2f}",
+                         fmt(m[x]["flip"], 4), f"{base['flip'] - m[x]['flip']:+.4f}"])
+    return "\n".join([
+        table(["ablation", "PSNR dB", "ours − it, dB", "FLIP", "ours − it, FLIP"], body),
+        "",
+        source("suite", ["summary.csv"]),
+    ])
+
+
+def b_demo():
+    rows = read_csv("demo", "summary.csv")
+    meta = read_json("demo", "meta.json")
+    return "\n".join([
+        means_table("demo", rows, None),
+        "",
+        f"The whole run took {meta['wall_s']:.0f} s of wall time after the build, "
+        "references included.",
+        "",
+        source("demo", ["summary.csv", "metrics.csv"]),
+    ])
+
+
+def b_development():
+    rows = read_csv("development", "summary.csv")
+    return "\n".join([means_table("development", rows, None,
+                                  ("psnr", "flip", "temporal_error")),
+                      "", source("development", ["summary.csv"])])
+
+
+def b_validation():
+    rows = read_csv("validation", "summary.csv")
+    methods = present(rows, ["taa", "svgf", "ours", "rae", "oidn", "oidn-aux"])
+    return "\n".join([
+        per_scene_table(rows, methods),
+        "",
+        means_table("validation", rows, None, ("psnr", "flip", "temporal_error")),
+        "",
+        source("validation", ["summary.csv"]),
+    ])
+
+
+def b_static():
+    rows = read_csv("static", "metrics.csv")
+    summ = read_csv("static", "summary.csv")
+    last = max(int(r["frame"]) for r in rows)
+    methods = present(summ, ["ours", "ours-no-prior", "svgf", "taa", "oidn", "oidn-aux"])
+    body = []
+    for s in scenes_of(rows):
+        vals = {r["method"]: num(r["psnr"]) for r in rows
+                if r["scene"] == s and int(r["frame"]) == last}
+        b = best({x: vals.get(x) for x in methods if x in COMPARED}, True)
+        body.append([s] + [bold_if(fmt(vals.get(x), 2),
+                                   x in COMPARED and fmt(vals.get(x), 2) == fmt(b, 2))
+                           for x in methods])
+    # ours only improves: its mean over the second half against the first's.
+    halves = []
+    mid = (last + 1) // 2
+    for s in scenes_of(rows):
+        ours = {int(r["frame"]): num(r["psnr"]) for r in rows
+                if r["scene"] == s and r["method"] == "ours"}
+        early = mean(ours.get(f) for f in range(8, mid))
+        late = mean(ours.get(f) for f in range(mid, last + 1))
+        worst = 0.0
+        top = -1e9
+        for f in range(8, last + 1):
+            v = ours.get(f)
+            if v is None:
+                continue
+            top = max(top, v)
+            worst = min(worst, v - top)
+        halves.append([s, fmt(early, 2), fmt(late, 2), f"{worst:.2f}"])
+    return "\n".join([
+        f"PSNR (dB) at frame {last}:",
+        "",
+        table(["scene"] + [f"`{x}`" for x in methods], body),
+        "",
+        "`ours` over time:",
+        "",
+        table(["scene", f"mean PSNR, frames 8–{mid - 1}", f"frames {mid}–{last}",
+               "worst frame after 8 against the best so far, dB"], halves),
+        "",
+        source("static", ["metrics.csv", "summary.csv"]),
+    ])
+
+
+def order_table(sets):
+    spps = sorted(sets)
+    body = []
+    for scene in scenes_of(sets[spps[0]]):
+        def val(spp, m):
+            for r in sets[spp]:
+                if r["scene"] == scene and r["method"] == m:
+                    return num(r["psnr"])
+            return None
+
+        def diff(a, b):
+            return " / ".join(
+                f"{val(x, a) - val(x, b):+.2f}" if val(x, a) is not None and val(x, b) is not None
+                else "" for x in spps)
+
+        body.append([scene, " / ".join(fmt(val(x, "none"), 1) for x in spps),
+                     diff("wrls-paper", "svgf"), diff("svgf", "taa")])
+    label = " / ".join(str(x) for x in spps)
+    return table(["scene", f"input dB at {label} spp", "`wrls-paper` − `svgf`",
+                  "`svgf` − `taa`"], body)
+
+
+def b_paper():
+    sets = {}
+    for spp in (1, 2, 4):
+        try:
+            sets[spp] = read_csv("paper", f"spp{spp}", "summary.csv")
+        except Missing:
+            pass
+    if 2 not in sets:
+        raise Missing("assets/results/paper/spp2/summary.csv")
+    methods = present(sets[2], ["none", "taa", "svgf", "wrls-paper", "rls-paper", "wrls",
+                                "rls", "rae", "oidn", "ours"])
+    ms = {spp: means(r) for spp, r in sets.items()}
+    body = []
+    for x in methods:
+        body.append([f"`{x}`"] + [fmt(ms[s].get(x, {}).get("psnr"), 2) for s in sorted(sets)]
+                    + [fmt(ms[2][x]["flip"], 4)])
+    return "\n".join([
+        "Mean PSNR (dB) over the five scenes at each noise level, and FLIP at 2 spp:",
+        "",
+        table(["method"] + [f"{s} spp" for s in sorted(sets)] + ["FLIP at 2 spp"], body),
+        "",
+        "PSNR per scene at 2 spp:",
+        "",
+        per_scene_table(sets[2], methods),
+        "",
+        "Where the paper's order holds, per scene and noise level (differences of mean "
+        "PSNR, dB; the paper reports wRLS above SVGF above TAA):",
+        "",
+        order_table(sets),
+        "",
+        source("paper", [f"spp{s}/summary.csv" for s in sorted(sets)]),
+    ])
+
+
+def b_cost():
+    body = []
+    sources = []
+    for name in ("mri-point-light", "phantom-orbit"):
+        try:
+            prof = read_json("cost", f"{name}.json")
+        except Missing:
+            continue
+        sources.append(f"{name}.json")
+        own, shared = {}, {}
+        for p in prof["passes"]:
+            owner = p.get("owner")
+            method = owner.get("method") if isinstance(owner, dict) else None
+            med = num(p.get("median_ms")) or 0.0
+            # The guides composited along the ray are shared: charged to the first method
+            # listed that reads them, they count for neither sum here.
+            if method and p["pass"] != "aux_features":
+                own[method] = own.get(method, 0.0) + med
+            else:
+                shared[p["pass"]] = shared.get(p["pass"], 0.0) + med
+        if "ours" in own and "svgf" in own:
+            body.append([prof.get("scene", name), fmt(own["ours"], 1), fmt(own["svgf"], 1),
+                         f"{own['ours'] / own['svgf']:.2f}×",
+                         fmt(shared.get("surface_features"), 1), fmt(shared.get("aux_features"), 1),
+                         fmt(shared.get("path_trace"), 1)])
+    if not body:
+        raise Missing("assets/results/cost/*.json")
+    return "\n".join([
+        "Medians over the frames of each method's own passes, summed, in ms per frame at "
+        "256×256; the shared passes, which neither sum includes, beside them:",
+        "",
+        table(["scene", "`ours`", "`svgf`", "ours / svgf", "`surface_features`",
+               "`aux_features`", "`path_trace`"], body),
+        "",
+        source("cost", sources),
+    ])
+
+
+def b_rae():
+    rows = read_csv("rae", "summary.csv")
+    methods = present(rows, ["svgf", "ours", "rae-phantom", "rae-mri"])
+    body = []
+    for sc in scenes_of(rows):
+        vals = {r["method"]: r for r in rows if r["scene"] == sc}
+        bp = best({x: num(vals[x]["psnr"]) for x in methods if x in vals}, True)
+        bf = best({x: num(vals[x]["flip"]) for x in methods if x in vals}, False)
+        cells = [sc]
+        for x in methods:
+            p, f = num(vals[x]["psnr"]), num(vals[x]["flip"])
+            cells.append(f"{bold_if(fmt(p, 2), fmt(p, 2) == fmt(bp, 2))} / "
+                         f"{bold_if(fmt(f, 3), fmt(f, 3) == fmt(bf, 3))}")
+        body.append(cells)
+    return "\n".join([
+        "PSNR / FLIP per scene (`cloud` is in neither network's training data):",
+        "",
+        table(["scene"] + [f"`{x}`" for x in methods], body),
+        "",
+        "Means over the scenes:",
+        "",
+        means_table("rae", rows, None, ("psnr", "flip", "temporal_error", "gpu_ms")),
+        "",
+        source("rae", ["summary.csv"]),
+    ])
+
+
+def b_fuzz():
+    rows = read_csv("fuzz", "runs.csv")
+    body = []
+    for r in rows:
+        body.append([f"`{r['target']}`", f"{int(r['execs']):,}", r["crashes"], r["hangs"],
+                     r["ooms"], f"{num(r['seconds']):.0f}", f"{num(r['exec_per_s']):,.0f}",
+                     f"{num(r['peak_rss_mb']):.0f}", r["commit"], r["date"]])
+    machines = sorted({r["machine"] for r in rows})
+    return "\n".join([
+        table(["target", "executions", "crashes", "hangs", "out of memory", "s", "exec/s",
+               "peak RSS MB", "commit", "date"], body),
+        "",
+        "Source: `assets/results/fuzz/runs.csv` (with each run's command); "
+        + "; ".join(f"machine: {m}" for m in machines) + ".",
+    ])
+
+
+def b_rae_training():
+    import glob
+    files = sorted(glob.glob(os.path.join(ROOT, "assets", "rae", "*.json")))
+    if not files:
+        raise Missing("assets/rae/*.json")
+    body = []
+    for f in files:
+        with open(f) as fh:
+            m = json.load(fh)
+        if not m.get("trained"):
+            continue
+        pre = m.get("initialised_from") or {}
+        pt = pre.get("training") or {}
+        t = m["training"]
+        curve = [c["validation"] for c in m.get("validation_curve", []) if c.get("validation") is not None]
+        bestv = min(curve) if curve else None
+        start = curve[0] if curve else None
+        data = m["training_data"]
+        body.append([
+            f"`{m['name']}`", f"{m['parameters']:,}",
+            (f"{pt['iterations']} it. in {pt['seconds']:.0f} s, {pt.get('crop')}² crops"
+             if pt else ""),
+            f"{t['iterations']} it. in {t['seconds']:.0f} s, {t.get('crop')}² crops",
+            f"{fmt(start, 4)} → {fmt(bestv, 4)}",
+            f"{fmt(t.get('final_validation_parts_l1_log_temporal', [None])[0], 4)} / "
+            f"{fmt(t.get('validation_l1_of_noisy_input'), 4)}",
+            f"{data['clips_train']} + {data['clips_validation']}",
+        ])
+    return "\n".join([
+        table(["network", "parameters", "pre-training", "fine-tuning",
+               "validation loss, start → best", "validation L1 (log space), network / noisy input",
+               "clips: training + validation"], body),
+        "",
+        "Source: `assets/rae/<net>.json`, the manifests `tools/rae/train.py` writes beside "
+        "the weights (settings, data hashes and the whole validation curve of each stage).",
+    ])
+
+
+BLOCKS = {
+    "headline": (b_headline, ["suite/summary.csv"]),
+    "suite-means": (b_suite_means, ["suite/summary.csv"]),
+    "suite-scenes": (b_suite_scenes, ["suite/summary.csv"]),
+    "ablations": (b_ablations, ["suite/summary.csv"]),
+    "demo": (b_demo, ["demo/summary.csv"]),
+    "development": (b_development, ["development/summary.csv"]),
+    "validation": (b_validation, ["validation/summary.csv"]),
+    "static": (b_static, ["static/metrics.csv", "static/summary.csv"]),
+    "paper": (b_paper, ["paper/spp{1,2,4}/summary.csv"]),
+    "cost": (b_cost, ["cost/*.json"]),
+    "rae": (b_rae, ["rae/summary.csv"]),
+    "fuzz": (b_fuzz, ["fuzz/runs.csv"]),
+    "rae-training": (b_rae_training, ["../rae/*.json"]),
+}
+
+
+def render(text, where):
+    errors = []
+
+    def sub(m):
+        name = m.group("name")
+        if name not in BLOCKS:
+            errors.append(f"{where}: unknown block results:{name}")
+            return m.group(0)
+        try:
+            body = BLOCKS[name][0]()
+        except Missing as e:
+            errors.append(f"{where}: block results:{name} needs {e}")
+            return m.group(0)
+        return m.group(1) + body.rstrip("\n") + "\n" + m.group(4)
+
+    return BLOCK.sub(sub, text), errors
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--check", action="store_true", help="fail if a page is stale")
+    ap.add_argument("--list", action="store_true", help="list the blocks")
+    args = ap.parse_args()
+    if args.list:
+        for k, (_, files) in BLOCKS.items():
+            print(f"{k}: assets/results/{', assets/results/'.join(files)}")
+        return 0
+    stale, errors, found = [], [], 0
+    for rel in PAGES:
+        p = os.path.join(ROOT, rel)
+        with open(p, encoding="utf-8") as f:
+            text = f.read()
+        found += len(BLOCK.findall(text))
+        new, errs = render(text, rel)
+        errors += errs
+        if new != text:
+            if args.check:
+                stale += [m.group("name") for m, n in zip(BLOCK.finditer(text), BLOCK.finditer(new))
+                          if m.group(0) != n.group(0)]
+                print(f"results: {rel} is stale against its CSVs "
+                      f"(blocks: {', '.join(sorted(set(stale)))}); run tools/results.py",
+                      file=sys.stderr)
+            else:
+                with open(p, "w", encoding="utf-8") as f:
+                    f.write(new)
+                print(f"results: wrote {rel}")
+    for e in errors:
+        print(f"results: {e}", file=sys.stderr)
+    if errors or stale:
+        return 1
+    print(f"results: {found} blocks in {len(PAGES)} pages "
+          f"{'up to date' if args.check else 'rendered'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
