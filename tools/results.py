@@ -495,6 +495,117 @@ def b_rae_training():
     ])
 
 
+def b_viewer():
+    rows = read_csv("viewer", "viewer.csv")
+    body = [[r["size"], f"`{r['denoiser']}`", r["device"], r["render_fps"], r["shown_fps"],
+             f"{r['latency_ms_median']} / {r['latency_ms_max']}",
+             f"{num(r['latency_frames_median']):.1f} / {num(r['latency_frames_max']):.1f}",
+             r["drags"]] for r in rows]
+    r0 = rows[0]
+    lines = [
+        table(["view", "shown", "device", "frames rendered / s", "frames shown / s",
+               "drag → first frame showing it, ms (median / max)", "in frames (median / max)",
+               "drags"], body),
+        "",
+        f"Measured in a real JupyterLab driven by headless Chromium by `{r0['command']}` at "
+        f"commit {r0['commit']} ({r0['date']}) on {r0['machine']}. Source: "
+        "`assets/results/viewer/viewer.csv`.",
+    ]
+    try:
+        gpu = read_csv("gpu", "h200-profile.csv")
+        meta = read_json("gpu", "meta.json")
+    except Missing:
+        return "\n".join(lines)
+    at = [g for g in gpu if g["size"] == "256x256"]
+    total = sum(num(g["mean_ms"]) for g in at)
+    parts = ", ".join(f"`{g['pass']}` {num(g['mean_ms']):.3f}" for g in at)
+    lines += [
+        "",
+        f"On a GPU the device is no longer what limits the view: {meta['machine']} renders "
+        f"a 256×256 frame of `ours` in {total:.2f} ms ({parts}; {meta['command']}, "
+        f"{meta['date']}), so frames reach the page as fast as they are encoded and the "
+        "page shows them. Source: `assets/results/gpu/h200-profile.csv`.",
+    ]
+    return "\n".join(lines)
+
+
+def b_soak():
+    rows = read_csv("soak", "soak.csv")
+    body = [[r["session"], f"{int(r['frames']):,}", r["seconds"],
+             f"{r['rss_warm_mib']} → {r['rss_end_mib']} ({100 * num(r['rss_growth']):+.1f} %)",
+             f"{r['gpu_allocated_warm_mib']} → {r['gpu_allocated_end_mib']}",
+             r["validation_messages"], "yes" if r["passed"] == "True" else "**no**"] for r in rows]
+    r0 = rows[0]
+    return "\n".join([
+        table(["session", "frames", "s", "resident MiB, after warm-up → end", "device MiB allocated",
+               "validation messages", "holds"], body),
+        "",
+        f"Made by `{r0['command']}` at commit {r0['commit']} ({r0['date']}) on {r0['machine']}. "
+        "Source: `assets/results/soak/soak.csv`.",
+    ])
+
+
+def cut_frames(metrics):
+    """Per scene: the closest frame after frame 4 of ours to the better of svgf and taa,
+    as (margin dB, frame)."""
+    by = {}
+    for r in metrics:
+        by.setdefault(r["scene"], {}).setdefault(int(r["frame"]), {})[r["method"]] = num(r["psnr"])
+    out = {}
+    for sc, frames in by.items():
+        worst = None
+        for f, v in sorted(frames.items()):
+            if f <= 4 or "ours" not in v:
+                continue
+            rival = max(v.get("svgf", -math.inf), v.get("taa", -math.inf))
+            margin = v["ours"] - rival
+            if worst is None or margin < worst[0]:
+                worst = (margin, f)
+        out[sc] = worst
+    return out
+
+
+def b_cuts():
+    rows = read_csv("cuts", "summary.csv")
+    metrics = read_csv("cuts", "metrics.csv")
+    methods = present(rows, ["none", "taa", "svgf", "oidn", "oidn-aux", "ours"])
+    worst = cut_frames(metrics)
+    body = []
+    for sc in scenes_of(rows):
+        v = {r["method"]: r for r in rows if r["scene"] == sc}
+        bp = best({x: num(v[x]["psnr"]) for x in methods if x in v}, True)
+        cells = [sc] + [bold_if(fmt(num(v[x]["psnr"]), 2), fmt(num(v[x]["psnr"]), 2) == fmt(bp, 2))
+                        for x in methods]
+        w = worst.get(sc)
+        cells.append(f"{w[0]:+.2f} (frame {w[1]})" if w else "")
+        if "oidn-aux" in v:
+            cells.append(f"{num(v['ours']['psnr']) - num(v['oidn-aux']['psnr']):+.2f}")
+        body.append(cells)
+    header = ["scene"] + [f"`{x}`" for x in methods] + [
+        "ours − max(svgf, taa), closest frame after 4", "ours − oidn-aux, mean"]
+    return "\n".join([
+        "Mean PSNR (dB) per scene, 128×128, 48 frames, 256-spp references:",
+        "",
+        table(header, body),
+        "",
+        source("cuts", ["summary.csv", "metrics.csv"]),
+    ])
+
+
+def b_cut_cost():
+    rows = read_csv("cut-cost", "profile.csv")
+    body = [[r["scene"], r["cut"], r["run"], fmt(num(r["path_trace_ms"]), 1),
+             fmt(num(r["frame_ms"]), 1)] for r in rows]
+    return "\n".join([
+        "Median GPU ms per frame of the path-tracing pass and of the whole frame, the same "
+        "view with and without a plane that removes half the volume, runs alternating:",
+        "",
+        table(["scene", "cut", "run", "`path_trace`", "frame"], body),
+        "",
+        source("cut-cost", ["profile.csv"]),
+    ])
+
+
 BLOCKS = {
     "headline": (b_headline, ["suite/summary.csv"]),
     "suite-means": (b_suite_means, ["suite/summary.csv"]),
@@ -509,6 +620,10 @@ BLOCKS = {
     "rae": (b_rae, ["rae/summary.csv"]),
     "fuzz": (b_fuzz, ["fuzz/runs.csv"]),
     "rae-training": (b_rae_training, ["../rae/*.json"]),
+    "viewer": (b_viewer, ["viewer/viewer.csv", "gpu/h200-profile.csv"]),
+    "soak": (b_soak, ["soak/soak.csv"]),
+    "cuts": (b_cuts, ["cuts/summary.csv", "cuts/metrics.csv"]),
+    "cut-cost": (b_cut_cost, ["cut-cost/profile.csv"]),
 }
 
 

@@ -74,6 +74,7 @@ def main():
     ap.add_argument("--seconds", type=float, default=20.0)
     ap.add_argument("--drags", type=int, default=10)
     ap.add_argument("--out", type=pathlib.Path, required=True)
+    ap.add_argument("--screenshot", type=pathlib.Path, help="a PNG of the notebook with the viewer (the first size)")
     args = ap.parse_args()
     from playwright.sync_api import sync_playwright
 
@@ -96,6 +97,9 @@ def main():
                 nb = Notebook(page, lab, name)
                 nb.run(0)
                 elapsed, rendered, shown, ms, frames = measure(page, nb, args.seconds, args.drags)
+                if args.screenshot and not rows:
+                    page.wait_for_timeout(3000)  # refined after the last drag
+                    page.locator(".jp-Cell").first.screenshot(path=str(args.screenshot))
                 device = nb.run(1).strip().removeprefix("device ").strip()
                 nb.run(2)
                 page.close()
