@@ -173,8 +173,71 @@ pub fn write_atomic(path: &Path, bytes: &[u8], durability: Durability) -> std::i
     result
 }
 
-/// `.<name>.<pid>.<n>.tmp` beside `path`: hidden, unique per process and call, and
-/// never mistaken for an output (caches look for exact names).
+/// Removes, in `dir`, the temporary files of [`write_atomic`] that no writer will
+/// finish: those of a process of this machine that is gone, and any last modified more
+/// than `older_than` ago (a write takes milliseconds, so one that old belongs to no live
+/// writer on any machine sharing the folder). What a writer killed mid-write left is
+/// never read (outputs are read by their exact names) and, after this, not left either.
+/// Returns how many were removed.
+pub fn remove_stale_temporaries(
+    dir: &Path,
+    older_than: std::time::Duration,
+) -> std::io::Result<usize> {
+    let mut removed = 0;
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let name = entry.file_name();
+        let Some((host, pid)) = temporary_writer(&name.to_string_lossy()) else {
+            continue;
+        };
+        let gone = host == this_host() && !Path::new(&format!("/proc/{pid}")).exists();
+        let age = entry.metadata()?.modified()?.elapsed().unwrap_or_default();
+        if (gone || age > older_than) && entry.file_type()?.is_file() {
+            std::fs::remove_file(entry.path())?;
+            removed += 1;
+        }
+    }
+    Ok(removed)
+}
+
+/// The host and process id a temporary name of [`temporary_name`] records.
+fn temporary_writer(name: &str) -> Option<(String, u32)> {
+    let inner = name.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let mut parts = inner.rsplitn(4, '.');
+    let _n: u64 = parts.next()?.parse().ok()?;
+    let pid = parts.next()?.parse().ok()?;
+    let host = parts.next()?.to_string();
+    parts.next()?; // the target's own name
+    Some((host, pid))
+}
+
+/// This machine's name as a temporary name records it: letters, digits and '-'.
+fn this_host() -> &'static str {
+    static HOST: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    HOST.get_or_init(|| {
+        let raw = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap_or_default();
+        let host: String = raw
+            .trim()
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' {
+                    c
+                } else {
+                    '-'
+                }
+            })
+            .collect();
+        if host.is_empty() {
+            "host".into()
+        } else {
+            host
+        }
+    })
+}
+
+/// `.<name>.<host>.<pid>.<n>.tmp` beside `path`: hidden, unique per machine, process
+/// and call, never mistaken for an output (caches look for exact names), and telling
+/// [`remove_stale_temporaries`] whose it is.
 pub fn temporary_name(path: &Path) -> PathBuf {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -182,7 +245,11 @@ pub fn temporary_name(path: &Path) -> PathBuf {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.{n}.tmp", std::process::id()))
+    path.with_file_name(format!(
+        ".{name}.{}.{}.{n}.tmp",
+        this_host(),
+        std::process::id()
+    ))
 }
 
 #[cfg(test)]
@@ -290,5 +357,36 @@ mod tests {
         assert_eq!(read_bounded(&p, 10).expect("fits").len(), 10);
         let err = read_bounded(&p, 9).unwrap_err();
         assert!(err.to_string().contains("10 bytes"), "{err}");
+    }
+
+    #[test]
+    fn temporaries_of_killed_writers_are_removed_and_live_ones_kept() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let d = dir.path();
+        // A writer of this machine that is gone (no such process), one that is alive
+        // (this test), one of another machine written just now, and the same an hour ago.
+        let gone = d.join(format!(".0003.exr.{}.4194300.0.tmp", this_host()));
+        let live = temporary_name(&d.join("0004.exr"));
+        let remote = d.join(".0005.exr.elsewhere.12.0.tmp");
+        let old = d.join(".0006.exr.elsewhere.13.0.tmp");
+        let output = d.join("0007.exr");
+        for p in [&gone, &live, &remote, &old, &output] {
+            std::fs::write(p, b"half a frame").expect("write");
+        }
+        let hour_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+        std::fs::File::options()
+            .write(true)
+            .open(&old)
+            .and_then(|f| f.set_modified(hour_ago))
+            .expect("age");
+        let removed =
+            remove_stale_temporaries(d, std::time::Duration::from_secs(600)).expect("cleared");
+        assert_eq!(removed, 2);
+        assert!(!gone.exists() && !old.exists());
+        assert!(live.exists() && remote.exists() && output.exists());
+        assert_eq!(
+            temporary_writer(&live.file_name().unwrap().to_string_lossy()),
+            Some((this_host().to_string(), std::process::id()))
+        );
     }
 }

@@ -62,8 +62,23 @@ trap '{ray_cli} stop --force >/dev/null 2>&1 || true' EXIT
 {start} --head --port={port} --num-gpus=0 --include-dashboard=false --temp-dir={ray_tmp}
 {start} --address=127.0.0.1:{port} --num-gpus=1
 {start} --address=127.0.0.1:{port} --num-gpus=1
+# What a writer killed mid-write on another machine left in the cache an hour ago.
+mkdir -p {tmp}/farm-ref/reference
+printf 'half a frame' > {tmp}/farm-ref/reference/.0003.exr.elsewhere.4242.0.tmp
+touch -d '1 hour ago' {tmp}/farm-ref/reference/.0003.exr.elsewhere.4242.0.tmp
 DVR_FARM_KILL_ONCE=1:{marker} {farm} reference --shards 4 --dvr {dvr_bin} --summary {tmp}/ref.json -- {q(SCENE)} --out {tmp}/farm-ref
 {farm} eval --shards 3 --dvr {dvr_bin} --summary {tmp}/eval.json -- {q(EVAL)} --out {tmp}/farm-eval
+# The driver killed mid-run (its shards and their dvr processes with it, some perhaps
+# mid-write), then the same job again: it finishes what is missing and no more.
+{farm} reference --shards 4 --dvr {dvr_bin} --summary {tmp}/killed.json -- {q(SCENE)} --out {tmp}/farm-killed &
+driver=$!
+until [ "$(ls {tmp}/farm-killed/reference/*.exr 2>/dev/null | wc -l)" -ge 2 ]; do sleep 0.1; done
+kill -9 $driver
+wait $driver || true
+pkill -9 -f -- '--out {tmp}/farm-killed' || true
+sleep 1
+ls -a {tmp}/farm-killed/reference > {tmp}/killed-left.txt
+{farm} reference --shards 4 --dvr {dvr_bin} --summary {tmp}/rerun.json -- {q(SCENE)} --out {tmp}/farm-killed
 """
     run = subprocess.run(
         in_loopback_namespace() + ["bash", "-c", script], capture_output=True, text=True, timeout=600
@@ -109,6 +124,26 @@ def test_reference_shards_run_on_two_nodes_each_frame_once_and_equal_one_run(far
     assert len(one) == 8 * 2 + 2, sorted(one)  # EXR + PNG a frame, the key, the lock
     assert farmed == one, "the farm's references differ from one run's"
     assert "4/4 shards" in log
+
+
+def test_a_killed_driver_is_rerun_without_redoing_finished_frames(farm_runs):
+    tmp, _, _ = farm_runs
+    left = (tmp / "killed-left.txt").read_text().split()
+    finished = sorted(n for n in left if n.endswith(".exr") and not n.startswith("."))
+    assert len(finished) >= 2, left
+    shards = json.loads((tmp / "rerun.json").read_text())["references"]
+    rendered = sorted(f for s in shards for r in s["report"]["references"] for f in r["rendered"])
+    reused = sorted(f for s in shards for r in s["report"]["references"] for f in r["reused"])
+    assert sorted(rendered + reused) == list(range(8))
+    assert [f"{f:04d}.exr" for f in reused] == finished, (finished, reused)
+    # Whatever the killed writers left is gone, and the frames are one run's.
+    assert files(tmp / "farm-killed" / "reference") == files(tmp / "one-ref" / "reference")
+
+
+def test_a_temporary_a_killed_writer_left_is_removed_not_read(farm_runs):
+    tmp, _, _ = farm_runs
+    left = [p.name for p in (tmp / "farm-ref" / "reference").iterdir() if p.name.endswith(".tmp")]
+    assert not left, left
 
 
 def test_a_shard_whose_worker_was_killed_is_retried(farm_runs):

@@ -26,6 +26,9 @@ use dvr_engine::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+/// Age past which a temporary file in the cache is the leftover of a killed writer.
+const STALE_TEMPORARY: std::time::Duration = std::time::Duration::from_secs(600);
+
 /// What a reference frame depends on. Written before the first frame is rendered, so
 /// frames finished under it are reusable after an interruption.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -414,6 +417,16 @@ impl ReferenceCache {
         };
         lock.lock()
             .with_context(|| format!("locking {}", lock_path.display()))?;
+        // A frame written by a run killed mid-write is only ever a temporary file (the
+        // cache reads exact names): what such runs left is removed here.
+        let stale = dvr_engine::files::remove_stale_temporaries(&self.dir, STALE_TEMPORARY)
+            .with_context(|| format!("clearing {}", self.dir.display()))?;
+        if stale > 0 {
+            log::info!(
+                "{}: removed {stale} temporary file(s) of interrupted writes",
+                self.dir.display()
+            );
+        }
         for path in self.files_named(|n| n.starts_with(".run-") && n.ends_with(".json"))? {
             let Ok(file) = File::open(&path) else {
                 continue; // removed since it was listed: its run ended
