@@ -5,7 +5,7 @@
 # book's results pages and README's headline table from those files.
 #
 #   tools/measure.sh SET [SET ...]     SET: demo static development validation paper
-#                                           suite cost rae
+#                                           suite cost rae cuts cut-cost
 #
 # Needs a release build (cargo build --release). The eval sets also add Intel OIDN with
 # tools/oidn_eval.py, which needs a Python with the dvr package, pyoidn, numpy, OpenEXR
@@ -145,8 +145,47 @@ for set in "$@"; do
       done
       meta cost "$out" "$secs" "dvr profile --scene S --frames 30 --size 256x256 --denoiser ours,svgf --json out/cost/S.json, S = mri/point-light, phantom/orbit"
       ;;
+    cuts)
+      # The cut scenes: three development scenes and the validation scene, at the
+      # validation set's size and reference count.
+      d=assets/scenes/development
+      args=(--scene "$d/mri-clip-sweep.toml,$d/phantom-crop-shrink.toml,$d/phantom-clip-toggle.toml,assets/scenes/validation/cloud-oblique-clip-light.toml"
+        --size 128x128 --frames 48 --ref-spp 256 --aux --denoiser none,taa,svgf,ours)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      oidn "$out"
+      KEEP_METRICS=1 keep cuts "$out"
+      meta cuts "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
+      ;;
+    cut-cost)
+      # The same view with and without a plane that removes half the volume, profiled
+      # alternately (two runs each), so the machine's drift falls on both.
+      mkdir -p "$out"
+      "$dvr" scenes --dump phantom/orbit > "$out/plain.toml"
+      { cat "$out/plain.toml"; printf '\n[[clip]]\npoint = [0.0, 0.0, 0.0]\nnormal = [1.0, 0.0, 0.0]\n'; } > "$out/half.toml"
+      t0=$(date +%s.%N)
+      for run in 1 2; do
+        for cut in plain half; do
+          "$dvr" profile --scene "$out/$cut.toml" --frames 20 --size 256x256 --denoiser ours \
+            --json "$out/$cut-$run.json" >/dev/null
+        done
+      done
+      secs=$(echo "$(date +%s.%N) - $t0" | bc)
+      python3 - "$out" <<'EOF2'
+import csv, json, sys
+out = sys.argv[1]
+with open("assets/results/cut-cost/profile.csv", "w", newline="") as f:
+    w = csv.writer(f)
+    w.writerow(["scene", "cut", "run", "path_trace_ms", "frame_ms"])
+    for run in (1, 2):
+        for cut, what in (("plain", "none"), ("half", "x < 0 removed")):
+            p = json.load(open(f"{out}/{cut}-{run}.json"))
+            pt = next(x["median_ms"] for x in p["passes"] if x["pass"] == "path_trace")
+            w.writerow(["phantom/orbit", what, run, f"{pt:.3f}", f"{p['total']['median_ms']:.3f}"])
+EOF2
+      meta cut-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit with and without [[clip]] point [0,0,0] normal [1,0,0], alternating, two runs each"
+      ;;
     *)
-      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae)" >&2
+      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost)" >&2
       exit 2
       ;;
   esac

@@ -26,7 +26,7 @@ sys.path.insert(0, str(ROOT / "python/tests"))
 from lab import CHROMIUM, Lab, Notebook, write_notebook  # noqa: E402
 
 FIELDS = [
-    "size", "denoiser", "device", "seconds", "frames_rendered", "frames_shown", "render_fps", "shown_fps",
+    "size", "scene", "denoiser", "device", "seconds", "frames_rendered", "frames_shown", "render_fps", "shown_fps",
     "drags", "latency_ms_median", "latency_ms_max", "latency_frames_median", "latency_frames_max",
     "command", "commit", "date", "machine",
 ]
@@ -71,6 +71,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", type=int, nargs="+", default=[256])
     ap.add_argument("--denoiser", default="ours")
+    ap.add_argument("--scene", default="mri/point-light")
     ap.add_argument("--seconds", type=float, default=20.0)
     ap.add_argument("--drags", type=int, default=10)
     ap.add_argument("--out", type=pathlib.Path, required=True)
@@ -89,7 +90,7 @@ def main():
             for size in args.size:
                 name = f"bench{size}.ipynb"
                 write_notebook(root / name, [
-                    f"import dvr\nv = dvr.Viewer('phantom/orbit', size=({size}, {size}), denoisers=[{args.denoiser!r}])\nv",
+                    f"import dvr\nv = dvr.Viewer({args.scene!r}, size=({size}, {size}), denoisers=[{args.denoiser!r}])\nv",
                     "print('device', v.renderer.device)",
                     "v.close()",
                 ])
@@ -104,7 +105,7 @@ def main():
                 nb.run(2)
                 page.close()
                 rows.append({
-                    "size": f"{size}x{size}", "denoiser": args.denoiser, "device": device,
+                    "size": f"{size}x{size}", "scene": args.scene, "denoiser": args.denoiser, "device": device,
                     "seconds": f"{elapsed:.1f}", "frames_rendered": rendered, "frames_shown": shown,
                     "render_fps": f"{rendered / elapsed:.2f}", "shown_fps": f"{shown / elapsed:.2f}",
                     "drags": len(ms), "latency_ms_median": f"{statistics.median(ms):.0f}",

@@ -33,3 +33,27 @@ def no_validation_messages():
     yield
     after = dvr._native.validation_messages()
     assert after == before, f"the Vulkan validation layer reported {after - before} message(s)"
+
+
+@pytest.fixture(scope="session")
+def lab(tmp_path_factory):
+    """A JupyterLab server on loopback for the notebook tests (one for the session: it
+    takes seconds to start)."""
+    from lab import Lab
+
+    root = tmp_path_factory.mktemp("lab")
+    server = Lab(root, root / "jupyter.log")
+    yield server
+    server.stop()
+
+
+@pytest.fixture(scope="session")
+def browser():
+    """Debian's Chromium, headless, driven by Playwright (no browser is downloaded)."""
+    from lab import CHROMIUM
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        yield b
+        b.close()

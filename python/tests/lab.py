@@ -53,7 +53,9 @@ class Lab:
         return f"http://127.0.0.1:{self.port}/api/{path}?token={self.token}"
 
     def url(self, notebook):
-        return f"http://127.0.0.1:{self.port}/lab/tree/{notebook}?token={self.token}"
+        # `reset`: a fresh workspace, so the notebooks an earlier page opened are not
+        # restored beside this one.
+        return f"http://127.0.0.1:{self.port}/lab/tree/{notebook}?reset&token={self.token}"
 
     def kernels(self):
         return json.loads(urllib.request.urlopen(self.api("kernels"), timeout=5).read())

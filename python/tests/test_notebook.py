@@ -8,30 +8,11 @@ import re
 import time
 
 import nbformat
-import pytest
 from nbclient import NotebookClient
 
-from lab import CHROMIUM, Lab, Notebook, image_stats, write_notebook
+from lab import Notebook, image_stats, write_notebook
 
 EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
-
-
-@pytest.fixture(scope="module")
-def lab(tmp_path_factory):
-    root = tmp_path_factory.mktemp("lab")
-    server = Lab(root, root / "jupyter.log")
-    yield server
-    server.stop()
-
-
-@pytest.fixture(scope="module")
-def browser():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
-        yield b
-        b.close()
 
 
 def wait_for(what, predicate, timeout=60):

@@ -3,10 +3,7 @@ and the notebook viewer, each with random edits, hold resident memory within 5 %
 the warm-up and device memory flat, with no validation message. `tools/soak.py` runs
 the long ones (10,000 frames, 30 minutes) and records them."""
 
-import pytest
-
 import soak
-from test_notebook import browser, lab  # noqa: F401  (the module's server and browser)
 
 
 def check(row):
@@ -22,5 +19,5 @@ def test_the_explorer_soaks(dvr_bin):
     check(soak.explorer_session(dvr_bin, frames=300))
 
 
-def test_the_notebook_viewer_soaks(lab, browser):  # noqa: F811
+def test_the_notebook_viewer_soaks(lab, browser):
     check(soak.notebook_session(lab, browser, seconds=60))
