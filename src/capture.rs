@@ -1,13 +1,15 @@
-//! The offscreen commands: capture (sequences), reference (high-sample frames) and the
-//! render loop behind profile.
+//! The offscreen commands: capture (sequences, and the small page beside them),
+//! reference (high-sample frames) and the render loop behind profile.
 
-use crate::eval::reference::{FillReport, ReferenceCache, ReferenceKey};
-use crate::profile::{self, Profile};
+use crate::args::SceneArgs;
+use crate::eval::plan::keys::ReferenceKey;
+use crate::eval::references::fill::FillReport;
+use crate::eval::references::ReferenceCache;
+use crate::profile::{self, PassStats, Profile};
 use crate::progress::{FrameRate, Progress};
 use crate::setup::Setup;
 use crate::shard::{FolderReport, RunReport, ShardArgs};
 use crate::video::{self, Track, VideoArgs};
-use crate::SceneArgs;
 use anyhow::{bail, Context, Result};
 use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png};
@@ -73,7 +75,7 @@ pub fn capture(
         timings.push(done.timings);
     }
     progress.finish();
-    profile::write_json(
+    crate::output::write_json(
         &out.join("timings.json"),
         &serde_json::json!({
             "device": session.ctx().info.name,
@@ -96,7 +98,7 @@ pub fn capture(
     } else {
         Vec::new()
     };
-    crate::setup::write_capture_page(out, &setup, &methods, &passes, &total, &videos)?;
+    write_capture_page(out, &setup, &methods, &passes, &total, &videos)?;
     println!(
         "wrote {} frames × {} method(s) to {} ({:.1} s)",
         setup.frames,
@@ -214,14 +216,14 @@ pub fn profile(
     let (report, window) = run_profile(args, denoisers, Some(&stop))?;
     print!("{}", profile::table(&report));
     if let Some(p) = json {
-        profile::write_json(p, &report)?;
+        crate::output::write_json(p, &report)?;
     }
     if let Some(p) = trace {
         let mut t = profile::chrome_trace(window.frames(), window.first(), &report.frames_note);
         if let Some(why) = &report.interrupted {
             t["metadata"]["interrupted"] = why.clone().into();
         }
-        profile::write_json(p, &t)?;
+        crate::output::write_json(p, &t)?;
     }
     match stop.received() {
         Some(signal) => Err(signal.into()),
@@ -294,4 +296,98 @@ pub fn run_profile(
 /// `capture: frame 12/60 | 3.4 fps`.
 fn frame_status(what: &str, submitted: u32, total: u32, rate: &FrameRate) -> String {
     format!("{what}: frame {submitted}/{total} | {}", rate.text())
+}
+
+/// A small page next to a capture: the last frame of each method, a frame slider, and
+/// the per-pass timing table.
+fn write_capture_page(
+    out: &Path,
+    setup: &Setup,
+    methods: &[String],
+    passes: &[PassStats],
+    total: &PassStats,
+    videos: &[std::path::PathBuf],
+) -> Result<()> {
+    let mut html = String::new();
+    html.push_str("<!doctype html><meta charset=utf-8><title>dvr capture</title>");
+    html.push_str("<style>body{font-family:sans-serif;background:#222;color:#eee}img{image-rendering:pixelated;width:384px}figure{display:inline-block;margin:8px}td,th{padding:2px 10px;text-align:right}</style>");
+    html.push_str(&format!(
+        "<h1>{}</h1><p>{}×{}, {} spp/frame, {} frames</p>",
+        html_escape(&setup.name),
+        setup.width(),
+        setup.height(),
+        setup.settings.spp(),
+        setup.frames
+    ));
+    html.push_str(&format!(
+        "<input id=f type=range min=0 max={} value={} style='width:600px'> frame <span id=n></span><br>",
+        setup.frames.saturating_sub(1),
+        setup.frames.saturating_sub(1)
+    ));
+    for m in methods {
+        let m = html_escape(m);
+        html.push_str(&format!(
+            "<figure><img class=seq data-m='{m}'><figcaption>{m}</figcaption></figure>"
+        ));
+    }
+    if !videos.is_empty() {
+        html.push_str("<h2>Videos</h2><p>");
+        for v in videos.iter().filter_map(|v| v.file_name()) {
+            // Denoiser names and fixed file names, escaped like every string on the page.
+            let name = html_escape(&v.to_string_lossy());
+            html.push_str(&format!("<a href='videos/{name}'>{name}</a> "));
+        }
+        html.push_str(&format!(
+            "</p><video controls loop src='videos/{}' style='max-width:100%'></video>",
+            video::COMPARISON
+        ));
+    }
+    html.push_str(
+        "<h2>GPU time per pass (ms)</h2><table><tr><th>pass<th>mean<th>median<th>p95</tr>",
+    );
+    for p in passes.iter().chain(std::iter::once(total)) {
+        html.push_str(&format!(
+            "<tr><td style=text-align:left>{}<td>{:.3}<td>{:.3}<td>{:.3}</tr>",
+            html_escape(&p.pass),
+            p.mean_ms,
+            p.median_ms,
+            p.p95_ms
+        ));
+    }
+    html.push_str(
+        "</table><script>const f=document.getElementById('f'),n=document.getElementById('n');",
+    );
+    html.push_str("function show(){const i=String(f.value).padStart(4,'0');n.textContent=f.value;for(const im of document.querySelectorAll('img.seq'))im.src=im.dataset.m+'/'+i+'.png';}f.oninput=show;show();</script>");
+    let path = out.join("index.html");
+    crate::output::write_text(&path, &html)
+}
+
+/// Text as HTML that shows exactly it: a scene's `name` is anyone's string, and a name
+/// like `</h1><script>…` must not run in the page.
+fn html_escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::html_escape;
+
+    #[test]
+    fn html_escape_leaves_no_markup() {
+        assert_eq!(
+            html_escape("a</script><script>alert('x')&\""),
+            "a&lt;/script&gt;&lt;script&gt;alert(&#39;x&#39;)&amp;&quot;"
+        );
+    }
 }

@@ -7,8 +7,8 @@
 //! 1024-spp references; anywhere else (lavapipe on a CPU) it is sized for a 2-core
 //! CPU ([`CPU_PRESET`]). The page says which was chosen.
 
+use crate::args::{parse_size, DEFAULT_SCENE};
 use crate::eval::{self, EvalArgs};
-use crate::setup::{parse_size, DEFAULT_SCENE};
 use crate::video::{self, VideoArgs};
 use anyhow::Result;
 use ash::vk;
@@ -24,7 +24,7 @@ pub struct DemoArgs {
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Frames of the animation (default: by device).
-    #[arg(long, value_parser = crate::setup::parse_frames)]
+    #[arg(long, value_parser = crate::args::parse_frames)]
     pub frames: Option<u32>,
     /// Samples per pixel of the references (default: by device; at least 1).
     #[arg(long = "ref-spp", value_parser = clap::value_parser!(u32).range(1..))]
@@ -33,7 +33,7 @@ pub struct DemoArgs {
     #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub volume_size: u32,
     /// Comma-separated denoisers, all fed the same noisy frames.
-    #[arg(long, default_value = "none,taa,svgf,ours,rae", value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
+    #[arg(long, default_value = "none,taa,svgf,ours,rae", value_delimiter = ',', value_parser = crate::args::parse_denoiser)]
     pub denoiser: Vec<String>,
     /// Skip the videos (written by default when ffmpeg is on PATH).
     #[arg(long)]
@@ -125,7 +125,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
         size: chosen.size,
         denoiser: args.denoiser.clone(),
         out: args.out.clone(),
-        render: crate::RenderArgs {
+        render: crate::args::RenderArgs {
             volume_size: args.volume_size,
             ..Default::default()
         },

@@ -5,11 +5,13 @@
 //! plots, HTML), profile (per-pass GPU timing), bench (the one-call GPU benchmark), scenes
 //! (the built-in scenes).
 
+mod args;
 mod bench;
 mod capture;
 mod demo;
 mod eval;
 mod explore;
+mod font;
 mod logger;
 mod output;
 mod profile;
@@ -19,6 +21,7 @@ mod shard;
 mod video;
 
 use anyhow::Result;
+use args::SceneArgs;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 
@@ -34,68 +37,6 @@ struct Cli {
     quiet: bool,
     #[command(subcommand)]
     command: Command,
-}
-
-/// Options shared by every rendering command.
-#[derive(clap::Args, Clone, Debug)]
-pub struct SceneArgs {
-    /// Built-in scene (`dvr scenes` lists them) or a scene TOML file.
-    #[arg(long, default_value = setup::DEFAULT_SCENE)]
-    pub scene: String,
-    /// Frames of the animation to render (default: the scene's own length).
-    #[arg(long, value_parser = crate::setup::parse_frames)]
-    pub frames: Option<u32>,
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "256x256", value_parser = setup::parse_size)]
-    pub size: (u32, u32),
-    #[command(flatten)]
-    pub render: RenderArgs,
-}
-
-/// How every rendering command (and the explorer) renders a scene.
-#[derive(clap::Args, Clone, Debug)]
-pub struct RenderArgs {
-    /// Samples per pixel per frame, 1 to 64; lavapipe takes up to 4 (default: the
-    /// scene's, 2 for built-ins).
-    #[arg(long, value_parser = setup::parse_spp)]
-    pub spp: Option<u32>,
-    /// Edge length of procedural volumes (phantom, cloud), 8 to 4096.
-    #[arg(long, default_value_t = RenderArgs::default().volume_size,
-          value_parser = clap::value_parser!(u32).range(8..=4096))]
-    pub volume_size: u32,
-    /// Position the temporal denoisers reproject with: `features` (opacity-threshold
-    /// surface, or the expected first collision through semi-transparent layers) or
-    /// `first-hit` (the closest first real collision among the frame's samples, the
-    /// paper's choice). References do not depend on it.
-    #[arg(long, default_value_t = RenderArgs::default().motion)]
-    pub motion: dvr_engine::denoise::MotionSource,
-    /// Bytes the volume may take on the device, e.g. `512M`, `2G` (default: the scene's
-    /// `[render] gpu_memory`, else half the device-local heap). A volume past it is paged
-    /// through a brick pool of the bricks the TF makes visible.
-    #[arg(long, value_parser = dvr_engine::scene::parse_gpu_memory)]
-    pub gpu_memory: Option<u64>,
-}
-
-impl RenderArgs {
-    /// `--gpu-memory` into the scene's render settings, where the renderer and the
-    /// OME-Zarr level choice read it.
-    pub fn apply_budget(&self, scene: &mut dvr_engine::scene::Scene) -> anyhow::Result<()> {
-        if let Some(bytes) = self.gpu_memory {
-            scene.render.set_gpu_memory(Some(bytes))?;
-        }
-        Ok(())
-    }
-}
-
-impl Default for RenderArgs {
-    fn default() -> Self {
-        Self {
-            spp: None,
-            volume_size: dvr_engine::renderer::scene_setup::DEFAULT_VOLUME_SIZE,
-            motion: dvr_engine::denoise::MotionSource::Features,
-            gpu_memory: None,
-        }
-    }
 }
 
 #[derive(Subcommand)]
@@ -114,7 +55,7 @@ enum Command {
         #[command(flatten)]
         scene: SceneArgs,
         /// Comma-separated denoisers (the noisy frames are rendered once and fed to all).
-        #[arg(long, default_value = "none,accum", value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
+        #[arg(long, default_value = "none,accum", value_delimiter = ',', value_parser = crate::args::parse_denoiser)]
         denoiser: Vec<String>,
         /// Output folder.
         #[arg(long, default_value = "out/capture")]
@@ -131,7 +72,7 @@ enum Command {
               value_parser = clap::value_parser!(u32).range(1..))]
         ref_spp: u32,
         /// Only the frames from A up to but not including B (`A..B`, 0-based).
-        #[arg(long = "frame-range", value_parser = crate::setup::parse_frame_range)]
+        #[arg(long = "frame-range", value_parser = crate::args::parse_frame_range)]
         frame_range: Option<(u32, u32)>,
         #[command(flatten)]
         shard: shard::ShardArgs,
@@ -146,7 +87,7 @@ enum Command {
     Profile {
         #[command(flatten)]
         scene: SceneArgs,
-        #[arg(long, default_value = "none", value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
+        #[arg(long, default_value = "none", value_delimiter = ',', value_parser = crate::args::parse_denoiser)]
         denoiser: Vec<String>,
         /// Write the statistics (per pass: times, bytes, GB/s, % of the measured peak
         /// bandwidth) and the last 300 frames' raw timings as JSON.

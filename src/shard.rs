@@ -23,7 +23,7 @@ pub struct ShardArgs {
     /// (`$SLURM_ARRAY_TASK_ID/N`, `$JOB_COMPLETION_INDEX/N`). A unit is a reference
     /// frame for `dvr reference` and `dvr eval --references-only`, a scene for `dvr
     /// eval` (then `dvr eval --merge` writes the reports).
-    #[arg(long, value_parser = crate::setup::parse_shard)]
+    #[arg(long, value_parser = crate::args::parse_shard)]
     pub shard: Option<(u32, u32)>,
     /// Render nothing: check that every selected unit is present under these settings
     /// and reads back, name each one that is not, and exit 1 if any is not (a rerun
@@ -78,7 +78,7 @@ impl RunReport {
 
     pub fn write(&self, path: Option<&Path>) -> Result<()> {
         match path {
-            Some(p) => crate::profile::write_json(p, self),
+            Some(p) => crate::output::write_json(p, self),
             None => Ok(()),
         }
     }

@@ -113,7 +113,7 @@ impl Track {
 /// Writes `<out>/videos/<track>.mp4` for every track and `<out>/videos/comparison.mp4`
 /// with all tracks side by side; returns the files written.
 pub fn write_videos(out: &Path, tracks: &[Track], fps: u32) -> Result<Vec<PathBuf>> {
-    crate::eval::init_font()?;
+    crate::font::init_font()?;
     let dir = dir(out);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut written = Vec::new();

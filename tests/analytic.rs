@@ -153,7 +153,7 @@ fn emissive_slab_matches_the_emission_absorption_solution() {
 /// image's centre row sees the horizon (v = 0.5) and the top rows see the sky side.
 #[test]
 fn environment_map_is_z_up_equirectangular() {
-    use dvr_engine::renderer::scene_gpu::EnvironmentUpload;
+    use dvr_engine::renderer::uploads::EnvironmentUpload;
     use dvr_engine::shaders::frame::{ENV_MAP, LIGHT_ENV};
     let (w, h) = (64u32, 32u32);
     // Radiance 1 − v: bright at the zenith (v = 0), dark at the nadir.

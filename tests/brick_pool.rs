@@ -12,7 +12,7 @@
 mod common;
 
 use common::*;
-use dvr_engine::renderer::scene_gpu::{LutUpload, VolumeUpload};
+use dvr_engine::renderer::uploads::{LutUpload, VolumeUpload};
 use dvr_engine::renderer::{FrameInputs, FrameRequest, Renderer, VolumeResidency};
 use dvr_engine::scene::{ClipPlane, Cut};
 use dvr_engine::volume::{Volume, VolumeData};

@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use dvr_engine::renderer::scene_gpu::{LutUpload, VolumeUpload};
+use dvr_engine::renderer::uploads::{LutUpload, VolumeUpload};
 use dvr_engine::renderer::{CameraMatrices, FrameInputs, Renderer};
 use dvr_engine::transfer::TransferFunction;
 use dvr_engine::volume::Volume;
@@ -78,7 +78,7 @@ fn majorant_grid_matches_a_global_majorant_on_odd_sized_volumes() {
             VolumeUpload::from_volume(&Volume::builtin("phantom", 36).expect("phantom"));
         assert_ne!(volume.dims[0] % volume.bricks.brick, 0);
         if global {
-            volume.bricks = dvr_engine::renderer::scene_gpu::BrickRanges {
+            volume.bricks = dvr_engine::renderer::uploads::BrickRanges {
                 brick: 64,
                 grid: [1, 1, 1],
                 min: vec![0.0],

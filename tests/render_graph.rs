@@ -132,7 +132,8 @@ fn new_images_start_at_zero() {
 #[test]
 fn a_volume_past_the_device_limits_is_paged_and_a_mis_sized_one_refused_before_allocation() {
     use dvr_engine::renderer::brick_pool::VolumePath;
-    use dvr_engine::renderer::scene_gpu::{plan_volume, BrickRanges, VolumeFormat, VolumeUpload};
+    use dvr_engine::renderer::scene_gpu::plan_volume;
+    use dvr_engine::renderer::uploads::{BrickRanges, VolumeFormat, VolumeUpload};
     let ctx = context();
     // A header whose bytes are missing: refused, naming the volume, before anything else.
     let huge = VolumeUpload {

@@ -68,7 +68,7 @@ def need(module, pip_name):
 
 
 def dir_name(scene):
-    """dvr's folder name for a scene (src/eval/scenes.rs: dir_name)."""
+    """dvr's folder name for a scene (src/eval/plan/scenes.rs: dir_name)."""
     s = "".join(c if (c.isascii() and c.isalnum()) or c in "-." else "_" for c in scene)
     s = s.strip(".")
     return s or "scene"

@@ -22,8 +22,8 @@ pub type Result<T> = std::result::Result<T, ImageIoError>;
 /// Largest EXR read (pixels of one layer): the largest frame `dvr` renders.
 pub const MAX_EXR_PIXELS: usize = 8192 * 8192;
 
-/// Exposure applied before the tone map for PNGs.
-pub const PNG_EXPOSURE: f32 = 1.0;
+/// Exposure applied before the tone map for PNGs (the metrics score what they show).
+pub const PNG_EXPOSURE: f32 = crate::metrics::DISPLAY_EXPOSURE;
 
 pub fn to_rgb(width: u32, height: u32, rgba: &[[f32; 4]]) -> Rgb32Image {
     Rgb32Image {

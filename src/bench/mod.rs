@@ -16,12 +16,12 @@
 
 mod plots;
 
+use crate::args::{RenderArgs, SceneArgs};
 use crate::capture::run_profile;
 use crate::eval::run::{method_gpu_ms, owned_by};
 use crate::eval::EvalArgs;
 use crate::output::{opt, write_text as write};
 use crate::profile::{self, Profile};
-use crate::SceneArgs;
 use anyhow::{Context, Result};
 use dvr_engine::gpu::timestamps::{gb_per_s, PassTiming};
 use std::fmt::Write as _;
@@ -38,25 +38,25 @@ pub struct BenchArgs {
     pub eval_out: Option<PathBuf>,
     /// Sizes to profile at.
     #[arg(long, default_value = "256x256,1280x720,1920x1080", value_delimiter = ',',
-          value_parser = crate::setup::parse_size)]
+          value_parser = crate::args::parse_size)]
     pub sizes: Vec<(u32, u32)>,
     /// Scene to profile.
-    #[arg(long, default_value = crate::setup::DEFAULT_SCENE)]
+    #[arg(long, default_value = crate::args::DEFAULT_SCENE)]
     pub scene: String,
     /// Frames per profile.
-    #[arg(long, default_value_t = 60, value_parser = crate::setup::parse_frames)]
+    #[arg(long, default_value_t = 60, value_parser = crate::args::parse_frames)]
     pub frames: u32,
     /// Denoisers to profile and evaluate (default: every one).
-    #[arg(long, value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
+    #[arg(long, value_delimiter = ',', value_parser = crate::args::parse_denoiser)]
     pub denoiser: Vec<String>,
     /// Scenes of the eval (`suite`, `stress` or a list).
     #[arg(long, default_value = "suite")]
     pub eval_scene: String,
     /// Image size of the eval.
-    #[arg(long, default_value = "256x256", value_parser = crate::setup::parse_size)]
+    #[arg(long, default_value = "256x256", value_parser = crate::args::parse_size)]
     pub eval_size: (u32, u32),
     /// Frames of each eval scene (default: each scene's own length).
-    #[arg(long, value_parser = crate::setup::parse_frames)]
+    #[arg(long, value_parser = crate::args::parse_frames)]
     pub eval_frames: Option<u32>,
     /// Samples per pixel of the eval's references (at least 1).
     #[arg(long = "ref-spp", default_value_t = 1024,
@@ -89,7 +89,7 @@ struct EvalRecord<'a> {
     size: String,
     ref_spp: u32,
     frames: Option<u32>,
-    timing: crate::eval::timing::Outcome,
+    timing: crate::eval::run::timing::Outcome,
     /// Eval wall time over the GPU time it spends (the goal is at most 1.5).
     wall_over_gpu: f64,
 }
@@ -107,7 +107,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         args.denoiser.clone()
     };
     // Fail before the long part, not after: the plots need a font.
-    crate::eval::plots::init_font()?;
+    crate::font::init_font()?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let started = Instant::now();
@@ -118,14 +118,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             scene: args.scene.clone(),
             frames: Some(args.frames),
             size,
-            render: crate::RenderArgs {
+            render: RenderArgs {
                 volume_size: args.volume_size,
                 ..Default::default()
             },
         };
         let (report, _) = run_profile(&scene, &denoisers, None)?;
         let stem = args.out.join(format!("profile_{}", size_name(size)));
-        profile::write_json(&stem.with_extension("json"), &report)?;
+        crate::output::write_json(&stem.with_extension("json"), &report)?;
         plots::pass_chart(&report, &stem)?;
         print!("{}", profile::table(&report));
         profiles.push(report);
@@ -150,7 +150,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         profile_seconds,
         eval,
     };
-    profile::write_json(&args.out.join("bench.json"), &record)?;
+    crate::output::write_json(&args.out.join("bench.json"), &record)?;
     println!(
         "bench: wrote {} in {:.0} s",
         args.out.display(),
@@ -173,7 +173,7 @@ fn run_eval<'a>(args: &'a BenchArgs, denoisers: &[String]) -> Result<EvalRecord<
         size: args.eval_size,
         denoiser: denoisers.to_vec(),
         out: eval_out.clone(),
-        render: crate::RenderArgs {
+        render: RenderArgs {
             volume_size: args.volume_size,
             ..Default::default()
         },

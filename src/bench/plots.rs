@@ -3,7 +3,7 @@
 //! the time and its passes' share of the measured peak bandwidth.
 
 use super::method_rows;
-use crate::eval::plots::{method_colour, save, Chart};
+use crate::eval::report::plots::{method_colour, save, Chart};
 use crate::profile::Profile;
 use anyhow::Result;
 use plotters::coord::Shift;

@@ -1,35 +1,20 @@
 //! An eval split over machines (see [`crate::shard`]): the references alone
 //! (`--references-only`, a unit per frame), the check that every unit is done
 //! (`--verify`), and the reports written from scenes evaluated by shards (`--merge`).
+//!
+//! The eval's top layer: it drives the layers below (plan, references, results, run)
+//! as the command does, and nothing below imports it.
 
-use super::record::{self, ResultKey};
-use super::run::{scene_args, Plan, PlannedScene, ReferenceProgress, SceneResult};
-use super::timing::Timing;
-use super::EvalArgs;
+use super::plan::settings::{scene_args, EvalArgs};
+use super::plan::Plan;
+use super::references::ReferenceCache;
+use super::results::{record, SceneResult};
+use super::run::timing::Timing;
+use super::run::ReferenceProgress;
 use crate::setup::Setup;
 use crate::shard::{FolderReport, RunReport, ShardArgs};
 use anyhow::{Context, Result};
 use std::sync::Arc;
-
-#[derive(clap::Args, Clone, Debug, Default)]
-pub struct FarmArgs {
-    #[command(flatten)]
-    pub shard: ShardArgs,
-    /// Render the references only (into `<out>/<scene>/reference/`, where an eval with
-    /// the same options reuses them); with --shard, a unit is one frame of one scene.
-    #[arg(long, conflicts_with = "merge")]
-    pub references_only: bool,
-    /// Write metrics.csv, summary.csv, the plots and the page from every scene's
-    /// `result.json` (left by `--shard` runs), as one run writes them; fails, naming
-    /// each, when a scene's result is missing or was made under other settings.
-    #[arg(long, conflicts_with = "shard")]
-    pub merge: bool,
-}
-
-/// The key a scene's `result.json` must carry for this eval.
-pub fn result_key(args: &EvalArgs, methods: &[String], scene: &PlannedScene) -> ResultKey {
-    ResultKey::new(args, methods, scene.spp, &scene.references)
-}
 
 /// The reference frames of this shard, numbered over all scenes in order.
 fn reference_units(plan: &Plan, shard: &ShardArgs) -> Vec<Vec<u32>> {
@@ -56,7 +41,7 @@ pub fn references(args: &EvalArgs, plan: &Plan, timing: &Arc<Timing>) -> Result<
             .scenes
             .iter()
             .zip(&units)
-            .flat_map(|(s, frames)| s.references.problems(frames))
+            .flat_map(|(s, frames)| ReferenceCache::of(s).problems(frames))
             .collect();
         let checked = units.iter().map(Vec::len).sum();
         return crate::shard::verdict("reference frames", checked, &problems);
@@ -69,7 +54,7 @@ pub fn references(args: &EvalArgs, plan: &Plan, timing: &Arc<Timing>) -> Result<
         // A scene with none of this shard's frames is not read back at all.
         .filter(|(_, frames)| !frames.is_empty())
         .map(|(s, frames)| {
-            let m = s.references.missing();
+            let m = ReferenceCache::of(s).missing();
             frames.iter().filter(|f| m.contains(f)).count()
         })
         .sum();
@@ -82,8 +67,8 @@ pub fn references(args: &EvalArgs, plan: &Plan, timing: &Arc<Timing>) -> Result<
         let label = format!("[{}/{}] {}", i + 1, plan.scenes.len(), scene.name);
         progress.show(&format!("{label} | loading"));
         let setup = Setup::new(&scene_args(args, &scene.spec))?;
-        let filled = scene
-            .references
+        let references = ReferenceCache::of(scene);
+        let filled = references
             .fill_frames(
                 &setup,
                 &mut ReferenceProgress {
@@ -98,7 +83,7 @@ pub fn references(args: &EvalArgs, plan: &Plan, timing: &Arc<Timing>) -> Result<
             .with_context(|| format!("rendering the references of {}", scene.name))?;
         report.references.push(FolderReport {
             scene: scene.name.clone(),
-            folder: scene.references.dir.clone(),
+            folder: references.dir.clone(),
             selected: frames.clone(),
             rendered: filled.rendered,
             reused: filled.reused,
@@ -134,8 +119,8 @@ pub fn verify(args: &EvalArgs, plan: &Plan, methods: &[String]) -> Result<()> {
     {
         checked += 1;
         let frames: Vec<u32> = (0..scene.frames).collect();
-        problems.extend(scene.references.problems(&frames));
-        if let Err(p) = record::load(&scene.dir, &result_key(args, methods, scene)) {
+        problems.extend(ReferenceCache::of(scene).problems(&frames));
+        if let Err(p) = record::load(&scene.dir, &scene.result_key(args, methods)) {
             problems.push(p);
         }
     }
@@ -153,7 +138,7 @@ pub fn results(
     let mut problems = Vec::new();
     let mut seconds = 0.0;
     for scene in &plan.scenes {
-        match record::load(&scene.dir, &result_key(args, methods, scene)) {
+        match record::load(&scene.dir, &scene.result_key(args, methods)) {
             Ok((r, s)) => {
                 results.push(r);
                 seconds += s;

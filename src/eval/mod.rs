@@ -5,7 +5,7 @@
 //! `DIR/<scene>/reference/`, reused when the settings match), then one renderer with all
 //! denoisers renders each noisy frame once and feeds it to every method; each method's
 //! HDR output is tone-mapped with [`tonemap_srgb`](dvr_engine::metrics::tonemap_srgb)
-//! (exposure [`EXPOSURE`]) and scored against the tone-mapped reference (PSNR, SSIM,
+//! (exposure [`EXPOSURE`](plan::settings::EXPOSURE)) and scored against the tone-mapped reference (PSNR, SSIM,
 //! FLIP, temporal error), and its GPU time is the shared passes plus its own. A plain
 //! accumulation baseline at 1, 2, 4, … spp on a few frames gives the speed-vs-accuracy
 //! curve. Outputs (see the book's evaluation page):
@@ -24,83 +24,35 @@
 //! DIR/<scene>/aux/NNNN_{albedo,normal}.exr  with --aux: guide images for OIDN
 //! ```
 //!
-//! One file per responsibility: [`scenes`] (which scenes, folder names, the event frame),
-//! [`reference`] (the cache), [`run`] (the frame loop), [`record`] (each scene's
-//! `result.json`), [`farm`] (shards, `--references-only`, `--verify`, `--merge`), [`score`] (metrics of one frame),
-//! [`baseline`], [`csv`], [`plots`], [`html`]; progress lines come from
-//! [`crate::progress`].
+//! A one-way pipeline of layers, each importing only those below it:
+//!
+//! ```text
+//! farm          --references-only, --verify, --merge: the eval split over machines
+//! report        csv, plots, html (+ page.html), videos: written from results and scores
+//! run | scores  the frames of a scene, scored | the means and recoveries of the results
+//! references | results   the reference cache | what a scene produced, its result.json
+//! plan          settings (the options), scenes, keys: what runs, under which keys
+//! ```
+//!
+//! This file drives them in order (plan → references → run → scores → reports); progress
+//! lines come from [`crate::progress`], shards from [`crate::shard`].
 
-mod baseline;
-mod csv;
 mod farm;
-mod html;
-mod images;
-mod overlap;
-pub mod plots;
-mod record;
-pub(crate) mod reference;
+pub mod plan;
+pub mod references;
+pub mod report;
+pub mod results;
 pub mod run;
-mod scenes;
-pub mod timing;
-mod videos;
+pub mod scores;
 
-pub use plots::init_font;
+pub use plan::settings::EvalArgs;
 
 use anyhow::{Context, Result};
-use std::path::PathBuf;
+use plan::scenes;
+use plan::Plan;
+use results::record;
+use run::timing;
 use std::time::Instant;
-
-/// Exposure of the tone map every metric and PNG of an eval uses: the PNGs' own, so
-/// what is measured is what is shown (and what `dvr.metrics` in Python measures).
-pub const EXPOSURE: f32 = dvr_engine::image_io::PNG_EXPOSURE;
-
-/// A method's PSNR must come back within this many dB of its level before a sudden
-/// change for the change to count as recovered from.
-pub const RECOVERY_TOLERANCE_DB: f64 = 1.0;
-
-/// Frames left out of the mean GPU time: the first dispatches include driver
-/// compilation (see [`crate::profile::WARMUP_FRAMES`]).
-pub const GPU_WARMUP_FRAMES: usize = crate::profile::WARMUP_FRAMES;
-
-#[derive(clap::Args, Clone, Debug)]
-pub struct EvalArgs {
-    /// `suite` (every built-in scene but the stress ones), `stress` (the tf-jump,
-    /// light-jump and fast-orbit scenes), a shipped set (`validation`, `development`,
-    /// `static`, `paper`: `assets/scenes/<set>/`), or a comma-separated list of these,
-    /// built-in scene names and scene files.
-    #[arg(long, default_value = "suite")]
-    pub scene: String,
-    /// Frames of each animation (default: each scene's own length).
-    #[arg(long, value_parser = crate::setup::parse_frames)]
-    pub frames: Option<u32>,
-    /// Samples per pixel of the references (at least 1).
-    #[arg(long = "ref-spp", default_value_t = 1024,
-          value_parser = clap::value_parser!(u32).range(1..))]
-    pub ref_spp: u32,
-    /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "256x256", value_parser = crate::setup::parse_size)]
-    pub size: (u32, u32),
-    /// Comma-separated denoisers, all fed the same noisy frames.
-    #[arg(long, default_value = "none,accum,ours", value_delimiter = ',', value_parser = crate::setup::parse_denoiser)]
-    pub denoiser: Vec<String>,
-    /// Output folder (references in it are reused when their settings match).
-    #[arg(long, default_value = "out/eval")]
-    pub out: PathBuf,
-    #[command(flatten)]
-    pub render: crate::RenderArgs,
-    #[command(flatten)]
-    pub video: crate::video::VideoArgs,
-    /// Also write each frame's guide images for single-frame denoisers
-    /// (`<scene>/aux/NNNN_albedo.exr`, `NNNN_normal.exr`: the TF albedo and gradient
-    /// normal composited along the ray, what `tools/oidn_eval.py` gives OIDN).
-    #[arg(long)]
-    pub aux: bool,
-    /// A paragraph shown at the top of the results page (what was run, and why).
-    #[arg(long)]
-    pub note: Option<String>,
-    #[command(flatten)]
-    pub farm: farm::FarmArgs,
-}
 
 /// Runs the eval; returns where its time went.
 pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
@@ -110,7 +62,7 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     // and a parameter override must be in range.
     dvr_engine::denoise::check_env_overrides()?;
     let names = scenes::select(&args.scene)?;
-    let plan = run::Plan::new(args, &names, &methods)?;
+    let plan = Plan::new(args, &names, &methods)?;
     let timing = timing::Timing::shared();
     let farm = &args.farm;
     if farm.references_only {
@@ -121,12 +73,12 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
         farm::verify(args, &plan, &methods)?;
         return Ok(timing.outcome(started.elapsed()));
     }
-    plots::init_font()?;
+    crate::font::init_font()?;
     if farm.merge {
         let (results, seconds) = farm::results(args, &plan, &methods)?;
         let device = results.last().map(|r| r.device.clone()).unwrap_or_default();
-        write_reports(args, &methods, &results, &device, seconds)?;
-        print_summary(args, &methods, &results, seconds);
+        report::write(args, &methods, &results, &device, seconds)?;
+        report::print_summary(args, &methods, &results, seconds);
         return Ok(timing.outcome(started.elapsed()));
     }
     if args.video.video {
@@ -134,8 +86,8 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     }
     crate::setup::create_out_dir(&args.out)?;
     let take = |i: usize| farm.shard.takes(i);
-    let mut progress = crate::progress::Progress::new(plan.total_units(take));
-    let mut report = crate::shard::RunReport::new(&farm.shard);
+    let mut progress = crate::progress::Progress::new(run::total_units(&plan, take));
+    let mut run_report = crate::shard::RunReport::new(&farm.shard);
     let mut results = Vec::new();
     let mut device = String::new();
     for (i, scene) in plan.scenes.iter().enumerate().filter(|(i, _)| take(*i)) {
@@ -148,32 +100,32 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
             &label,
             &mut progress,
             &timing,
-            &mut report,
+            &mut run_report,
         )
         .with_context(|| format!("evaluating {}", scene.name))?;
         device.clone_from(&r.device);
         timing.reports.time(|| -> Result<()> {
             record::save(
                 &scene.dir,
-                &farm::result_key(args, &methods, scene),
+                &scene.result_key(args, &methods),
                 scene_started.elapsed().as_secs_f64(),
                 &r,
             )?;
-            report.scenes.push(r.name.clone());
-            report.write(farm.shard.report.as_deref())?;
-            plots::scene_plots(&args.out, &r)?;
+            run_report.scenes.push(r.name.clone());
+            run_report.write(farm.shard.report.as_deref())?;
+            report::plots::scene_plots(&args.out, &r)?;
             if args.video.video {
                 progress.newline();
                 let dir = crate::video::dir(&args.out.join(&r.dir));
                 eprintln!("{label}: writing videos to {}", dir.display());
-                videos::write_scene_videos(&args.out, &r, args.video.video_fps)?;
+                report::videos::write_scene_videos(&args.out, &r, args.video.video_fps)?;
             }
             results.push(r);
             // Everything is rewritten after each scene, so an interrupted eval leaves a
             // consistent report of the scenes it finished. A shard leaves the reports
             // to `--merge`.
             if farm.shard.shard.is_none() {
-                write_reports(
+                report::write(
                     args,
                     &methods,
                     &results,
@@ -185,7 +137,7 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
         })?;
     }
     progress.finish();
-    report.write(farm.shard.report.as_deref())?;
+    run_report.write(farm.shard.report.as_deref())?;
     if let Some(shard) = farm.shard.label() {
         println!(
             "eval: shard {shard} evaluated {} of {} scene(s) into {}; when every shard has \
@@ -195,46 +147,9 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
             args.out.display()
         );
     } else {
-        print_summary(args, &methods, &results, started.elapsed().as_secs_f64());
+        report::print_summary(args, &methods, &results, started.elapsed().as_secs_f64());
     }
     let wall = started.elapsed();
     eprintln!("{}", timing.summary(wall));
     Ok(timing.outcome(wall))
-}
-
-fn print_summary(args: &EvalArgs, methods: &[String], results: &[run::SceneResult], seconds: f64) {
-    let overall = csv::overall_summary(results, methods);
-    print!("{}", csv::summary_table(results, &overall));
-    println!(
-        "eval: {} scene(s) × {} method(s) in {seconds:.1} s; open {}",
-        results.len(),
-        methods.len(),
-        args.out.join("index.html").display()
-    );
-}
-
-fn write_reports(
-    args: &EvalArgs,
-    methods: &[String],
-    results: &[run::SceneResult],
-    device: &str,
-    seconds: f64,
-) -> Result<()> {
-    let out = &args.out;
-    csv::write_metrics(&out.join("metrics.csv"), results)?;
-    csv::write_summary(&out.join("summary.csv"), results)?;
-    csv::write_baseline(&out.join("baseline.csv"), results)?;
-    let overall = csv::overall_summary(results, methods);
-    plots::overall_plot(out, results, &overall)?;
-    html::write_page(
-        &out.join("index.html"),
-        &html::PageInfo {
-            args,
-            methods,
-            device,
-            seconds,
-        },
-        results,
-        &overall,
-    )
 }

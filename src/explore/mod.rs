@@ -34,7 +34,6 @@ mod tf_editor;
 mod ui;
 mod window;
 
-use crate::setup;
 use anyhow::{bail, Context, Result};
 use ash::vk;
 use dvr_engine::denoise::registry;
@@ -75,17 +74,17 @@ const HISTOGRAM_BINS: usize = 128;
 pub struct ExploreArgs {
     /// Built-in scene (`dvr scenes` lists them) or a scene TOML file; its camera,
     /// lights, TF and render settings at frame 0 are the starting point.
-    #[arg(long, default_value = setup::DEFAULT_SCENE)]
+    #[arg(long, default_value = crate::args::DEFAULT_SCENE)]
     pub scene: String,
     /// A volume file (NRRD, NIfTI, DICOM folder, raw with sidecar, OME-Zarr image,
     /// OME-TIFF stack) to explore instead of the scene's.
     #[arg(long)]
     pub volume: Option<PathBuf>,
     /// Size of the rendered view, WIDTHxHEIGHT (the window adds the panel's width).
-    #[arg(long, default_value = "512x512", value_parser = setup::parse_size)]
+    #[arg(long, default_value = "512x512", value_parser = crate::args::parse_size)]
     pub size: (u32, u32),
     /// Denoiser shown; `A,B` starts in a split view of A (left) and B (right).
-    #[arg(long, default_value = "ours", value_parser = setup::parse_view_denoisers)]
+    #[arg(long, default_value = "ours", value_parser = crate::args::parse_view_denoisers)]
     pub denoiser: String,
     /// Exit after this many frames.
     #[arg(long)]
@@ -109,7 +108,7 @@ pub struct ExploreArgs {
     #[arg(long, default_value_t = 100.0, value_parser = parse_moving_ms)]
     pub moving_ms: f32,
     #[command(flatten)]
-    pub render: crate::RenderArgs,
+    pub render: crate::args::RenderArgs,
 }
 
 /// `--moving-ms`: a finite number of milliseconds, 0 or more.
@@ -130,7 +129,7 @@ fn has_display() -> bool {
 }
 
 pub fn run(args: ExploreArgs) -> Result<()> {
-    // Checked names (setup::parse_view_denoisers): one, or two for a split view.
+    // Checked names (args::parse_view_denoisers): one, or two for a split view.
     let names: Vec<String> = args.denoiser.split(',').map(str::to_string).collect();
     let script = match &args.script {
         Some(s) => Script::parse(s).context("--script")?,

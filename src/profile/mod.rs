@@ -9,13 +9,11 @@
 pub mod interrupt;
 pub mod stats;
 
-use anyhow::Result;
 use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::passes::bandwidth::PeakBandwidth;
 use serde::Serialize;
 pub use stats::{aggregate, PassStats, Stats, WARMUP_FRAMES};
 use std::collections::VecDeque;
-use std::path::Path;
 
 /// Frames whose raw timings a profile keeps for its JSON and trace: the most recent, so
 /// a long run shows its steady state; older frames only count in the statistics.
@@ -221,10 +219,6 @@ pub fn chrome_trace<'a>(
         "displayTimeUnit": "ms",
         "metadata": { "process": "dvr GPU", "frames": note },
     })
-}
-
-pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
-    crate::output::write_text(path, &serde_json::to_string_pretty(value)?)
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ pub mod eval;
 
 use dvr_engine::gpu::{validation, GpuContext};
 use dvr_engine::graph::Extent;
-use dvr_engine::renderer::scene_gpu::{BrickRanges, LutUpload, VolumeFormat, VolumeUpload};
+use dvr_engine::renderer::uploads::{BrickRanges, LutUpload, VolumeFormat, VolumeUpload};
 use dvr_engine::renderer::{CameraMatrices, FrameInputs, Renderer, RendererConfig};
 use dvr_engine::scene::RenderSettings;
 use dvr_engine::shaders::frame::{GpuLight, ENV_CONSTANT, LIGHT_ENV, LIGHT_POINT};
@@ -113,7 +113,7 @@ pub fn renderer_with(
     ctx: GpuContext,
     s: TestSettings,
     v: &VolumeUpload,
-    environment: Option<&dvr_engine::renderer::scene_gpu::EnvironmentUpload>,
+    environment: Option<&dvr_engine::renderer::uploads::EnvironmentUpload>,
     denoisers: &[&str],
 ) -> Renderer {
     Renderer::new(

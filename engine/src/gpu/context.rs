@@ -299,6 +299,18 @@ impl GpuContext {
     }
 }
 
+/// Names an object for validation messages and GPU captures.
+pub fn set_name<H: vk::Handle>(ctx: &GpuContext, handle: H, name: &str) {
+    if let (Some(du), Ok(cname)) = (&ctx.debug_utils, std::ffi::CString::new(name)) {
+        let info = vk::DebugUtilsObjectNameInfoEXT::default()
+            .object_handle(handle)
+            .object_name(&cname);
+        unsafe {
+            let _ = du.set_debug_utils_object_name(&info);
+        }
+    }
+}
+
 impl Drop for GpuContext {
     fn drop(&mut self) {
         unsafe {

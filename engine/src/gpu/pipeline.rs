@@ -171,7 +171,7 @@ impl ComputePipeline {
             call: "vkCreateComputePipelines",
             result: e,
         })?[0];
-        super::resources::set_name(ctx, pipeline, shader);
+        super::context::set_name(ctx, pipeline, shader);
         Ok(Self {
             name: shader.into(),
             pipeline,

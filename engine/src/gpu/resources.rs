@@ -1,7 +1,7 @@
 //! GPU images and buffers backed by gpu-allocator. These are plain resources: who may
 //! access them when, and in which layout, is the render graph's business.
 
-use super::context::GpuContext;
+use super::context::{set_name, GpuContext};
 use crate::error::{EngineError, Result, VkContext};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
@@ -297,16 +297,4 @@ fn allocate(
             what: format!("{name:?} ({} bytes)", requirements.size),
             source,
         })
-}
-
-/// Names an object for validation messages and GPU captures.
-pub fn set_name<H: vk::Handle>(ctx: &GpuContext, handle: H, name: &str) {
-    if let (Some(du), Ok(cname)) = (&ctx.debug_utils, std::ffi::CString::new(name)) {
-        let info = vk::DebugUtilsObjectNameInfoEXT::default()
-            .object_handle(handle)
-            .object_name(&cname);
-        unsafe {
-            let _ = du.set_debug_utils_object_name(&info);
-        }
-    }
 }

@@ -292,7 +292,7 @@ impl Swapchain {
                 .subresource_range(super::resources::color_range());
             let view = unsafe { ctx.device.create_image_view(&view_info, None) }
                 .vk("vkCreateImageView")?;
-            super::resources::set_name(ctx, image, &format!("swapchain.{i}"));
+            super::context::set_name(ctx, image, &format!("swapchain.{i}"));
             self.views.push(view);
             self.rendered.push(semaphore(ctx)?);
         }

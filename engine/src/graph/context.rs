@@ -1,8 +1,7 @@
 //! What a pass sees while it records: its declared resources and nothing else.
 
 use super::access::Access;
-use super::frame::Bound;
-use super::resources::{BufferHandle, ImageHandle, Res};
+use super::resources::{Bound, BufferHandle, ImageHandle, Res};
 use super::RenderGraph;
 use crate::error::{EngineError, Result};
 use crate::gpu::{ComputePipeline, GpuContext, Pipeline};

@@ -10,23 +10,13 @@
 
 use super::access::Access;
 use super::context::PassContext;
-use super::resources::{BufferHandle, Extent, ImageHandle, Res};
+use super::resources::{Bound, BufferHandle, Extent, ImageHandle, Res};
 use crate::error::Result;
 use crate::gpu::timestamps::PassOwner;
 use crate::gpu::Pipeline;
 use crate::shaders::GpuBlock;
 
 type RecordFn<'f> = Box<dyn FnOnce(&mut PassContext) -> Result<()> + 'f>;
-
-/// A resource bound to a shader variable of a pass.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Bound {
-    /// The variable's name in the shader.
-    pub var: &'static str,
-    pub res: Res,
-    /// Sampled with the nearest (not the linear) clamp sampler.
-    pub nearest: bool,
-}
 
 /// One declared pass of the frame being built.
 pub(crate) struct Pass<'f> {

@@ -1,4 +1,4 @@
-//! Handles and slots of graph resources.
+//! Handles and slots of graph resources, and a resource bound to a shader variable.
 
 use super::access::ResourceState;
 use crate::gpu::{GpuBuffer, GpuImage};
@@ -27,6 +27,16 @@ impl From<BufferHandle> for Res {
     fn from(h: BufferHandle) -> Self {
         Res::Buffer(h)
     }
+}
+
+/// A resource bound to a shader variable of a pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Bound {
+    /// The variable's name in the shader.
+    pub var: &'static str,
+    pub res: Res,
+    /// Sampled with the nearest (not the linear) clamp sampler.
+    pub nearest: bool,
 }
 
 /// Image size of a frame.

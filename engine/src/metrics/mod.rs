@@ -37,7 +37,7 @@ pub use recovery::{frames_to_recover, RECOVERY_BASELINE_FRAMES};
 pub use score::{display, score, FrameReference, Scores};
 pub use ssim::ssim;
 pub use temporal::temporal_error;
-pub use tonemap::tonemap_srgb;
+pub use tonemap::{tonemap_srgb, DISPLAY_EXPOSURE};
 
 /// A three-channel `f32` image: linear HDR radiance as rendered, or sRGB-encoded
 /// display values in `[0,1]` after [`tonemap_srgb`] (the type does not say which; the

@@ -2,10 +2,10 @@
 //! sRGB display values (the same tone map and exposure as the PNGs): what `dvr eval`
 //! reports and what the Python package's `dvr.metrics` computes.
 
+use super::DISPLAY_EXPOSURE as EXPOSURE;
 use super::{
     psnr, ssim, temporal_error, tonemap_srgb, FlipReference, Rgb32Image, DEFAULT_PPD, PSNR_CAP,
 };
-use crate::image_io::PNG_EXPOSURE as EXPOSURE;
 
 /// A reference frame prepared for scoring every method against it.
 pub struct FrameReference {

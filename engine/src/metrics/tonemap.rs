@@ -2,6 +2,10 @@
 
 use super::Rgb32Image;
 
+/// The exposure every frame is tone-mapped at where it is shown or scored: the PNGs'
+/// (`image_io::PNG_EXPOSURE`) and so the metrics'.
+pub const DISPLAY_EXPOSURE: f32 = 1.0;
+
 /// Tone-maps linear HDR radiance to sRGB-encoded display values in `[0,1]`.
 ///
 /// Per channel `c`:

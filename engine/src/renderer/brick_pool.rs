@@ -13,7 +13,7 @@
 //! edge as the dense texture's sampler clamps. So a resident brick's samples are the
 //! dense texture's, up to the rounding of a different texture coordinate.
 
-use super::scene_gpu::{BrickRanges, VolumeFormat, VolumeUpload};
+use super::uploads::{BrickRanges, VolumeFormat, VolumeUpload};
 use crate::bytes::human_bytes;
 
 /// Interior edge of a pool brick in voxels: a multiple of the majorant grid's brick, so a
@@ -175,90 +175,6 @@ pub fn write_brick(v: &VolumeUpload, b: [u32; 3], out: &mut [u8]) {
     );
 }
 
-/// Writes the `size` block of `bytes` (a dense `dims` volume of `bpp`-byte voxels, x
-/// fastest) starting at `origin` into `out`, reading the nearest edge voxel outside the
-/// volume as a clamp-to-edge sampler does. Rows are copied whole where they lie inside.
-pub fn fill_clamped(
-    bytes: &[u8],
-    dims: [u32; 3],
-    bpp: usize,
-    origin: [i64; 3],
-    size: [u32; 3],
-    out: &mut [u8],
-) {
-    let [nx, ny, nz] = dims.map(|d| d as i64);
-    let w = size[0] as usize;
-    // The run of x inside the volume: [x0, x1) in the block, starting at voxel origin.x + x0.
-    let x0 = (-origin[0]).clamp(0, w as i64) as usize;
-    let x1 = (nx - origin[0]).clamp(x0 as i64, w as i64) as usize;
-    let mut o = 0;
-    for z in 0..size[2] as i64 {
-        let sz = (origin[2] + z).clamp(0, nz - 1);
-        for y in 0..size[1] as i64 {
-            let sy = (origin[1] + y).clamp(0, ny - 1);
-            let row = &bytes[((sz * ny + sy) * nx) as usize * bpp..][..nx as usize * bpp];
-            let dst = &mut out[o..o + w * bpp];
-            let first = &row[..bpp];
-            let last = &row[row.len() - bpp..];
-            for px in dst[..x0 * bpp].chunks_exact_mut(bpp) {
-                px.copy_from_slice(first);
-            }
-            if x1 > x0 {
-                let start = (origin[0] + x0 as i64) as usize * bpp;
-                dst[x0 * bpp..x1 * bpp].copy_from_slice(&row[start..start + (x1 - x0) * bpp]);
-            }
-            for px in dst[x1 * bpp..].chunks_exact_mut(bpp) {
-                px.copy_from_slice(last);
-            }
-            o += w * bpp;
-        }
-    }
-}
-
-/// The volume averaged over 2^level voxels per side (a box filter; partial blocks at the
-/// far edges average what they hold), in the volume's own format: the coarse copy of a
-/// volume held dense (see [`VolumeUpload::coarse`]).
-pub fn coarse_copy(v: &VolumeUpload, level: u32, dims: [u32; 3]) -> Vec<u8> {
-    let f = 1usize << level;
-    let [nx, ny, nz] = v.dims.map(|d| d as usize);
-    let read = |i: usize| -> f64 {
-        match v.format {
-            VolumeFormat::R8 => v.bytes[i] as f64,
-            VolumeFormat::R16 => u16::from_le_bytes([v.bytes[2 * i], v.bytes[2 * i + 1]]) as f64,
-            VolumeFormat::R32F => {
-                f32::from_le_bytes(v.bytes[4 * i..4 * i + 4].try_into().expect("four bytes")) as f64
-            }
-        }
-    };
-    let mut out =
-        Vec::with_capacity(dims.iter().map(|&d| d as usize).product::<usize>() * v.format.bytes());
-    for cz in 0..dims[2] as usize {
-        for cy in 0..dims[1] as usize {
-            for cx in 0..dims[0] as usize {
-                let (mut sum, mut n) = (0.0, 0usize);
-                for z in cz * f..((cz + 1) * f).min(nz) {
-                    for y in cy * f..((cy + 1) * f).min(ny) {
-                        let row = (z * ny + y) * nx;
-                        for x in cx * f..((cx + 1) * f).min(nx) {
-                            sum += read(row + x);
-                            n += 1;
-                        }
-                    }
-                }
-                let mean = sum / n.max(1) as f64;
-                match v.format {
-                    VolumeFormat::R8 => out.push(mean.round() as u8),
-                    VolumeFormat::R16 => {
-                        out.extend_from_slice(&(mean.round() as u16).to_le_bytes())
-                    }
-                    VolumeFormat::R32F => out.extend_from_slice(&(mean as f32).to_le_bytes()),
-                }
-            }
-        }
-    }
-    out
-}
-
 /// Density ranges per pool brick from the majorant grid's (whose bricks tile a pool
 /// brick exactly): the union of the cells' ranges, which include their one-voxel aprons.
 pub fn pool_ranges(cells: &BrickRanges) -> BrickRanges {
@@ -416,6 +332,49 @@ impl Residency {
                 None => [-1.0, self.ranges.min[b].max(0.0)],
             })
             .collect()
+    }
+}
+
+/// How a renderer holds its volume: dense, or in a brick pool (this module).
+#[derive(Clone, Debug, PartialEq)]
+pub enum VolumeResidency {
+    /// One dense 3D texture.
+    Dense,
+    /// A brick pool: of the bricks the current TF can make visible, `resident` have a
+    /// slot, `pending` wait for their upload, and the rest (past the pool's slots) show at
+    /// the coarse level.
+    Pool {
+        layout: PoolLayout,
+        visible: usize,
+        resident: usize,
+        pending: usize,
+        /// Bricks uploaded into slots since the renderer was made.
+        uploaded: u64,
+    },
+}
+
+impl std::fmt::Display for VolumeResidency {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            VolumeResidency::Dense => write!(f, "dense volume"),
+            VolumeResidency::Pool {
+                layout,
+                visible,
+                resident,
+                ..
+            } => {
+                write!(
+                    f,
+                    "brick pool: {resident} of {visible} visible bricks resident ({} slots of {}³), coarse level {} ({}×{}×{})",
+                    layout.slot_count(),
+                    BRICK,
+                    layout.level,
+                    layout.coarse_dims[0],
+                    layout.coarse_dims[1],
+                    layout.coarse_dims[2]
+                )
+            }
+        }
     }
 }
 

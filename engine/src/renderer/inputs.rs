@@ -1,7 +1,7 @@
 //! What a frame takes (camera, lights, TF; what to produce) and what it gives back.
 
-use super::scene_gpu::LutUpload;
-use super::Screenshot;
+use super::present::Screenshot;
+use super::uploads::LutUpload;
 use crate::gpu::timestamps::PassTiming;
 use crate::scene::Cut;
 use crate::shaders::frame::GpuLight;

@@ -10,6 +10,8 @@ mod reference;
 pub mod scene_gpu;
 pub mod scene_setup;
 mod submit;
+mod tf_upload;
+pub mod uploads;
 
 pub use inputs::{CameraMatrices, FrameInputs, FrameRequest, FrameResult, FEATURE_IMAGES};
 pub use reference::{samples_per_dispatch, MAX_SAMPLES_PER_DISPATCH, PIXEL_SAMPLES_PER_DISPATCH};
@@ -32,12 +34,14 @@ use crate::passes::SceneBindings;
 use crate::scene::RenderSettings;
 use crate::shaders::frame::{FrameBlock, FrameParams, SampleStream, MAX_LIGHTS};
 use ash::vk;
+pub use brick_pool::VolumeResidency;
 use brick_pool::{Residency, VolumePath};
 use glam::{Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 pub use present::{Overlay, PresentTarget, Screenshot};
-use scene_gpu::{EnvironmentUpload, LutUpload, SceneImages, VolumeUpload};
+use scene_gpu::SceneImages;
 use std::sync::Arc;
+use uploads::{BrickRanges, EnvironmentUpload, LutUpload, VolumeUpload};
 
 const SLOTS: usize = 2;
 
@@ -71,49 +75,6 @@ impl Default for RendererConfig {
             motion_source: denoise::MotionSource::FirstHit,
             dataset: None,
             gpu_memory: None,
-        }
-    }
-}
-
-/// How a renderer holds its volume (see [`brick_pool`]).
-#[derive(Clone, Debug, PartialEq)]
-pub enum VolumeResidency {
-    /// One dense 3D texture.
-    Dense,
-    /// A brick pool: of the bricks the current TF can make visible, `resident` have a
-    /// slot, `pending` wait for their upload, and the rest (past the pool's slots) show at
-    /// the coarse level.
-    Pool {
-        layout: brick_pool::PoolLayout,
-        visible: usize,
-        resident: usize,
-        pending: usize,
-        /// Bricks uploaded into slots since the renderer was made.
-        uploaded: u64,
-    },
-}
-
-impl std::fmt::Display for VolumeResidency {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            VolumeResidency::Dense => write!(f, "dense volume"),
-            VolumeResidency::Pool {
-                layout,
-                visible,
-                resident,
-                ..
-            } => {
-                write!(
-                    f,
-                    "brick pool: {resident} of {visible} visible bricks resident ({} slots of {}³), coarse level {} ({}×{}×{})",
-                    layout.slot_count(),
-                    brick_pool::BRICK,
-                    layout.level,
-                    layout.coarse_dims[0],
-                    layout.coarse_dims[1],
-                    layout.coarse_dims[2]
-                )
-            }
         }
     }
 }
@@ -160,7 +121,7 @@ pub struct Renderer {
     passes: Passes,
     denoisers: Vec<Method>,
     scene: SceneImages,
-    bricks: scene_gpu::BrickRanges,
+    bricks: BrickRanges,
     /// The volume as loaded: the brick pool reads its bricks from it.
     volume: Arc<VolumeUpload>,
     /// Which brick is in which pool slot (the pool path only).
@@ -588,160 +549,6 @@ impl Renderer {
         self.last_inputs = Some(inputs.clone());
         self.frame_index += 1;
         Ok(completed)
-    }
-
-    /// Adds uploads of the TF LUTs and the majorant grid when the TF or the cut differs
-    /// from the one on the device (bricks a cut removes whole get majorant 0), and on
-    /// the pool path the bricks they make visible and the brick table; returns the
-    /// largest extinction (the global majorant). `stream`: a frame uploads at most
-    /// [`brick_pool::STREAM_PER_FRAME`] bricks after the first frame; a reference
-    /// (`false`) waits for them all.
-    fn upload_transfer_function(
-        &mut self,
-        frame: &mut Frame,
-        slot: usize,
-        inputs: &FrameInputs,
-        stream: bool,
-    ) -> Result<f32> {
-        let (lut, cut) = (&inputs.lut, &inputs.cut);
-        if lut.diffuse_opacity.len() != self.lut_size as usize {
-            return Err(EngineError::Resource {
-                resource: "transfer function".into(),
-                problem: format!(
-                    "LUT has {} entries, renderer expects {}",
-                    lut.diffuse_opacity.len(),
-                    self.lut_size
-                ),
-            });
-        }
-        let first = self.current_lut.is_none();
-        if self.current_lut.as_ref() != Some(lut) || self.current_cut.as_ref() != Some(cut) {
-            let opacity: Vec<f32> = lut.diffuse_opacity.iter().map(|c| c[3]).collect();
-            let scale = self.config.density_scale;
-            let (dims, world) = (self.volume_dims, self.world_size);
-            let mut majorants = scene_gpu::majorants(&self.bricks, &opacity, scale);
-            scene_gpu::mask_cut(&mut majorants, &self.bricks, dims, world, cut);
-            self.majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
-            let (ctx, graph) = (&self.ctx, &mut self.graph);
-            let [a, b, c] = self.scene.tf;
-            for (name, image, bytes) in [
-                (
-                    "upload_tf_diffuse",
-                    a,
-                    bytemuck::cast_slice(&lut.diffuse_opacity),
-                ),
-                (
-                    "upload_tf_specular",
-                    b,
-                    bytemuck::cast_slice(&lut.specular_roughness),
-                ),
-                ("upload_tf_emissive", c, bytemuck::cast_slice(&lut.emissive)),
-                (
-                    "upload_majorant",
-                    self.scene.majorant,
-                    bytemuck::cast_slice(&majorants),
-                ),
-            ] {
-                scene_gpu::add_frame_upload(ctx, graph, frame, name, slot, image, bytes)?;
-            }
-            if let Some(r) = &mut self.residency {
-                let mut pool_majorants = scene_gpu::majorants(r.ranges(), &opacity, scale);
-                scene_gpu::mask_cut(&mut pool_majorants, r.ranges(), dims, world, cut);
-                self.table_dirty |= r.set_transfer_function(&pool_majorants);
-                let slots = r.layout.slot_count();
-                // Said once each time the TF goes past the pool (not on every edit while
-                // it stays there); the HUD and profile header show the count throughout.
-                let over = r.visible_count > slots;
-                if over && !std::mem::replace(&mut self.over_budget, over) {
-                    log::warn!(
-                        "{} of the {} bricks this TF makes visible show at the coarse level (1/{} resolution): the budget holds {slots} (raise --gpu-memory)",
-                        r.visible_count - slots,
-                        r.visible_count,
-                        1 << r.layout.level
-                    );
-                }
-                self.over_budget = over;
-            }
-            self.current_lut = Some(lut.clone());
-            self.current_cut = Some(cut.clone());
-        }
-        self.upload_bricks(frame, slot, first || !stream)?;
-        if first && self.residency.is_some() {
-            log::info!("{}", self.volume_residency());
-        }
-        Ok(self.majorant_max)
-    }
-
-    /// On the pool path: uploads pending bricks into their slots (at most one frame's
-    /// worth into `frame`; with `all`, the rest first through set-up submissions) and
-    /// the brick table after them, in the same frame, so no frame reads a slot the
-    /// table does not describe.
-    fn upload_bricks(&mut self, frame: &mut Frame, slot: usize, all: bool) -> Result<()> {
-        /// Bricks per set-up submission when a whole TF's bricks load at once.
-        const SETUP_CHUNK: usize = 512;
-        let Some(r) = &mut self.residency else {
-            return Ok(());
-        };
-        let (ctx, graph, volume) = (&self.ctx, &mut self.graph, &self.volume);
-        let size = brick_pool::brick_bytes(volume.format) as u64;
-        while all && r.pending() > brick_pool::STREAM_PER_FRAME {
-            let uploads = r.take_uploads(SETUP_CHUNK);
-            let staging = graph.buffer(
-                ctx,
-                "brick_pool.staging.setup",
-                SETUP_CHUNK as u64 * size,
-                MemoryLocation::CpuToGpu,
-            )?;
-            let mut setup = Frame::new();
-            let pool = self.scene.pool;
-            scene_gpu::add_brick_uploads(
-                graph, &mut setup, staging, pool, volume, &r.layout, &uploads,
-            )?;
-            ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, setup))?;
-            self.table_dirty = true;
-        }
-        let uploads = r.take_uploads(brick_pool::STREAM_PER_FRAME);
-        if !uploads.is_empty() {
-            let staging = graph.buffer(
-                ctx,
-                &format!("brick_pool.staging.{slot}"),
-                brick_pool::STREAM_PER_FRAME as u64 * size,
-                MemoryLocation::CpuToGpu,
-            )?;
-            let pool = self.scene.pool;
-            scene_gpu::add_brick_uploads(graph, frame, staging, pool, volume, &r.layout, &uploads)?;
-            self.table_dirty = true;
-        }
-        if std::mem::take(&mut self.table_dirty) {
-            let table = r.table();
-            let image = self.scene.brick_table;
-            let bytes = bytemuck::cast_slice(&table);
-            scene_gpu::add_frame_upload(
-                ctx,
-                graph,
-                frame,
-                "upload_brick_table",
-                slot,
-                image,
-                bytes,
-            )?;
-        }
-        Ok(())
-    }
-
-    /// How the volume reaches the device, and on the pool path how many of the bricks the
-    /// current TF makes visible have a slot.
-    pub fn volume_residency(&self) -> VolumeResidency {
-        match &self.residency {
-            None => VolumeResidency::Dense,
-            Some(r) => VolumeResidency::Pool {
-                layout: r.layout.clone(),
-                visible: r.visible_count,
-                resident: r.resident_visible(),
-                pending: r.pending(),
-                uploaded: r.uploaded(),
-            },
-        }
     }
 
     /// Writes `uniforms` into slot `slot`'s uniform buffer; returns the scene bindings.

@@ -4,7 +4,7 @@
 //! as GPU structs and the transfer function as LUTs, from a [`View`]. The CLI, the explorer and the tests
 //! all go through here.
 
-use super::scene_gpu::{EnvironmentUpload, LutUpload, VolumeUpload};
+use super::uploads::{EnvironmentUpload, LutUpload, VolumeUpload};
 use super::{CameraMatrices, FrameInputs, Renderer, RendererConfig};
 use crate::error::{EngineError, Result as EngineResult};
 use crate::gpu::GpuContext;

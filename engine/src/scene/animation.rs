@@ -33,7 +33,7 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use super::camera::{check_fov, CameraSpec, MAX_CAMERA_DISTANCE};
-use super::cut::{ClipKey, CropKey, Cut};
+use super::cut::{ClipPlane, CropBox, Cut};
 use super::error::{Ctx, SceneError};
 use super::light::{check_intensity, check_position, Light};
 
@@ -102,6 +102,37 @@ pub struct TfKey {
     pub blend: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shift: Option<f64>,
+    #[serde(default, skip_serializing_if = "Interpolation::is_linear")]
+    pub interpolation: Interpolation,
+}
+
+/// `[[animation.clip]]`: sets any of point, normal, enabled of plane `index` at `frame`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClipKey {
+    pub index: usize,
+    pub frame: u32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point: Option<DVec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<DVec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub enabled: Option<bool>,
+    #[serde(default, skip_serializing_if = "Interpolation::is_linear")]
+    pub interpolation: Interpolation,
+}
+
+/// `[[animation.crop]]`: sets any of min, max, enabled of the crop box at `frame`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CropKey {
+    pub frame: u32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min: Option<DVec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max: Option<DVec3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub enabled: Option<bool>,
     #[serde(default, skip_serializing_if = "Interpolation::is_linear")]
     pub interpolation: Interpolation,
 }
@@ -494,7 +525,7 @@ impl Animation {
                 )
             })?;
             frame_ok(field("frame"), k.frame)?;
-            super::cut::ClipPlane {
+            ClipPlane {
                 point: k.point.unwrap_or(plane.point),
                 normal: k.normal.unwrap_or(plane.normal),
                 enabled: true,
@@ -530,7 +561,7 @@ impl Animation {
             };
             for (i, k) in self.crop.iter().enumerate() {
                 frame_ok(format!("animation.crop[{i}].frame"), k.frame)?;
-                super::cut::CropBox {
+                CropBox {
                     min: k.min.unwrap_or(crop.min),
                     max: k.max.unwrap_or(crop.max),
                     ..crop

@@ -205,43 +205,6 @@ impl Cut {
     }
 }
 
-/// `[[animation.clip]]`: sets any of point, normal, enabled of plane `index` at `frame`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ClipKey {
-    pub index: usize,
-    pub frame: u32,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub point: Option<DVec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub normal: Option<DVec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub enabled: Option<bool>,
-    #[serde(
-        default,
-        skip_serializing_if = "super::animation::Interpolation::is_linear"
-    )]
-    pub interpolation: super::animation::Interpolation,
-}
-
-/// `[[animation.crop]]`: sets any of min, max, enabled of the crop box at `frame`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CropKey {
-    pub frame: u32,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub min: Option<DVec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub max: Option<DVec3>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub enabled: Option<bool>,
-    #[serde(
-        default,
-        skip_serializing_if = "super::animation::Interpolation::is_linear"
-    )]
-    pub interpolation: super::animation::Interpolation,
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

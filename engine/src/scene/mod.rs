@@ -54,9 +54,11 @@ mod tests;
 use std::path::Path;
 
 pub use crate::bytes::parse_memory_size;
-pub use animation::{Animation, CameraKey, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES};
+pub use animation::{
+    Animation, CameraKey, ClipKey, CropKey, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES,
+};
 pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR, MAX_CAMERA_DISTANCE};
-pub use cut::{ClipKey, ClipPlane, CropBox, CropKey, CropUnits, Cut, MAX_CLIP_PLANES};
+pub use cut::{ClipPlane, CropBox, CropUnits, Cut, MAX_CLIP_PLANES};
 pub use error::SceneError;
 pub use frame::{changed, Change, FrameState};
 pub use light::{

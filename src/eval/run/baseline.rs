@@ -4,8 +4,9 @@
 //! axis as the denoisers (which pay path tracing at `--spp` plus their own passes).
 
 use super::overlap::Overlap;
-use super::reference::ReferenceCache;
 use super::timing::Timing;
+use crate::eval::references::ReferenceCache;
+use crate::eval::results::BaselinePoint;
 use crate::progress::Progress;
 use crate::setup::Setup;
 use anyhow::Result;
@@ -20,16 +21,6 @@ pub const MAX_SPP: u32 = 256;
 /// Seed offset of the baseline's sample stream, so it is independent of the
 /// references' (which would otherwise share its first n samples and flatter it).
 const SEED_OFFSET: u32 = 0x5eed_0b11;
-
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct BaselinePoint {
-    pub frame: u32,
-    pub spp: u32,
-    #[serde(with = "super::record::float")]
-    pub gpu_ms: f64,
-    #[serde(with = "super::record::float")]
-    pub psnr: f64,
-}
 
 /// Sample counts of the curve: powers of two up to min([`MAX_SPP`], ref_spp / 2), so
 /// the baseline always has at most half the reference's samples.
@@ -100,24 +91,6 @@ pub fn measure(
     jobs.finish()
 }
 
-/// The curve averaged over the measured frames: (spp, mean GPU ms, mean PSNR).
-pub fn mean_curve(points: &[BaselinePoint]) -> Vec<(u32, f64, f64)> {
-    let mut spps: Vec<u32> = points.iter().map(|p| p.spp).collect();
-    spps.sort_unstable();
-    spps.dedup();
-    spps.into_iter()
-        .map(|n| {
-            let at: Vec<&BaselinePoint> = points.iter().filter(|p| p.spp == n).collect();
-            let k = at.len() as f64;
-            (
-                n,
-                at.iter().map(|p| p.gpu_ms).sum::<f64>() / k,
-                at.iter().map(|p| p.psnr).sum::<f64>() / k,
-            )
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -137,17 +110,5 @@ mod tests {
         assert_eq!(frames(3), vec![0, 1]);
         assert_eq!(frames(1), vec![0]);
         assert_eq!(units(16, 16), 2.0 * 15.0);
-    }
-
-    #[test]
-    fn mean_curve_averages_frames() {
-        let p = |frame, spp, gpu_ms, psnr| BaselinePoint {
-            frame,
-            spp,
-            gpu_ms,
-            psnr,
-        };
-        let c = mean_curve(&[p(0, 1, 1.0, 20.0), p(8, 1, 1.0, 22.0), p(0, 2, 2.0, 25.0)]);
-        assert_eq!(c, vec![(1, 1.0, 21.0), (2, 2.0, 25.0)]);
     }
 }

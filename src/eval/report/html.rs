@@ -8,11 +8,10 @@
 //! `<body data-…>` and to the title, and counts image loads on `<body>`
 //! (`data-loaded`, `data-failed`, `data-pending`), so a headless browser can check it.
 
-use super::baseline::mean_curve;
-use super::csv::{overall_recovery_text, scene_summary, Overall, Recovery};
 use super::plots::{colour_hex, method_colour, scene_plot_stems, METRIC_PLOTS, OVERALL_PLOT_STEM};
-use super::run::SceneResult;
-use super::{EvalArgs, EXPOSURE, GPU_WARMUP_FRAMES, RECOVERY_TOLERANCE_DB};
+use crate::eval::plan::settings::{EvalArgs, EXPOSURE, GPU_WARMUP_FRAMES, RECOVERY_TOLERANCE_DB};
+use crate::eval::results::{MetricRow, SceneResult};
+use crate::eval::scores::{mean_curve, overall_recovery_text, scene_summary, Overall, Recovery};
 use anyhow::Result;
 use serde_json::{json, Value};
 use std::path::Path;
@@ -40,7 +39,7 @@ fn scene_json(r: &SceneResult) -> Value {
         .iter()
         .map(|m| {
             let rows = r.series(m);
-            let col = |f: &dyn Fn(&super::run::MetricRow) -> Option<f64>| -> Value {
+            let col = |f: &dyn Fn(&MetricRow) -> Option<f64>| -> Value {
                 rows.iter().map(|x| f(x)).collect::<Vec<_>>().into()
             };
             (
@@ -158,8 +157,9 @@ pub fn write_page(
 
 #[cfg(test)]
 mod tests {
-    use super::super::csv::{overall_summary, tests::result};
+    use super::super::csv::tests::result;
     use super::*;
+    use crate::eval::scores::overall_summary;
     use clap::Parser;
 
     #[derive(Parser)]

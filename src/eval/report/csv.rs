@@ -1,13 +1,11 @@
 //! The tables of an eval: `metrics.csv` (per frame), `summary.csv` (per scene and
-//! method), `baseline.csv` (the accumulation curve), and the text table printed at the
-//! end. Means are plain means over frames, except the temporal error (frames 1.., as
-//! frame 0 has no previous frame) and GPU time (frames after the warm-up).
+//! method, from [`crate::eval::scores`]), `baseline.csv` (the accumulation curve), and
+//! the text table printed at the end.
 
-use super::run::{MetricRow, SceneResult};
-use super::{GPU_WARMUP_FRAMES, RECOVERY_TOLERANCE_DB};
+use crate::eval::results::{MetricRow, SceneResult};
+use crate::eval::scores::{overall_recovery_text, scene_summary, Overall};
 use crate::output::{opt, write_text as write};
 use anyhow::Result;
-use dvr_engine::metrics::frames_to_recover;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -15,129 +13,6 @@ pub const METRICS_HEADER: &str = "scene,method,frame,psnr,ssim,flip,temporal_err
 pub const SUMMARY_HEADER: &str =
     "scene,method,psnr,ssim,flip,temporal_error,gpu_ms,frames_to_recover";
 pub const BASELINE_HEADER: &str = "scene,frame,spp,gpu_ms,psnr";
-
-/// Frames a method needs after a sudden change to be back within
-/// [`RECOVERY_TOLERANCE_DB`] of its PSNR before it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Recovery {
-    /// The scene has no sudden change (written as an empty field).
-    NotApplicable,
-    Frames(usize),
-    /// Still degraded at the last frame (written as `never`).
-    Never,
-}
-
-impl Recovery {
-    pub fn csv(&self) -> String {
-        match self {
-            Recovery::NotApplicable => String::new(),
-            Recovery::Frames(n) => n.to_string(),
-            Recovery::Never => "never".into(),
-        }
-    }
-}
-
-/// Means of one method on one scene.
-#[derive(Clone, Debug)]
-pub struct Summary {
-    pub scene: String,
-    pub method: String,
-    pub psnr: f64,
-    pub ssim: f64,
-    pub flip: f64,
-    pub temporal_error: Option<f64>,
-    pub gpu_ms: f64,
-    pub recovery: Recovery,
-}
-
-/// Means of one method over all scenes (each scene weighs the same).
-#[derive(Clone, Debug)]
-pub struct Overall {
-    pub method: String,
-    pub scenes: usize,
-    pub psnr: f64,
-    pub ssim: f64,
-    pub flip: f64,
-    pub temporal_error: Option<f64>,
-    pub gpu_ms: f64,
-    /// Mean frames to recover over the scenes with a sudden change that recovered,
-    /// and how many never did; `None` without such scenes.
-    pub recovery: Option<(Option<f64>, usize)>,
-}
-
-fn mean(values: impl IntoIterator<Item = f64>) -> Option<f64> {
-    let (sum, n) = values
-        .into_iter()
-        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
-    (n > 0).then(|| sum / n as f64)
-}
-
-pub fn scene_summary(r: &SceneResult) -> Vec<Summary> {
-    r.methods
-        .iter()
-        .map(|m| {
-            let rows = r.series(m);
-            let timed = if rows.len() > GPU_WARMUP_FRAMES {
-                &rows[GPU_WARMUP_FRAMES..]
-            } else {
-                &rows[..]
-            };
-            let recovery = match r.event_frame {
-                None => Recovery::NotApplicable,
-                Some(e) => {
-                    let psnr: Vec<f64> = rows.iter().map(|x| x.psnr).collect();
-                    match frames_to_recover(&psnr, e as usize, RECOVERY_TOLERANCE_DB) {
-                        Some(n) => Recovery::Frames(n),
-                        None => Recovery::Never,
-                    }
-                }
-            };
-            Summary {
-                scene: r.name.clone(),
-                method: m.clone(),
-                psnr: mean(rows.iter().map(|x| x.psnr)).unwrap_or(f64::NAN),
-                ssim: mean(rows.iter().map(|x| x.ssim)).unwrap_or(f64::NAN),
-                flip: mean(rows.iter().map(|x| x.flip)).unwrap_or(f64::NAN),
-                temporal_error: mean(rows.iter().filter_map(|x| x.temporal_error)),
-                gpu_ms: mean(timed.iter().map(|x| x.gpu_ms)).unwrap_or(f64::NAN),
-                recovery,
-            }
-        })
-        .collect()
-}
-
-pub fn overall_summary(results: &[SceneResult], methods: &[String]) -> Vec<Overall> {
-    let all: Vec<Summary> = results.iter().flat_map(scene_summary).collect();
-    methods
-        .iter()
-        .map(|m| {
-            let s: Vec<&Summary> = all.iter().filter(|x| &x.method == m).collect();
-            let sudden: Vec<Recovery> = s
-                .iter()
-                .map(|x| x.recovery)
-                .filter(|r| *r != Recovery::NotApplicable)
-                .collect();
-            let recovery = (!sudden.is_empty()).then(|| {
-                let frames = sudden.iter().filter_map(|r| match r {
-                    Recovery::Frames(n) => Some(*n as f64),
-                    _ => None,
-                });
-                let never = sudden.iter().filter(|r| **r == Recovery::Never).count();
-                (mean(frames), never)
-            });
-            Overall {
-                method: m.clone(),
-                scenes: s.len(),
-                psnr: mean(s.iter().map(|x| x.psnr)).unwrap_or(f64::NAN),
-                ssim: mean(s.iter().map(|x| x.ssim)).unwrap_or(f64::NAN),
-                flip: mean(s.iter().map(|x| x.flip)).unwrap_or(f64::NAN),
-                temporal_error: mean(s.iter().filter_map(|x| x.temporal_error)),
-                gpu_ms: mean(s.iter().map(|x| x.gpu_ms)).unwrap_or(f64::NAN),
-                recovery,
-            }
-        })
-        .collect()
-}
 
 /// A CSV field: quoted when it holds a comma, quote or line break.
 fn field(s: &str) -> String {
@@ -225,16 +100,6 @@ pub fn write_baseline(path: &Path, results: &[SceneResult]) -> Result<()> {
     write(path, &baseline_csv(results))
 }
 
-/// Frames to recover over all scenes, as text: `2.5`, `3.0 (1 never)`, `never (2)`.
-pub fn overall_recovery_text(r: Option<(Option<f64>, usize)>) -> String {
-    match r {
-        None => String::new(),
-        Some((Some(m), 0)) => format!("{m:.1}"),
-        Some((Some(m), n)) => format!("{m:.1} ({n} never)"),
-        Some((None, n)) => format!("never ({n})"),
-    }
-}
-
 /// The summary as a fixed-width text table: every scene, then the means over scenes.
 pub fn summary_table(results: &[SceneResult], overall: &[Overall]) -> String {
     let mut s = String::new();
@@ -284,8 +149,10 @@ pub fn summary_table(results: &[SceneResult], overall: &[Overall]) -> String {
 
 #[cfg(test)]
 pub(crate) mod tests {
-    use super::super::baseline::BaselinePoint;
     use super::*;
+    use crate::eval::plan::scenes::dir_name;
+    use crate::eval::results::BaselinePoint;
+    use crate::eval::scores::{overall_summary, Recovery};
 
     /// A small synthetic result: 2 methods × `frames` frames; `ours` dips after the
     /// event and recovers two frames later.
@@ -313,7 +180,7 @@ pub(crate) mod tests {
         }
         SceneResult {
             name: name.into(),
-            dir: super::super::scenes::dir_name(name),
+            dir: dir_name(name),
             frames,
             spp: 2,
             methods,

@@ -2,7 +2,7 @@
 //! side-by-side comparison whose labels carry each frame's PSNR, in
 //! `DIR/<scene>/videos/` (see [`crate::video`]).
 
-use super::run::SceneResult;
+use crate::eval::results::SceneResult;
 use crate::video::{self, Track};
 use anyhow::Result;
 use std::path::Path;

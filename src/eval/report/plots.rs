@@ -3,86 +3,16 @@
 //! per scene and over all scenes, mean GPU ms per frame (log x) vs mean PSNR with the
 //! accumulation baseline curve.
 //!
-//! Text is drawn with `ab_glyph` from a TrueType file read at run time ([`init_font`]),
-//! so building needs no fontconfig/freetype; `tools/setup.sh` installs
-//! `fonts-dejavu-core`, and `DVR_FONT` can name any other font file.
+//! Text is drawn with the font [`crate::font`] registers.
 
-use super::baseline::mean_curve;
-use super::csv::{scene_summary, Overall};
-use super::run::SceneResult;
-use anyhow::{anyhow, bail, Context, Result};
+use crate::eval::results::SceneResult;
+use crate::eval::scores::{mean_curve, scene_summary, Overall};
+use anyhow::{anyhow, Context, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::path::Path;
 
 const SIZE: (u32, u32) = (640, 400);
-
-/// Font files tried in order after `DVR_FONT` (Debian/Ubuntu, Fedora, Arch, macOS,
-/// Windows).
-const FONT_CANDIDATES: [&str; 7] = [
-    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/dejavu-sans-fonts/DejaVuSans.ttf",
-    "/usr/share/fonts/TTF/DejaVuSans.ttf",
-    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
-    "/usr/share/fonts/truetype/noto/NotoSans-Regular.ttf",
-    "/System/Library/Fonts/Supplemental/Arial.ttf",
-    "C:\\Windows\\Fonts\\arial.ttf",
-];
-
-static FONT: OnceLock<std::result::Result<PathBuf, String>> = OnceLock::new();
-
-/// Registers the plots' font once per process; fails with what to install when there
-/// is none.
-pub fn init_font() -> Result<()> {
-    let r = FONT.get_or_init(|| {
-        let chosen = std::env::var_os("DVR_FONT").map(PathBuf::from);
-        if let Some(path) = &chosen {
-            // A named font that does not load is worth a warning; the usual places
-            // are tried next.
-            match load_font(path) {
-                Ok(()) => return Ok(path.clone()),
-                Err(why) => {
-                    log::warn!("DVR_FONT={}: {why}; trying the usual fonts", path.display())
-                }
-            }
-        }
-        for path in FONT_CANDIDATES.iter().map(PathBuf::from) {
-            if load_font(&path).is_ok() {
-                return Ok(path);
-            }
-        }
-        Err(
-            "no TrueType font found for the plots: install fonts-dejavu-core \
-             (tools/setup.sh does) or set DVR_FONT=/path/to/font.ttf"
-                .to_string(),
-        )
-    });
-    match r {
-        Ok(_) => Ok(()),
-        Err(e) => bail!("{e}"),
-    }
-}
-
-/// Largest font file read: real TrueType/OpenType fonts are well under this (DejaVu
-/// Sans is 0.7 MB; the largest CJK fonts about 20 MB).
-const MAX_FONT_BYTES: u64 = 64 << 20;
-
-/// Reads and registers one font file for every family the plots use; says why not.
-fn load_font(path: &std::path::Path) -> std::result::Result<(), String> {
-    let bytes = dvr_engine::files::read_bounded(path, MAX_FONT_BYTES).map_err(|e| e.to_string())?;
-    // Parsed first, so a file that is not a font is told apart from one that is.
-    ab_glyph::FontRef::try_from_slice(&bytes)
-        .map_err(|_| "is not a TrueType or OpenType font".to_string())?;
-    // plotters keeps fonts for the life of the process.
-    let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-    ["sans-serif", "serif", "monospace"]
-        .iter()
-        .try_for_each(|family| {
-            plotters::style::register_font(family, FontStyle::Normal, bytes)
-                .map_err(|_| "is not a font the plots can use".to_string())
-        })
-}
 
 /// Colours of the registry's rows, in its order (`dvr_engine::denoise::DENOISERS`):
 /// grey for the noisy input, red for ours, the rest a categorical palette.
@@ -160,7 +90,7 @@ pub(crate) fn save(chart: &impl Chart, stem: &Path) -> Result<()> {
             .and_then(|_| root.present())
             .map_err(|e| anyhow!("drawing {}: {e}", png_path.display()))?;
     }
-    super::images::save_rgb8(&png_path, SIZE.0, SIZE.1, &pixels)
+    crate::output::write_rgb8_png(&png_path, SIZE.0, SIZE.1, &pixels)
 }
 
 /// `(lo, hi)` of the finite values, padded by 5 % (and widened when flat).
@@ -451,8 +381,9 @@ pub fn overall_plot(out: &Path, results: &[SceneResult], overall: &[Overall]) ->
 
 #[cfg(test)]
 mod tests {
-    use super::super::csv::{overall_summary, tests::result};
+    use super::super::csv::tests::result;
     use super::*;
+    use crate::eval::scores::overall_summary;
 
     #[test]
     fn every_denoiser_has_its_own_colour() {
@@ -471,7 +402,7 @@ mod tests {
 
     #[test]
     fn plots_are_written_as_svg_and_png() {
-        init_font().expect("a font (install fonts-dejavu-core)");
+        crate::font::init_font().expect("a font (install fonts-dejavu-core)");
         let tmp = tempfile::tempdir().unwrap();
         let r = result("cloud/tf-jump", 8, Some(4));
         scene_plots(tmp.path(), &r).unwrap();

@@ -1,18 +1,25 @@
 //! The evaluation of one scene: references (cached), then the animation rendered once
 //! with every method, each method's frames scored and written, then the accumulation
-//! baseline.
+//! baseline ([`baseline`]). CPU work runs on a pool while the GPU renders
+//! ([`overlap`]); where the wall time went is counted in [`timing`].
+//!
+//! The eval's third layer: it imports the plan, the references and the results' types,
+//! and nothing above them (the scores and reports read what it returns).
 
-use super::baseline::{self, BaselinePoint};
-use super::images::{write_display_png, write_flip_png};
-use super::overlap::Overlap;
-use super::record::float;
-use super::reference::{frame_name, FillReport, ReferenceCache, ReferenceKey};
-use super::timing::Timing;
-use super::{scenes, EvalArgs, GPU_WARMUP_FRAMES};
+pub mod baseline;
+mod images;
+pub mod overlap;
+pub mod timing;
+
+use super::plan::scenes;
+use super::plan::settings::{scene_args, EvalArgs, GPU_WARMUP_FRAMES};
+use super::plan::{Plan, PlannedScene};
+use super::references::fill::FillReport;
+use super::references::{frame_name, ReferenceCache};
+use super::results::{MetricRow, SceneResult};
 use crate::progress::Progress;
 use crate::setup::Setup;
 use crate::shard::{FolderReport, RunReport};
-use crate::SceneArgs;
 use anyhow::{Context, Result};
 use dvr_engine::gpu::timestamps::{PassOwner, PassTiming};
 use dvr_engine::image_io::{to_rgb, write_exr};
@@ -20,10 +27,12 @@ use dvr_engine::metrics::Rgb32Image;
 use dvr_engine::metrics::{self as score, score, FrameReference};
 use dvr_engine::passes::aux_features;
 use dvr_engine::renderer::{FrameRequest, FrameResult};
+use images::{write_display_png, write_flip_png};
+use overlap::Overlap;
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use timing::Timing;
 
 /// The method whose frames are also kept as EXR: the noisy input, for external
 /// denoisers (`tools/oidn_eval.py`).
@@ -32,121 +41,19 @@ pub const NOISY_METHOD: &str = "none";
 /// The folder of a scene's guide images (`--aux`): `NNNN_albedo.exr`, `NNNN_normal.exr`.
 pub const AUX_DIR: &str = "aux";
 
-/// One scene as planned before anything renders.
-pub struct PlannedScene {
-    /// What `--scene` named: a built-in name or a scene file's path (opened again for
-    /// rendering).
-    pub spec: String,
-    /// The label in tables, plots and the page: the scene's `name` (a file's own name or
-    /// its file stem, `dvr scenes`' name for a built-in), made unique within the eval.
-    pub name: String,
-    pub dir: PathBuf,
-    pub frames: u32,
-    pub spp: u32,
-    pub references: ReferenceCache,
-}
-
-pub struct Plan {
-    pub scenes: Vec<PlannedScene>,
-    ref_spp: u32,
-    methods: usize,
-}
-
-impl Plan {
-    pub fn new(args: &EvalArgs, names: &[String], methods: &[String]) -> Result<Self> {
-        let mut opened = Vec::new();
-        for spec in names {
-            let mut scene = crate::setup::open_scene(spec)?;
-            if let Some(n) = args.frames {
-                scene = scene.with_frames(n)?;
-            }
-            opened.push((spec, scene));
-        }
-        let labels: Vec<String> = opened.iter().map(|(_, s)| s.name.clone()).collect();
-        let mut scenes = Vec::new();
-        for ((spec, scene), (label, dir)) in opened.into_iter().zip(scenes::unique_labels(&labels))
-        {
-            let dir = args.out.join(dir);
-            let key = ReferenceKey::new(&scene, args.size, args.ref_spp, args.render.volume_size)?;
-            scenes.push(PlannedScene {
-                spec: spec.clone(),
-                name: label,
-                frames: scene.frames,
-                spp: args.render.spp.unwrap_or(scene.render.spp()),
-                references: ReferenceCache::new(&dir, key),
-                dir,
-            });
-        }
-        Ok(Self {
-            scenes,
-            ref_spp: args.ref_spp,
-            methods: methods.len(),
+/// Work units of the plan's scenes that `take` accepts (by index; see [`Progress`]):
+/// references still missing, frames, the baseline.
+pub fn total_units(plan: &Plan, take: impl Fn(usize) -> bool) -> f64 {
+    plan.scenes
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| take(*i))
+        .map(|(_, s)| {
+            ReferenceCache::of(s).missing().len() as f64 * f64::from(plan.ref_spp)
+                + f64::from(s.frames) * (f64::from(s.spp) + plan.methods as f64)
+                + baseline::units(s.frames, plan.ref_spp)
         })
-    }
-
-    /// Work units of the scenes `take` accepts (by index; see [`Progress`]).
-    pub fn total_units(&self, take: impl Fn(usize) -> bool) -> f64 {
-        self.scenes
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| take(*i))
-            .map(|(_, s)| {
-                s.references.missing().len() as f64 * f64::from(self.ref_spp)
-                    + f64::from(s.frames) * (f64::from(s.spp) + self.methods as f64)
-                    + baseline::units(s.frames, self.ref_spp)
-            })
-            .sum()
-    }
-}
-
-/// Per-frame scores of one method.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct MetricRow {
-    pub scene: String,
-    pub method: String,
-    pub frame: u32,
-    #[serde(with = "float")]
-    pub psnr: f64,
-    #[serde(with = "float")]
-    pub ssim: f64,
-    #[serde(with = "float")]
-    pub flip: f64,
-    #[serde(with = "float::option")]
-    pub temporal_error: Option<f64>,
-    #[serde(with = "float")]
-    pub gpu_ms: f64,
-}
-
-/// Everything the reports need about one evaluated scene (kept in
-/// `<scene>/result.json`, see [`super::record`]).
-#[derive(Clone, Serialize, Deserialize)]
-pub struct SceneResult {
-    pub name: String,
-    /// Folder name inside the eval folder.
-    pub dir: String,
-    pub frames: u32,
-    pub spp: u32,
-    pub methods: Vec<String>,
-    /// Frame of the sudden change, for scenes that have one.
-    pub event_frame: Option<u32>,
-    pub rows: Vec<MetricRow>,
-    pub baseline: Vec<BaselinePoint>,
-    #[serde(with = "float")]
-    pub path_trace_ms_per_spp: f64,
-    pub device: String,
-    /// How the volume was held: "dense volume", or the brick pool's residency at the
-    /// scene's last frame (the page shows it); empty in results written before it.
-    #[serde(default)]
-    pub volume: String,
-}
-
-impl SceneResult {
-    /// A method's rows in frame order.
-    pub fn series(&self, method: &str) -> Vec<&MetricRow> {
-        let mut rows: Vec<&MetricRow> = self.rows.iter().filter(|r| r.method == method).collect();
-        rows.sort_by_key(|r| r.frame);
-        rows
-    }
+        .sum()
 }
 
 /// Whether a pass is one of `method`'s own (the graph records who each pass works for).
@@ -263,6 +170,7 @@ impl ScoreJob {
 /// What the frame loop keeps between frames.
 struct FrameState<'a> {
     scene: &'a PlannedScene,
+    references: &'a ReferenceCache,
     setup: &'a Setup,
     previous: Option<(Images, Arc<Rgb32Image>)>,
     jobs: Overlap<Vec<MetricRow>>,
@@ -291,7 +199,7 @@ impl FrameState<'_> {
                 Ok(Vec::new())
             })?;
         }
-        let reference = Arc::new(self.scene.references.load(f)?);
+        let reference = Arc::new(self.references.load(f)?);
         let gpu_ms = done
             .images
             .iter()
@@ -313,15 +221,6 @@ impl FrameState<'_> {
         self.previous = Some((images, reference));
         self.timings.push(done.timings);
         Ok(())
-    }
-}
-
-pub(super) fn scene_args(args: &EvalArgs, name: &str) -> SceneArgs {
-    SceneArgs {
-        scene: name.to_string(),
-        frames: args.frames,
-        size: args.size,
-        render: args.render.clone(),
     }
 }
 
@@ -383,8 +282,9 @@ pub fn evaluate_scene(
 ) -> Result<SceneResult> {
     progress.show(&format!("{label} | loading"));
     let setup = Setup::new(&scene_args(args, &scene.spec))?;
+    let references = ReferenceCache::of(scene);
     let filled = timing.references.time(|| {
-        scene.references.fill(
+        references.fill(
             &setup,
             &mut ReferenceProgress {
                 progress,
@@ -397,7 +297,7 @@ pub fn evaluate_scene(
     })?;
     report.references.push(FolderReport {
         scene: scene.name.clone(),
-        folder: scene.references.dir.clone(),
+        folder: references.dir.clone(),
         selected: (0..scene.frames).collect(),
         rendered: filled.rendered,
         reused: filled.reused,
@@ -415,6 +315,7 @@ pub fn evaluate_scene(
     }
     let mut state = FrameState {
         scene,
+        references: &references,
         setup: &setup,
         previous: None,
         jobs: Overlap::new(timing),
@@ -454,7 +355,7 @@ pub fn evaluate_scene(
         baseline::measure(
             &mut session,
             &setup,
-            &scene.references,
+            &references,
             ms_per_spp,
             args.ref_spp,
             progress,
@@ -465,7 +366,7 @@ pub fn evaluate_scene(
     let renderer = session.renderer()?;
     timing.add_gpu_ms(renderer.gpu_ms());
     let device = renderer.ctx().info.name.clone();
-    crate::profile::write_json(
+    crate::output::write_json(
         &scene.dir.join("timings.json"),
         &serde_json::json!({
             "device": device,
