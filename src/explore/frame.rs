@@ -7,8 +7,8 @@ use super::*;
 const WARMUP_FRAMES: usize = 5;
 
 /// The frame after which device memory is sampled for the summary (every image the
-/// frame uses exists by then), beside the figure at the end.
-const MEMORY_WARMUP_FRAMES: u64 = 20;
+/// frame uses exists by then).
+const MEMORY_WARMUP_FRAMES: u64 = 40;
 
 impl Explorer {
     /// One frame: see the module docs.
@@ -227,8 +227,14 @@ impl Explorer {
         if r.screenshot.is_some() {
             self.last_screenshot = r.screenshot;
         }
-        if r.index == MEMORY_WARMUP_FRAMES {
-            self.gpu_memory_warm = self.gfx.as_ref().map(|g| g.ctx.memory_in_use());
+        // Device memory every tenth frame after the warm-up, the most over each half of
+        // the run (a leak grows it; switching sizes and denoisers only moves it).
+        if r.index >= MEMORY_WARMUP_FRAMES && r.index.is_multiple_of(10) {
+            if let (Some(g), Some(n)) = (self.gfx.as_ref(), self.args.frames) {
+                let used = g.ctx.memory_in_use().allocated;
+                let half = &mut self.gpu_memory_peaks[usize::from(2 * r.index >= n)];
+                *half = (*half).max(used);
+            }
         }
         if r.index >= WARMUP_FRAMES as u64 {
             self.gpu_spans.push(ui::gpu_span_ms(&r.timings));
@@ -266,7 +272,7 @@ impl Explorer {
                 format!("{:?}", g.swapchain.present_mode),
             )
         });
-        let memory_end = self.gfx.as_ref().map(|g| g.ctx.memory_in_use());
+
         self.gfx = None;
         if let Some(path) = &self.args.screenshot {
             let shot = self.last_screenshot.as_ref().with_context(|| {
@@ -294,15 +300,14 @@ impl Explorer {
                 );
             }
         }
-        if let (Some(warm), Some(end)) = (self.gpu_memory_warm, memory_end) {
+        let [first, second] = self.gpu_memory_peaks;
+        if first > 0 && second > 0 {
             let mib = |b: u64| b as f64 / (1 << 20) as f64;
             println!(
-                "explore: GPU memory {:.1} MiB allocated ({:.1} MiB reserved) after frame \
-                 {MEMORY_WARMUP_FRAMES}, {:.1} MiB ({:.1} MiB) at the end",
-                mib(warm.allocated),
-                mib(warm.reserved),
-                mib(end.allocated),
-                mib(end.reserved)
+                "explore: GPU memory at most {:.3} MiB allocated over the first half, \
+                 {:.3} MiB over the second (after frame {MEMORY_WARMUP_FRAMES})",
+                mib(first),
+                mib(second)
             );
         }
         let timed: Vec<(f32, u32)> = self.frame_ms.iter().skip(WARMUP_FRAMES).copied().collect();
