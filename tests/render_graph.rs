@@ -313,3 +313,42 @@ fn images_no_frame_uses_any_more_are_released() {
     );
     assert_validation_clean();
 }
+
+/// Staging buffers go once no frame in flight copies from them: the volume's set-up
+/// staging does not outlive the first frames, and a still view then holds the same
+/// device memory frame after frame (what a long session holds follows what it draws).
+#[test]
+fn staging_is_released_and_a_still_view_holds_steady_memory() {
+    let n = 32;
+    let volume = constant_volume(n, 0.7);
+    let view = inputs(
+        front_camera(2.5, 40.0),
+        vec![point_light(glam::Vec3::new(1.0, 1.0, 2.0), 4.0)],
+        constant_lut(0.6, 0.8),
+    );
+    let request = dvr_engine::renderer::FrameRequest::default();
+    let mut r = renderer(context(), settings(16, 1), &volume, &["ours"]);
+    r.frame(&view, &request).expect("frame");
+    r.flush().expect("flush");
+    let first = r.ctx().memory_in_use().allocated;
+    let mut after = Vec::new();
+    for _ in 0..3 {
+        for _ in 0..4 {
+            r.frame(&view, &request).expect("frame");
+        }
+        r.flush().expect("flush");
+        after.push(r.ctx().memory_in_use().allocated);
+    }
+    let volume_bytes = u64::from(n * n * n);
+    assert!(
+        first >= after[0] + volume_bytes,
+        "the volume's staging ({volume_bytes} bytes) outlived the first frames: \
+         {first} bytes after one frame, {} after five",
+        after[0]
+    );
+    assert!(
+        after.windows(2).all(|w| w[0] == w[1]),
+        "a still view's device memory moved from frame to frame: {after:?}"
+    );
+    assert_validation_clean();
+}

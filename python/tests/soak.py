@@ -5,10 +5,10 @@ validation layer's messages. test_soak.py runs short versions; tools/soak.py the
 ones, writing assets/results/soak/soak.csv.
 
 A session passes when its resident memory at the end is within 5 % of the figure after
-the warm-up, its device memory (the allocator's counters) over the second half of the
-run never exceeds what it reached over the first (it moves with the size and the
-denoisers shown, within what they need, but does not grow), and the validation layer
-said nothing.
+the warm-up, its device memory (the allocator's counters) at the end is no more than
+after the warm-up, measured both times in the same state (size, denoisers shown: what
+the device holds follows what the last frames drew, so only a leak makes it grow), and
+the validation layer said nothing.
 """
 
 import os
@@ -25,8 +25,8 @@ import dvr
 RSS_GROWTH = 0.05
 
 
-def rss_mib(pid=None):
-    with open(f"/proc/{pid or os.getpid()}/status") as f:
+def rss_mib():
+    with open("/proc/self/status") as f:
         return next(int(l.split()[1]) for l in f if l.startswith("VmRSS")) / 1024
 
 
@@ -39,8 +39,7 @@ def passed(row):
 
 
 def _row(what, frames, seconds, rss, gpu, messages):
-    """`gpu`: the most device memory allocated over the first half of the run after the
-    warm-up, and over the second half (MiB)."""
+    """`rss`, `gpu`: resident and device memory (MiB) after the warm-up and at the end."""
     (rss_warm, rss_end), (gpu_warm, gpu_end) = rss, gpu
     return {
         "session": what,
@@ -100,26 +99,24 @@ def python_session(renders, seed=0, size=(32, 32)):
     for pair in pairs:
         r.denoisers = pair
         r.render()
-    # Measured in one state, after the warm-up and at the end: the first size, ours and
-    # svgf (device memory depends on the size and the denoisers' histories).
-    r.size, r.denoisers = size, pairs[2]
-    r.render()
-    rss_warm = rss_mib()
-    gpu = [[], []]  # device memory sampled over each half of the run
-    for i in range(renders):
+    def settle():
+        """The state both figures are taken in: the first size, ours and svgf, rendered
+        for more frames than the device keeps in flight."""
+        r.size, r.denoisers = size, pairs[2]
+        for _ in range(4):
+            r.render()
+        return rss_mib(), r.gpu_memory()["allocated"] / 2**20
+
+    rss_warm, gpu_warm = settle()
+    for _ in range(renders):
         if rng.random() < 0.7:
             edit(rng.choice(kinds))
         r.render()
-        if i % 50 == 0:
-            gpu[2 * i >= renders].append(r.gpu_memory()["allocated"] / 2**20)
-    r.size, r.denoisers = size, pairs[2]
-    r.render()
-    rss_end = rss_mib()
-    gpu[1].append(r.gpu_memory()["allocated"] / 2**20)
+    rss_end, gpu_end = settle()
     r.close()
     return _row(
         "python live renderer", renders, time.perf_counter() - started, (rss_warm, rss_end),
-        (max(gpu[0]), max(gpu[1])), dvr._native.validation_messages() - messages,
+        (gpu_warm, gpu_end), dvr._native.validation_messages() - messages,
     )
 
 
@@ -154,8 +151,8 @@ def explorer_script(frames, seed=0, size=64):
 
 
 def explorer_session(dvr_bin, frames, seed=0, size=64):
-    """`dvr explore` under its own Xvfb for `frames` frames of random edits; its resident
-    memory sampled from /proc, its device memory from its summary."""
+    """`dvr explore` under its own Xvfb for `frames` frames of random edits; its device and
+    resident memory after frame 40 and after the last, from its summary."""
     xvfb = shutil.which("Xvfb")
     if not xvfb:
         raise RuntimeError("Xvfb is not installed (tools/setup.sh installs it)")
@@ -174,29 +171,19 @@ def explorer_session(dvr_bin, frames, seed=0, size=64):
                  "--no-vsync", "--moving-ms", "0", "--script", explorer_script(frames, seed, size)],
                 stdout=log, stderr=subprocess.STDOUT, env=env,
             )
-            samples = []
-            while p.poll() is None:
-                try:
-                    samples.append((time.perf_counter() - started, rss_mib(p.pid)))
-                except (FileNotFoundError, StopIteration, ProcessLookupError):
-                    pass
-                time.sleep(0.5)
+            p.wait()
             seconds = time.perf_counter() - started
             log.seek(0)
             out = log.read()
         if p.returncode != 0:
             raise RuntimeError(f"dvr explore exited with {p.returncode}:\n{out[-3000:]}")
-        m = re.search(r"GPU memory at most ([\d.]+) MiB allocated over the first half, ([\d.]+) MiB over the second", out)
+        m = re.search(r"GPU memory ([\d.]+) MiB allocated after frame \d+, ([\d.]+) MiB after the last; "
+                      r"resident memory ([\d.]+) MiB after frame \d+, ([\d.]+) MiB after the last", out)
         if not m:
-            raise RuntimeError(f"no GPU memory in the explorer's summary:\n{out[-3000:]}")
+            raise RuntimeError(f"no memory figures in the explorer's summary:\n{out[-3000:]}")
         messages = len(re.findall(r"validation", out, re.IGNORECASE))
-        # The warm-up is the first tenth of the run (every kind of edit is made by
-        # frame 40); the end figure is the mean of the last tenth's samples.
-        n = max(1, len(samples) // 10)
-        rss_warm = max(s[1] for s in samples[: 2 * n]) if samples else 0.0
-        rss_end = sum(s[1] for s in samples[-n:]) / n if samples else 0.0
-        return _row("explorer under Xvfb", frames, seconds, (rss_warm, rss_end),
-                    (float(m.group(1)), float(m.group(2))), messages)
+        gpu_warm, gpu_end, rss_warm, rss_end = map(float, m.groups())
+        return _row("explorer under Xvfb", frames, seconds, (rss_warm, rss_end), (gpu_warm, gpu_end), messages)
     finally:
         x.kill()
         x.wait()
@@ -232,8 +219,6 @@ def notebook_session(lab, browser, seconds, size=64):
         samples.append(sample())
     nb.run(2)
     page.close()
-    half = max(1, len(samples) // 2)
-    first, second = samples[:half], samples[half:] or samples[-1:]
     warm, end = samples[0], samples[-1]
     return _row("notebook viewer", end[0], time.perf_counter() - started, (warm[2], end[2]),
-                (max(s[1] for s in first), max(s[1] for s in second)), end[3])
+                (warm[1], end[1]), end[3])

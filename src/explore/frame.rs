@@ -6,8 +6,8 @@ use super::*;
 /// Frames left out of the frame-rate summary (pipeline compilation on first use).
 const WARMUP_FRAMES: usize = 5;
 
-/// The frame after which device memory is sampled for the summary (every image the
-/// frame uses exists by then).
+/// The frame after which device memory is first sampled for the summary (a scripted
+/// warm-up has made every kind of edit by then).
 const MEMORY_WARMUP_FRAMES: u64 = 40;
 
 impl Explorer {
@@ -227,13 +227,13 @@ impl Explorer {
         if r.screenshot.is_some() {
             self.last_screenshot = r.screenshot;
         }
-        // Device memory every tenth frame after the warm-up, the most over each half of
-        // the run (a leak grows it; switching sizes and denoisers only moves it).
-        if r.index >= MEMORY_WARMUP_FRAMES && r.index.is_multiple_of(10) {
-            if let (Some(g), Some(n)) = (self.gfx.as_ref(), self.args.frames) {
-                let used = g.ctx.memory_in_use().allocated;
-                let half = &mut self.gpu_memory_peaks[usize::from(2 * r.index >= n)];
-                *half = (*half).max(used);
+        // Device and resident memory after the warm-up and on the last frame: a script
+        // that ends in its warm-up's state (size, denoiser, split) compares like with like,
+        // and what the graph holds follows the recent frames, so a leak shows as growth.
+        if let (Some(g), Some(n)) = (self.gfx.as_ref(), self.args.frames) {
+            if r.index == MEMORY_WARMUP_FRAMES || r.index + 1 == n {
+                let at = usize::from(r.index + 1 == n);
+                self.memory_samples[at] = (g.ctx.memory_in_use().allocated, resident_bytes());
             }
         }
         if r.index >= WARMUP_FRAMES as u64 {
@@ -300,14 +300,22 @@ impl Explorer {
                 );
             }
         }
-        let [first, second] = self.gpu_memory_peaks;
-        if first > 0 && second > 0 {
+        let [(warm, rss_warm), (end, rss_end)] = self.memory_samples;
+        if warm > 0 && end > 0 {
             let mib = |b: u64| b as f64 / (1 << 20) as f64;
+            let resident = match (rss_warm, rss_end) {
+                (Some(w), Some(e)) => format!(
+                    "; resident memory {:.1} MiB after frame {MEMORY_WARMUP_FRAMES}, {:.1} MiB after the last",
+                    mib(w),
+                    mib(e)
+                ),
+                _ => String::new(),
+            };
             println!(
-                "explore: GPU memory at most {:.3} MiB allocated over the first half, \
-                 {:.3} MiB over the second (after frame {MEMORY_WARMUP_FRAMES})",
-                mib(first),
-                mib(second)
+                "explore: GPU memory {:.3} MiB allocated after frame {MEMORY_WARMUP_FRAMES}, \
+                 {:.3} MiB after the last{resident}",
+                mib(warm),
+                mib(end)
             );
         }
         let timed: Vec<(f32, u32)> = self.frame_ms.iter().skip(WARMUP_FRAMES).copied().collect();
@@ -371,4 +379,12 @@ pub(super) fn save_screenshot(path: &Path, s: &Screenshot) -> Result<()> {
     let png = dvr_engine::image_io::encode_srgb8_png(path, s.width, s.height, &rgb)?;
     dvr_engine::image_io::write_file(path, &png, dvr_engine::files::Durability::Renamed)
         .with_context(|| format!("writing {}", path.display()))
+}
+
+/// This process's resident memory (VmRSS of /proc/self/status), where the system has it.
+fn resident_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }

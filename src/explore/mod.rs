@@ -207,9 +207,9 @@ struct Explorer {
     /// Which planes (and whether the crop box) were on when C switched the cuts off.
     cuts_off: Vec<bool>,
     crop_off: bool,
-    /// The most device memory allocated over each half of a `--frames` run, after the
-    /// warm-up (for the summary).
-    gpu_memory_peaks: [u64; 2],
+    /// Device memory allocated and resident memory after the warm-up and after the last
+    /// frame of a `--frames` run (for the summary).
+    memory_samples: [(u64, Option<u64>); 2],
     last_screenshot: Option<Screenshot>,
     frame_started: Option<Instant>,
     /// CPU frame intervals, ms, with the divisor each frame was rendered at.
@@ -283,7 +283,7 @@ impl Explorer {
             shot_count: 0,
             cuts_off: Vec::new(),
             crop_off: false,
-            gpu_memory_peaks: [0; 2],
+            memory_samples: [(0, None); 2],
             last_screenshot: None,
             frame_started: None,
             frame_ms: Vec::new(),

@@ -264,8 +264,14 @@ impl GpuBuffer {
         Ok(())
     }
 
+    /// False once destroyed.
+    pub fn is_allocated(&self) -> bool {
+        self.allocation.is_some()
+    }
+
     pub fn destroy(&mut self, ctx: &GpuContext) {
         unsafe { ctx.device.destroy_buffer(self.buffer, None) };
+        self.buffer = vk::Buffer::null();
         if let (Some(a), Ok(mut alloc)) = (self.allocation.take(), ctx.allocator.lock()) {
             let _ = alloc.free(a);
         }

@@ -194,17 +194,47 @@ impl RenderGraph {
         size: u64,
         location: MemoryLocation,
     ) -> Result<BufferHandle> {
+        self.buffer_slot(ctx, name, size, location, false)
+    }
+
+    /// A host-visible buffer named `name` that a copy of this frame reads from: released
+    /// by [`RenderGraph::release_unused`] once no frame in flight asked for it (a
+    /// volume's set-up staging does not outlive its upload), made again when asked for.
+    pub fn staging(&mut self, ctx: &GpuContext, name: &str, size: u64) -> Result<BufferHandle> {
+        self.buffer_slot(ctx, name, size, MemoryLocation::CpuToGpu, true)
+    }
+
+    /// A host-readable buffer named `name` that a copy of this frame writes into: like
+    /// [`RenderGraph::staging`], released once no frame in flight asked for it (the
+    /// readback of a denoiser no longer read, or of a size no longer drawn).
+    pub fn readback(&mut self, ctx: &GpuContext, name: &str, size: u64) -> Result<BufferHandle> {
+        self.buffer_slot(ctx, name, size, MemoryLocation::GpuToCpu, true)
+    }
+
+    fn buffer_slot(
+        &mut self,
+        ctx: &GpuContext,
+        name: &str,
+        size: u64,
+        location: MemoryLocation,
+        transient: bool,
+    ) -> Result<BufferHandle> {
         let usage = vk::BufferUsageFlags::UNIFORM_BUFFER
             | vk::BufferUsageFlags::STORAGE_BUFFER
             | vk::BufferUsageFlags::TRANSFER_SRC
             | vk::BufferUsageFlags::TRANSFER_DST;
+        let used_in = self.frames_ended;
         if let Some(&h) = self.buffer_names.get(name) {
             let slot = &mut self.buffers[h.0 as usize];
-            if slot.buffer.size == size && slot.location == location {
+            slot.used_in = used_in;
+            slot.transient = transient;
+            let same = slot.buffer.size == size && slot.location == location;
+            if same && slot.buffer.is_allocated() {
                 return Ok(h);
             }
             slot.buffer.destroy(ctx);
             slot.buffer = GpuBuffer::new(ctx, name, size, usage, location)?;
+            slot.location = location;
             slot.state = ResourceState::default();
             return Ok(h);
         }
@@ -214,6 +244,8 @@ impl RenderGraph {
             buffer: GpuBuffer::new(ctx, name, size, usage, location)?,
             state: ResourceState::default(),
             location,
+            transient,
+            used_in,
         });
         self.buffer_names.insert(name.to_string(), h);
         Ok(h)
@@ -498,23 +530,35 @@ impl RenderGraph {
         });
     }
 
-    /// Releases the memory of every image the last ended frame did not declare (a removed
-    /// denoiser's, another size's): call it only when no frame before that one is still
-    /// in flight. A released image keeps its name and shape and is allocated and cleared
-    /// again when a frame uses it; a history with a released side restarts.
-    pub fn release_unused(&mut self, ctx: &GpuContext) {
+    /// Releases the memory of every image none of the last `frames` ended frames declared
+    /// (a removed denoiser's, a split view switched off), and of every staging buffer
+    /// none of them asked for: the frames in flight must be
+    /// among those `frames`, so none uses a released image. A released image keeps its
+    /// name and shape and is allocated and cleared again when a frame uses it; a history
+    /// with a released side restarts. Called after every frame, it makes the memory held
+    /// a function of what the recent frames drew, not of everything drawn since start.
+    pub fn release_unused(&mut self, ctx: &GpuContext, frames: u64) {
         let Some(last) = self.frames_ended.checked_sub(1) else {
             return;
         };
         let mut released = Vec::new();
         for (i, slot) in self.images.iter_mut().enumerate() {
-            if slot.used_in < last && !slot.image.is_external() && slot.image.is_allocated() {
+            if slot.used_in + frames.max(1) <= last
+                && !slot.image.is_external()
+                && slot.image.is_allocated()
+            {
                 let desc = slot.image.desc;
                 slot.image.destroy(ctx);
                 slot.image = GpuImage::unallocated(desc);
                 slot.state = ResourceState::default();
                 slot.needs_clear = true;
                 released.push(ImageHandle(i as u32));
+            }
+        }
+        for slot in &mut self.buffers {
+            if slot.transient && slot.used_in + frames.max(1) <= last {
+                slot.buffer.destroy(ctx);
+                slot.state = ResourceState::default();
             }
         }
         for h in self.histories.values_mut() {

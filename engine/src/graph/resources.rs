@@ -81,6 +81,11 @@ pub(crate) struct BufferSlot {
     pub buffer: GpuBuffer,
     pub state: ResourceState,
     pub location: MemoryLocation,
+    /// A staging or readback buffer: released once no frame in flight copies with it, made again
+    /// when next asked for.
+    pub transient: bool,
+    /// The frame (the graph's count of ended frames) that last asked for it.
+    pub used_in: u64,
 }
 
 pub(crate) struct HistorySlot {

@@ -542,10 +542,14 @@ impl Renderer {
         self.slots[slot].pending = Some((self.frame_index, readbacks));
         self.slots[slot].pending_screenshot = screenshot;
         self.graph.end_frame();
-        if std::mem::take(&mut self.release_unused) {
-            // The frame before this one was waited for when the change was made.
-            self.graph.release_unused(&self.ctx);
-        }
+        // Right after a change (the frame before this one was waited for then), what only
+        // the old state used goes now; otherwise what no frame in flight can still use.
+        let idle = if std::mem::take(&mut self.release_unused) {
+            1
+        } else {
+            SLOTS as u64 + 1
+        };
+        self.graph.release_unused(&self.ctx, idle);
         self.last_inputs = Some(inputs.clone());
         self.frame_index += 1;
         Ok(completed)

@@ -12,7 +12,6 @@ use crate::graph::Extent;
 use crate::graph::{BufferHandle, Frame, ImageHandle, PassContext, RenderGraph};
 use crate::passes::present::{Present, PresentLayout};
 use ash::vk;
-use gpu_allocator::MemoryLocation;
 
 /// Something drawn over the presented frame by a graphics pipeline (the explorer's UI).
 /// It lives in the application; the renderer only schedules it.
@@ -128,12 +127,7 @@ pub(crate) fn add_present_passes<'f>(
     }
     let pending = if target.readback {
         let bytes = extent.width as u64 * extent.height as u64 * 4;
-        let buffer = graph.buffer(
-            ctx,
-            &format!("readback.present.{slot}"),
-            bytes,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let buffer = graph.readback(ctx, &format!("readback.present.{slot}"), bytes)?;
         frame.add_readback("present", swapchain_image, buffer);
         Some(PendingScreenshot {
             buffer,

@@ -8,7 +8,6 @@ use crate::error::{EngineError, Result};
 use crate::gpu::{GpuContext, ImageDesc};
 use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
 use ash::vk;
-use gpu_allocator::MemoryLocation;
 use std::borrow::Cow;
 
 pub struct SceneImages {
@@ -66,7 +65,7 @@ fn add_upload_via(
     image: ImageHandle,
     bytes: &[u8],
 ) -> Result<()> {
-    let staging = graph.buffer(ctx, staging, bytes.len() as u64, MemoryLocation::CpuToGpu)?;
+    let staging = graph.staging(ctx, staging, bytes.len() as u64)?;
     graph.buffer_mut(staging).write(bytes)?;
     frame.add_pass(
         name.to_string(),

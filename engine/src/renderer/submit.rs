@@ -7,7 +7,6 @@ use crate::gpu::timestamps::TimestampPool;
 use crate::gpu::GpuContext;
 use crate::graph::{BufferHandle, Extent, Frame, ImageHandle, RenderGraph};
 use ash::vk;
-use gpu_allocator::MemoryLocation;
 
 pub(super) struct Slot {
     pub cmd: vk::CommandBuffer,
@@ -41,12 +40,7 @@ pub(super) fn add_readbacks<'f>(
     let bytes = size.width as u64 * size.height as u64 * 16;
     let mut out = Vec::new();
     for (name, image) in outputs {
-        let buffer = graph.buffer(
-            ctx,
-            &format!("readback.{name}.{slot}"),
-            bytes,
-            MemoryLocation::GpuToCpu,
-        )?;
+        let buffer = graph.readback(ctx, &format!("readback.{name}.{slot}"), bytes)?;
         frame.add_readback(name, *image, buffer);
         out.push((name.clone(), buffer));
     }

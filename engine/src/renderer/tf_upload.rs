@@ -8,7 +8,6 @@ use super::FrameInputs;
 use super::Renderer;
 use crate::error::{EngineError, Result};
 use crate::graph::Frame;
-use gpu_allocator::MemoryLocation;
 
 impl Renderer {
     /// Adds uploads of the TF LUTs and the majorant grid when the TF or the cut differs
@@ -107,12 +106,8 @@ impl Renderer {
         let size = brick_pool::brick_bytes(volume.format) as u64;
         while all && r.pending() > brick_pool::STREAM_PER_FRAME {
             let uploads = r.take_uploads(SETUP_CHUNK);
-            let staging = graph.buffer(
-                ctx,
-                "brick_pool.staging.setup",
-                SETUP_CHUNK as u64 * size,
-                MemoryLocation::CpuToGpu,
-            )?;
+            let staging =
+                graph.staging(ctx, "brick_pool.staging.setup", SETUP_CHUNK as u64 * size)?;
             let mut setup = Frame::new();
             let pool = self.scene.pool;
             scene_gpu::add_brick_uploads(
@@ -123,11 +118,10 @@ impl Renderer {
         }
         let uploads = r.take_uploads(brick_pool::STREAM_PER_FRAME);
         if !uploads.is_empty() {
-            let staging = graph.buffer(
+            let staging = graph.staging(
                 ctx,
                 &format!("brick_pool.staging.{slot}"),
                 brick_pool::STREAM_PER_FRAME as u64 * size,
-                MemoryLocation::CpuToGpu,
             )?;
             let pool = self.scene.pool;
             scene_gpu::add_brick_uploads(graph, frame, staging, pool, volume, &r.layout, &uploads)?;
