@@ -199,7 +199,7 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
     // z of an OME-TIFF (pages `z * z_stride`).
     let wanted = |page: u64| match &pixels {
         None => true,
-        Some(p) => page % p.z_stride == 0 && page / p.z_stride < p.size[2],
+        Some(p) => page.is_multiple_of(p.z_stride) && page / p.z_stride < p.size[2],
     };
     let (width, height) = decoder.dimensions().map_err(bad)?;
     if let Some(p) = &pixels {
