@@ -163,7 +163,19 @@ fn parse_pixels(path: &Path, xml: &str) -> Result<Pixels, VolumeError> {
 
 pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
     let (file, _) = io::open_regular(path)?;
-    let bad = |e: tiff::TiffError| malformed(path, "TIFF", e.to_string());
+    let bad = |e: tiff::TiffError| {
+        match e {
+        tiff::TiffError::LimitsExceeded => malformed(
+            path,
+            "TIFF",
+            format!(
+                "a tag value, strip or page of more than {MAX_PAGE_BYTES} bytes (a {MAX_DIM}x{MAX_DIM} \
+                 float32 page), refused before it is read"
+            ),
+        ),
+        e => malformed(path, "TIFF", e.to_string()),
+    }
+    };
     let mut limits = Limits::default();
     limits.decoding_buffer_size = MAX_PAGE_BYTES;
     limits.intermediate_buffer_size = MAX_CHUNK_BYTES;
@@ -423,6 +435,15 @@ mod tests {
         // A 65535² page claiming 4 GiB: refused before the tiff crate allocates it.
         let e = load_error(dir.path(), &tiff(65535, 65535, "a stack", u32::MAX));
         assert!(e.contains("65535") && e.contains("exceeds 4096"), "{e}");
+        // A tag of 2^30 values (StripOffsets), which the tiff crate allocated (32 GiB) with
+        // no limits set: found by the fuzzer.
+        let mut file = tiff(4, 4, "a stack", 16);
+        file[86..90].copy_from_slice(&0x4000_0000u32.to_le_bytes());
+        let e = load_error(dir.path(), &file);
+        assert!(
+            e.contains("x.ome.tif") && e.contains("refused before it is read"),
+            "{e}"
+        );
         // A voxel size past the spacing limits.
         let xml = ome(r#"SizeX="4" SizeY="4" SizeZ="1" PhysicalSizeX="1e-12""#);
         let e = load_error(dir.path(), &tiff(4, 4, &xml, 16));
