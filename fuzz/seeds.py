@@ -1,12 +1,16 @@
 """Writes the seed corpus of every fuzz target into fuzz/corpus/<target>/ (small valid
 files of each format and variant the loaders read, plus the repository's scenes and
-transfer functions). Run from anywhere: python3 fuzz/seeds.py. Files that fuzzing
-found are added to the same folders by hand (see README "Reliability")."""
+transfer functions). Run from anywhere: python3 fuzz/seeds.py. The OME-Zarr and
+OME-TIFF seeds are written by zarr-python, ome-zarr and tifffile (pip install zarr
+ome-zarr tifffile numpy); without them those two targets' seeds are left as they are.
+Files that fuzzing found are added to the same folders by hand (see README
+"Reliability")."""
 import glob
 import gzip
 import os
 import shutil
 import struct
+import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -152,6 +156,261 @@ def text_seeds():
         shutil.copy(p, os.path.join(CORPUS, "tf_toml", os.path.basename(p)))
 
 
+ZARR_FILE_MARKER = b"\n--file "
+
+
+def zarr_input(folder, open_path=".", budget=None):
+    """A volume_zarr input (fuzz/src/entries.rs): the header line (the path to open
+    and the memory budget), then each file under `folder` as a record."""
+    out = f"{open_path} {budget if budget is not None else ''}".strip().encode()
+    for root, dirs, files in os.walk(folder):
+        dirs.sort()
+        for f in sorted(files):
+            path = os.path.join(root, f)
+            data = open(path, "rb").read()
+            assert ZARR_FILE_MARKER not in data, path  # would split the record
+            out += ZARR_FILE_MARKER + os.path.relpath(path, folder).encode() + b"\n" + data
+    assert len(out) <= 8192, (folder, len(out))  # small enough to fuzz fast
+    return out
+
+
+def ome_group(path, zarr_format, axes, levels, global_scale=None):
+    """A group holding OME multiscales metadata (0.5 on Zarr v3, 0.4 on v2) for
+    `levels` [(path, scale)], written by zarr-python."""
+    import zarr
+
+    image = {"axes": axes,
+             "datasets": [{"path": p, "coordinateTransformations": [{"type": "scale", "scale": s}]}
+                          for p, s in levels]}
+    if global_scale:
+        image["coordinateTransformations"] = [{"type": "scale", "scale": global_scale}]
+    root = zarr.open_group(path, mode="w", zarr_format=zarr_format)
+    if zarr_format == 3:
+        root.attrs["ome"] = {"version": "0.5", "multiscales": [image]}
+    else:
+        root.attrs["multiscales"] = [dict(image, version="0.4")]
+    return root
+
+
+def zarr_seeds():
+    import numcodecs
+    import numpy as np
+    import zarr
+    from ome_zarr.format import FormatV04, FormatV05
+    from ome_zarr.io import parse_url
+    from ome_zarr.writer import write_image
+    from zarr.codecs import BloscCodec, BytesCodec, GzipCodec, TransposeCodec
+
+    space = lambda n, unit="micrometer": {"name": n, "type": "space", "unit": unit}
+    with tempfile.TemporaryDirectory() as tmp:
+        def folder(name):
+            return os.path.join(tmp, name)
+
+        # ome-zarr's multiscale pyramids: OME-Zarr 0.5 (Zarr v3, zstd) and 0.4 (Zarr v2,
+        # blosc), opened as the image (the finest level that fits) and as one level.
+        z, y, x = np.meshgrid(np.arange(8), np.arange(12), np.arange(16), indexing="ij")
+        u16 = (z * 97 + y * 13 + x * 3 + (x * y) % 7).astype(np.uint16)
+        for name, fmt, data, extra in [
+            ("ome05-pyramid", FormatV05(), u16, {}),
+            ("ome04-pyramid-blosc", FormatV04(), (u16 % 251).astype(np.uint8),
+             {"storage_options": {"compressor": numcodecs.Blosc(cname="lz4")}}),
+        ]:
+            root = zarr.group(store=parse_url(folder(name), mode="w", fmt=fmt).store, zarr_format=fmt.zarr_format)
+            write_image(image=data, group=root, fmt=fmt, axes="zyx",
+                        scale_factors=[{"z": 2, "y": 2, "x": 2}, {"z": 4, "y": 4, "x": 4}],
+                        scale={"z": 2.0, "y": 0.5, "x": 0.25}, axes_units={a: "micrometer" for a in "zyx"}, **extra)
+            put("volume_zarr", name, zarr_input(folder(name)))
+        put("volume_zarr", "ome05-level-s1", zarr_input(folder("ome05-pyramid"), "s1"))
+
+        # A level 0 over the 64 KiB budget, mostly empty (its empty chunks are not
+        # written: they read as the fill value): the budget picks level s1.
+        big = np.zeros((40, 40, 48), np.uint8)
+        big[10:14, 8:20, 8:24] = 200
+        fmt = FormatV05()
+        root = zarr.group(store=parse_url(folder("budget"), mode="w", fmt=fmt).store, zarr_format=3)
+        write_image(image=big, group=root, fmt=fmt, axes="zyx", scale_factors=[{"z": 2, "y": 2, "x": 2}],
+                    storage_options={"chunks": (16, 16, 16)})
+        put("volume_zarr", "ome05-budget-64k", zarr_input(folder("budget"), ".", 65536))
+
+        # Zarr v3 by zarr-python: a float32 czyx image in gzip, two channels.
+        root = ome_group(folder("czyx"), 3, [{"name": "c", "type": "channel"}] + [space(a) for a in "zyx"],
+                         [("0", [1.0, 3.0, 1.0, 1.0])])
+        a = root.create_array("0", shape=(2, 3, 4, 5), chunks=(1, 3, 2, 5), dtype="float32",
+                              compressors=[GzipCodec(level=1)])
+        a[:] = np.linspace(-1.0, 2.0, 120, dtype=np.float32).reshape(2, 3, 4, 5)
+        put("volume_zarr", "v3-czyx-gzip-f32", zarr_input(folder("czyx")))
+
+        # Zarr v3 sharding (gzip inner chunks, a crc32c index).
+        root = ome_group(folder("sharded"), 3, [space(a, "millimeter") for a in "zyx"], [("0", [1.0, 1.0, 1.0])])
+        a = root.create_array("0", shape=(4, 8, 8), chunks=(2, 4, 4), shards=(4, 8, 8), dtype="int16",
+                              compressors=[GzipCodec(level=1)])
+        a[:] = (np.arange(256, dtype=np.int16) * 37 - 4000).reshape(4, 8, 8)
+        put("volume_zarr", "v3-sharded-i16", zarr_input(folder("sharded")))
+
+        # Zarr v3 transpose codec and blosc (lz4, bit shuffle), opened as its level.
+        root = ome_group(folder("transpose"), 3, [space(a, "nanometer") for a in "zyx"], [("0", [500.0, 400.0, 300.0])])
+        a = root.create_array("0", shape=(3, 4, 5), chunks=(3, 4, 5), dtype="uint8",
+                              filters=[TransposeCodec(order=[2, 1, 0])], serializer=BytesCodec(),
+                              compressors=[BloscCodec(cname="lz4", shuffle="bitshuffle")])
+        a[:] = np.arange(60, dtype=np.uint8).reshape(3, 4, 5) * 4
+        put("volume_zarr", "v3-transpose-blosc-level0", zarr_input(folder("transpose"), "0"))
+
+        # Zarr v2: 5D tczyx, big-endian uint16 in Fortran order, no compressor, "/" chunk
+        # keys, one chunk left out (the fill value), a global scale.
+        axes = [{"name": "t", "type": "time"}, {"name": "c", "type": "channel"}] + [space(a) for a in "zyx"]
+        root = ome_group(folder("tczyx"), 2, axes, [("0", [1.0, 1.0, 2.0, 1.0, 1.0])], [1.0, 1.0, 1.0, 0.5, 0.5])
+        a = root.create_array("0", shape=(1, 2, 2, 3, 4), chunks=(1, 1, 1, 3, 4), dtype=">u2", compressors=None,
+                              order="F", fill_value=7, chunk_key_encoding={"name": "v2", "separator": "/"})
+        a[:] = np.arange(48).reshape(1, 2, 2, 3, 4) * 1000
+        shutil.rmtree(os.path.join(folder("tczyx"), "0", "0", "0", "1"))
+        put("volume_zarr", "v2-tczyx-raw-missing", zarr_input(folder("tczyx")))
+
+        # Zarr v2 blosc (zstd, byte shuffle) float32.
+        root = ome_group(folder("v2blosc"), 2, [space(a) for a in "zyx"], [("0", [1.0, 1.0, 1.0])])
+        a = root.create_array("0", shape=(3, 4, 5), chunks=(2, 4, 5), dtype="<f4",
+                              compressors=numcodecs.Blosc(cname="zstd", shuffle=1))
+        a[:] = np.arange(60, dtype=np.float32).reshape(3, 4, 5) - 20.0
+        put("volume_zarr", "v2-blosc-f32", zarr_input(folder("v2blosc")))
+
+
+def tiff_strips(pages, compression, encode, description):
+    """A little-endian TIFF of uint8 `pages` (2D numpy arrays), one strip each, in a
+    compression tifffile cannot write without imagecodecs (PackBits, LZW)."""
+    entries = lambda n: 2 + 12 * n + 4
+    out = bytearray(b"II*\0" + struct.pack("<I", 8))
+    desc = description.encode() + b"\0"
+    strips = [encode(p.tobytes()) for p in pages]
+    n_tags = 10
+    # Layout: IFDs back to back (the first has ImageDescription), then the description,
+    # then the strips.
+    sizes = [entries(n_tags + 1)] + [entries(n_tags)] * (len(pages) - 1)
+    ifd_at = [8 + sum(sizes[:i]) for i in range(len(pages))]
+    data_at = 8 + sum(sizes)
+    desc_at = data_at
+    strip_at = []
+    at = desc_at + len(desc)
+    for s in strips:
+        strip_at.append(at)
+        at += len(s)
+    for i, p in enumerate(pages):
+        h, w = p.shape
+        tags = [(256, 3, 1, w), (257, 3, 1, h), (258, 3, 1, 8), (259, 3, 1, compression), (262, 3, 1, 1)]
+        if i == 0:
+            tags.append((270, 2, len(desc), desc_at))
+        tags += [(273, 4, 1, strip_at[i]), (277, 3, 1, 1), (278, 3, 1, h), (279, 4, 1, len(strips[i])),
+                 (339, 3, 1, 1)]
+        ifd = struct.pack("<H", len(tags))
+        for tag, typ, count, value in tags:
+            ifd += struct.pack("<HHI", tag, typ, count) + (struct.pack("<HH", value, 0) if typ == 3 else struct.pack("<I", value))
+        ifd += struct.pack("<I", ifd_at[i + 1] if i + 1 < len(pages) else 0)
+        assert len(ifd) == sizes[i]
+        out += ifd
+    out += desc
+    for s in strips:
+        out += s
+    return bytes(out)
+
+
+def packbits(data):
+    out, i = bytearray(), 0
+    while i < len(data):
+        j = i
+        while j < len(data) and j - i < 128 and data[j] == data[i]:
+            j += 1
+        if j - i >= 3:
+            out += bytes([257 - (j - i), data[i]])
+            i = j
+        else:
+            k = i + 1
+            while k < len(data) and k - i < 128 and not (k + 2 < len(data) and data[k] == data[k + 1] == data[k + 2]):
+                k += 1
+            out += bytes([k - i - 1]) + data[i:k]
+            i = k
+    return bytes(out)
+
+
+def tiff_lzw(data):
+    """TIFF's LZW (MSB first, codes widen one code early, Clear 256, EOI 257)."""
+    table = {bytes([i]): i for i in range(256)}
+    next_code, width, bits, nbits, out = 258, 9, 0, 0, bytearray()
+
+    def emit(code):
+        nonlocal bits, nbits
+        bits, nbits = (bits << width) | code, nbits + width
+        while nbits >= 8:
+            nbits -= 8
+            out.append((bits >> nbits) & 0xFF)
+
+    emit(256)
+    w = b""
+    for c in data:
+        wc = w + bytes([c])
+        if wc in table:
+            w = wc
+            continue
+        emit(table[w])
+        table[wc] = next_code
+        next_code += 1
+        if next_code + 1 >= 1 << width and width < 12:
+            width += 1
+        w = bytes([c])
+    if w:
+        emit(table[w])
+    emit(257)
+    if nbits:
+        out.append((bits << (8 - nbits)) & 0xFF)
+    return bytes(out)
+
+
+def tiff_seeds():
+    import numpy as np
+    import tifffile
+
+    uuid = {"UUID": "urn:uuid:00000000-0000-0000-0000-000000000000"}  # the same bytes every run
+    with tempfile.TemporaryDirectory() as tmp:
+        def write(name, data, **kw):
+            path = os.path.join(tmp, name)
+            kw["metadata"] = dict(uuid, **kw.get("metadata", {"axes": "ZYX"})) if kw.get("ome", True) else None
+            tifffile.imwrite(path, data, **kw)
+            b = open(path, "rb").read()
+            assert len(b) <= 8192, (name, len(b))
+            put("volume_ome_tiff", name, b)
+
+        z, y, x = np.meshgrid(np.arange(4), np.arange(12), np.arange(16), indexing="ij")
+        ramp = z * 500 + y * 20 + x
+        write("u16-none.ome.tif", ramp.astype(np.uint16), resolution=(4.0, 4.0), ome=True)
+        write("u8-zlib.ome.tif", (ramp % 256).astype(np.uint8)[:, :8, :8].repeat(2, 0), compression="zlib", ome=True)
+        write("i16-deflate-predictor-bigtiff.ome.tif", (ramp - 1000).astype(np.int16), compression="deflate",
+              predictor=True, bigtiff=True, ome=True)
+        write("f32-tiles-bigendian.ome.tif", (ramp / 100.0).astype(np.float32)[:2], tile=(16, 16),
+              byteorder=">", ome=True)
+        # Channels and time points around z (XYCZT: channels run fastest), physical sizes.
+        czt = (np.arange(2 * 3 * 2 * 8 * 8) % 200).astype(np.uint8).reshape(2, 3, 2, 8, 8)
+        write("tzc-sizes.ome.tif", czt, ome=True,
+              metadata={"axes": "TZCYX", "PhysicalSizeX": 0.5, "PhysicalSizeY": 0.5, "PhysicalSizeZ": 0.002,
+                        "PhysicalSizeZUnit": "mm"})
+        write("u16-lzma.ome.tif", ramp.astype(np.uint16)[:2], compression="lzma", ome=True)
+        # A sub-resolution pyramid (SubIFDs) under the full-resolution pages.
+        path = os.path.join(tmp, "pyramid.ome.tif")
+        with tifffile.TiffWriter(path, ome=True) as w:
+            full = (ramp % 256).astype(np.uint8)
+            w.write(full, subifds=1, metadata=dict(uuid, axes="ZYX"), compression="zlib")
+            w.write(full[:, ::2, ::2], subfiletype=1, compression="zlib")
+        put("volume_ome_tiff", "pyramid.ome.tif", open(path, "rb").read())
+        # A plain (not OME) stack: pages as z slices of 1 mm voxels.
+        write("plain-stack.tif", (ramp % 256).astype(np.uint8)[:3, :6, :6], ome=False, photometric="minisblack")
+        # PackBits and LZW (which tifffile writes only with imagecodecs), by hand.
+        ome = ('<?xml version="1.0" encoding="UTF-8"?><OME xmlns="http://www.openmicroscopy.org/Schemas/OME/2016-06">'
+               '<Image ID="Image:0"><Pixels ID="Pixels:0" DimensionOrder="XYZCT" Type="uint8" SizeX="16" SizeY="12" '
+               'SizeZ="3" SizeC="1" SizeT="1" PhysicalSizeX="1.5" PhysicalSizeY="1.5" PhysicalSizeZ="4.0">'
+               '<Channel ID="Channel:0:0" SamplesPerPixel="1"/></Pixels></Image></OME>')
+        blob = np.zeros((3, 12, 16), np.uint8)
+        blob[:, 3:9, 4:12] = (np.arange(3) * 60 + 60)[:, None, None]
+        blob[:, 5, :] = np.arange(16) * 9
+        put("volume_ome_tiff", "u8-packbits.ome.tif", tiff_strips(list(blob), 32773, packbits, ome))
+        put("volume_ome_tiff", "u8-lzw.ome.tif", tiff_strips(list(blob), 5, tiff_lzw, ome))
+
+
 if __name__ == "__main__":
     os.makedirs(os.path.join(CORPUS, "tf_toml"), exist_ok=True)
     nifti_seeds()
@@ -160,4 +419,18 @@ if __name__ == "__main__":
     raw_seeds()
     dicom_seeds()
     text_seeds()
+    try:
+        import numpy, numcodecs, ome_zarr, tifffile, zarr  # noqa: F401
+    except ImportError as e:
+        print(f"{e}: volume_zarr and volume_ome_tiff seeds not written (pip install zarr ome-zarr tifffile numpy)")
+    else:
+        # gzip writes the time into each member's header: the epoch instead, so the seeds
+        # are the same bytes every run.
+        import types
+        real_time, gzip.time = gzip.time, types.SimpleNamespace(time=lambda: 0)
+        try:
+            zarr_seeds()
+        finally:
+            gzip.time = real_time
+        tiff_seeds()
     print("seeds in", CORPUS)

@@ -445,8 +445,8 @@ def b_fuzz():
     body = []
     for r in rows:
         body.append([f"`{r['target']}`", f"{int(r['execs']):,}", r["crashes"], r["hangs"],
-                     r["ooms"], f"{num(r['seconds']):.0f}", f"{num(r['exec_per_s']):,.0f}",
-                     f"{num(r['peak_rss_mb']):.0f}", r["commit"], r["date"]])
+                     r["ooms"], fmt(num(r["seconds"]), 0), f"{num(r['exec_per_s']):,.0f}",
+                     fmt(num(r["peak_rss_mb"]), 0), r["commit"][:7], r["date"][:10]])
     machines = sorted({r["machine"] for r in rows})
     return "\n".join([
         table(["target", "executions", "crashes", "hangs", "out of memory", "s", "exec/s",

@@ -7,13 +7,26 @@
 //! without OME-XML is a stack of its pages, one z slice each, with 1 mm voxels (the log
 //! says so). Pages are one grey sample each (uint8, uint16, int16, float32), all the
 //! same size; the full-resolution series is read (sub-resolution pages are not).
+//!
+//! Reads are bounded by the volume the file describes: the OME-XML's sizes and each
+//! page's size and sample type are checked against the volume limits before any pixel
+//! is decoded, and the `tiff` crate decodes at most one page of [`MAX_PAGE_BYTES`] at a
+//! time (tag values and compressed strips bounded likewise).
 
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
-use super::{io, name_of, validate_dims, Volume};
+use super::{io, name_of, validate_dims, validate_spacing, Volume, MAX_DIM};
 use std::path::Path;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::tags::Tag;
+
+/// Largest page decoded: `MAX_DIM`² samples of 4 bytes (float32), 64 MiB. Also the
+/// largest tag value (the OME-XML) read.
+pub const MAX_PAGE_BYTES: usize = (MAX_DIM as usize) * (MAX_DIM as usize) * 4;
+
+/// Largest compressed strip or tile read: a page's worth, and as much again for codecs
+/// that grow incompressible data.
+pub const MAX_CHUNK_BYTES: usize = 2 * MAX_PAGE_BYTES;
 
 /// What the OME-XML says about the pixels.
 struct Pixels {
@@ -96,9 +109,22 @@ fn parse_pixels(path: &Path, xml: &str) -> Result<Pixels, VolumeError> {
             format!("{order:?} is not XY followed by Z, C and T"),
         ));
     }
-    let mut z_stride = 1;
+    // Checked before anything is allocated for the pages they describe.
+    validate_dims(
+        path,
+        [x, y, z].map(|n| i64::try_from(n).unwrap_or(i64::MAX)),
+    )?;
+    let mut z_stride = 1u64;
     for d in order[2..].chars().take_while(|&d| d != 'Z') {
-        z_stride *= if d == 'C' { c } else { t };
+        z_stride = z_stride
+            .checked_mul(if d == 'C' { c } else { t })
+            .ok_or_else(|| {
+                malformed(
+                    path,
+                    "SizeC/SizeT",
+                    format!("{c} channels × {t} time points: more pages than a TIFF holds"),
+                )
+            })?;
     }
     let mut spacing_mm = [1.0; 3];
     for (i, axis) in ["X", "Y", "Z"].iter().enumerate() {
@@ -137,15 +163,30 @@ fn parse_pixels(path: &Path, xml: &str) -> Result<Pixels, VolumeError> {
 
 pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
     let (file, _) = io::open_regular(path)?;
-    let bad = |e: tiff::TiffError| malformed(path, "TIFF", e.to_string());
+    let bad = |e: tiff::TiffError| {
+        match e {
+        tiff::TiffError::LimitsExceeded => malformed(
+            path,
+            "TIFF",
+            format!(
+                "a tag value, strip or page of more than {MAX_PAGE_BYTES} bytes (a {MAX_DIM}x{MAX_DIM} \
+                 float32 page), refused before it is read"
+            ),
+        ),
+        e => malformed(path, "TIFF", e.to_string()),
+    }
+    };
+    let mut limits = Limits::default();
+    limits.decoding_buffer_size = MAX_PAGE_BYTES;
+    limits.intermediate_buffer_size = MAX_CHUNK_BYTES;
     let mut decoder = Decoder::new(std::io::BufReader::new(file))
         .map_err(bad)?
-        .with_limits(Limits::unlimited());
+        .with_limits(limits);
     let description = decoder.get_tag_ascii_string(Tag::ImageDescription).ok();
     let ome = description
         .as_deref()
         .filter(|d| d.contains("<OME") || d.contains(":OME"));
-    let (pixels, pages) = match ome {
+    let pixels = match ome {
         Some(xml) => {
             let p = parse_pixels(path, xml)?;
             if p.channels > 1 || p.times > 1 {
@@ -156,16 +197,21 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
                     p.times
                 );
             }
-            let pages: Vec<u64> = (0..p.size[2]).map(|z| z * p.z_stride).collect();
-            (Some(p), pages)
+            Some(p)
         }
         None => {
             log::info!(
                 "{}: no OME-XML; reading its pages as z slices of 1 mm voxels",
                 path.display()
             );
-            (None, Vec::new())
+            None
         }
+    };
+    // Page `page` is a z slice: every page of a plain stack; channel 0 at time 0 of each
+    // z of an OME-TIFF (pages `z * z_stride`).
+    let wanted = |page: u64| match &pixels {
+        None => true,
+        Some(p) => page.is_multiple_of(p.z_stride) && page / p.z_stride < p.size[2],
     };
     let (width, height) = decoder.dimensions().map_err(bad)?;
     if let Some(p) = &pixels {
@@ -183,8 +229,7 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
     let mut slices: Vec<DecodingResult> = Vec::new();
     let mut page = 0u64;
     loop {
-        let wanted = pixels.is_none() || pages.contains(&page);
-        if wanted {
+        if wanted(page) {
             if decoder.dimensions().map_err(bad)? != (width, height) {
                 return Err(malformed(
                     path,
@@ -193,20 +238,23 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
                 ));
             }
             let colour = decoder.colortype().map_err(bad)?;
-            if !matches!(colour, tiff::ColorType::Gray(_)) {
+            if !matches!(colour, tiff::ColorType::Gray(8 | 16 | 32)) {
                 return Err(VolumeError::UnsupportedType {
                     path: path.to_path_buf(),
                     datatype: format!("{colour:?} pages"),
                     supported: "one grey sample per pixel: uint8, uint16, int16, float32",
                 });
             }
-            slices.push(decoder.read_image().map_err(bad)?);
+            // The volume with this page, checked before the page is decoded.
             validate_dims(
                 path,
-                [i64::from(width), i64::from(height), slices.len() as i64],
+                [i64::from(width), i64::from(height), slices.len() as i64 + 1],
             )?;
+            slices.push(decoder.read_image().map_err(bad)?);
         }
-        let done = pixels.is_some() && slices.len() == pages.len();
+        let done = pixels
+            .as_ref()
+            .is_some_and(|p| slices.len() as u64 == p.size[2]);
         if done || !decoder.more_images() {
             break;
         }
@@ -225,7 +273,11 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
     let depth = slices.len() as i64;
     let dims = validate_dims(path, [i64::from(width), i64::from(height), depth])?;
     let samples = join(path, slices)?;
-    let spacing = pixels.map_or([1.0; 3], |p| p.spacing_mm).map(|s| s as f32);
+    let spacing = validate_spacing(
+        path,
+        "PhysicalSizeX/Y/Z",
+        pixels.map_or([1.0; 3], |p| p.spacing_mm),
+    )?;
     Volume::from_stored(
         path,
         name_of(path).trim_end_matches(".ome").to_string(),
@@ -305,5 +357,96 @@ mod tests {
             .to_string();
         assert!(e.contains("furlong"), "{e}");
         assert_eq!(attribute(r#"<P aSizeX="1" SizeX="7">"#, "SizeX"), Some("7"));
+    }
+
+    /// A little-endian TIFF of one uint8 page `width`×`height` with `description`, whose
+    /// one strip claims `strip_bytes` bytes and holds 16.
+    fn tiff(width: u32, height: u32, description: &str, strip_bytes: u32) -> Vec<u8> {
+        let desc = [description.as_bytes(), b"\0"].concat();
+        let tags: [(u16, u16, u32); 10] = [
+            (256, 4, width),
+            (257, 4, height),
+            (258, 3, 8),
+            (259, 3, 1),
+            (262, 3, 1),
+            (270, 2, 0),
+            (273, 4, 0),
+            (277, 3, 1),
+            (278, 4, height),
+            (279, 4, strip_bytes),
+        ];
+        let desc_at = 8 + 2 + 12 * tags.len() as u32 + 4;
+        let strip_at = desc_at + desc.len() as u32;
+        let mut out = b"II*\0\x08\0\0\0".to_vec();
+        out.extend((tags.len() as u16).to_le_bytes());
+        for (tag, kind, value) in tags {
+            let count = if tag == 270 { desc.len() as u32 } else { 1 };
+            let value = match tag {
+                270 => desc_at,
+                273 => strip_at,
+                _ => value,
+            };
+            out.extend(tag.to_le_bytes());
+            out.extend(kind.to_le_bytes());
+            out.extend(count.to_le_bytes());
+            out.extend(value.to_le_bytes());
+        }
+        out.extend(0u32.to_le_bytes());
+        out.extend(desc);
+        out.extend([0; 16]);
+        out
+    }
+
+    fn load_error(dir: &Path, bytes: &[u8]) -> String {
+        let path = dir.join("x.ome.tif");
+        std::fs::write(&path, bytes).unwrap();
+        crate::volume::load_within_seconds(&path, 20)
+            .unwrap_err()
+            .to_string()
+    }
+
+    fn ome(sizes: &str) -> String {
+        format!(r#"<OME><Image><Pixels DimensionOrder="XYZCT" {sizes}/></Image></OME>"#)
+    }
+
+    #[test]
+    fn sizes_are_checked_before_pages_are_listed_or_decoded() {
+        let dir = tempfile::tempdir().unwrap();
+        // SizeZ of 10^12: the list of pages to read took 8 TB.
+        let e = load_error(
+            dir.path(),
+            &tiff(
+                2,
+                2,
+                &ome(r#"SizeX="2" SizeY="2" SizeZ="1000000000000""#),
+                4,
+            ),
+        );
+        assert!(
+            e.contains("x.ome.tif") && e.contains("1000000000000") && e.contains("4096"),
+            "{e}"
+        );
+        // Channels × time points before z overflowing u64 (this panicked).
+        let xml =
+            ome(r#"SizeX="2" SizeY="2" SizeZ="4" SizeC="1099511627776" SizeT="1099511627776""#)
+                .replace("XYZCT", "XYCTZ");
+        let e = load_error(dir.path(), &tiff(2, 2, &xml, 4));
+        assert!(e.contains("SizeC/SizeT"), "{e}");
+        // A 65535² page claiming 4 GiB: refused before the tiff crate allocates it.
+        let e = load_error(dir.path(), &tiff(65535, 65535, "a stack", u32::MAX));
+        assert!(e.contains("65535") && e.contains("exceeds 4096"), "{e}");
+        // A tag of 2^30 values (StripOffsets), which the tiff crate allocated (32 GiB) with
+        // no limits set: found by the fuzzer.
+        let mut file = tiff(4, 4, "a stack", 16);
+        file[86..90].copy_from_slice(&0x4000_0000u32.to_le_bytes());
+        let e = load_error(dir.path(), &file);
+        assert!(
+            e.contains("x.ome.tif") && e.contains("refused before it is read"),
+            "{e}"
+        );
+        // A voxel size past the spacing limits.
+        let xml = ome(r#"SizeX="4" SizeY="4" SizeZ="1" PhysicalSizeX="1e-12""#);
+        let e = load_error(dir.path(), &tiff(4, 4, &xml, 16));
+        assert!(e.contains("PhysicalSize") && e.contains("spacing"), "{e}");
     }
 }

@@ -11,18 +11,49 @@
 //! the axes' units; none given is taken as millimetres, with a note). A chunk that is
 //! absent is the array's fill value, as Zarr defines it (writers skip chunks that hold
 //! only the fill value): the log counts them.
+//!
+//! Reads are bounded by the volume read, whatever the metadata says: metadata files are
+//! read up to [`MAX_METADATA_BYTES`]; a chunk (or shard) may hold at most
+//! [`CHUNK_OVER_READ`] times the voxels read (or [`MIN_CHUNK_ELEMENTS`] where that is
+//! more: chunks are decoded whole); the read may touch at most [`MAX_CHUNKS`] chunks (a
+//! shard's inner chunks counted); files are read only if they are regular files, and no
+//! byte range past a file's end or longer than a chunk is read; blosc and zstd data may
+//! not state a decoded size past its chunk's (see `zarr/bounded.rs`).
+
+mod bounded;
 
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
-use super::{name_of, Volume, MAX_DIM, MAX_VOXELS};
+use super::{name_of, validate_spacing, Volume, MAX_DIM, MAX_VOXELS};
 use crate::bytes::human_bytes;
+use bounded::BoundedStore;
 use ome_zarr_metadata::v0_4::{Axis, AxisType, CoordinateTransform, CoordinateTransformScale};
 use ome_zarr_metadata::AnyOmeFields;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use zarrs::array::Array;
-use zarrs::filesystem::FilesystemStore;
+use zarrs::array::{Array, ArraySubset};
 use zarrs::group::Group;
+
+/// Largest metadata file read (`zarr.json`, `.zattrs`, `.zarray`, `.zgroup`): an
+/// image's are a few KiB.
+pub const MAX_METADATA_BYTES: u64 = 16 << 20;
+
+/// Most chunks one read may touch, a shard's inner chunks counted, and most inner chunks
+/// a shard may hold (its index, 16 bytes per chunk, is read whole). A 4096×4096×128
+/// volume in 32³ chunks is 65,536; past this, chunks are so small that reading would
+/// take minutes of file opens.
+pub const MAX_CHUNKS: u64 = 1 << 18;
+
+/// How many times the voxels read a chunk or shard may hold: chunks are decoded whole,
+/// so the channels or time points a chunk holds beside the one read are decoded too.
+pub const CHUNK_OVER_READ: u64 = 4;
+
+/// Elements a chunk may hold whatever the volume read (a 256³ chunk), so small volumes
+/// may keep usual chunk sizes.
+pub const MIN_CHUNK_ELEMENTS: u64 = 1 << 24;
+
+type Store = BoundedStore;
 
 /// Whether `path` is a Zarr group or array (a folder with Zarr v2 or v3 metadata).
 pub(crate) fn is_zarr(path: &Path) -> bool {
@@ -55,6 +86,7 @@ fn malformed(path: &Path, field: &str, problem: impl Into<String>) -> VolumeErro
 }
 
 pub(crate) fn load(path: &Path, budget: Option<u64>) -> Result<Volume, VolumeError> {
+    bounded::register_bounded_codecs();
     // A level's array names its group as its parent folder.
     let is_array = path.join(".zarray").is_file() || array_metadata_v3(path);
     let (group, wanted) = match (is_array, path.parent(), path.file_name()) {
@@ -102,16 +134,17 @@ fn level_names(image: &Image) -> String {
     names.join(", ")
 }
 
-fn store(path: &Path) -> Result<Arc<FilesystemStore>, VolumeError> {
-    FilesystemStore::new(path)
+/// The store of the image's folder, reading at most `max_read` bytes at a time.
+fn store(path: &Path, max_read: u64) -> Result<Arc<Store>, VolumeError> {
+    BoundedStore::new(path, max_read)
         .map(Arc::new)
-        .map_err(|e| malformed(path, "zarr store", e.to_string()))
+        .map_err(|e| malformed(path, "zarr store", e))
 }
 
 /// The group's OME metadata, checked: its first multiscales image, three spatial axes
 /// last, a scale per level.
 fn read_image(group: &Path) -> Result<Image, VolumeError> {
-    let group_node = Group::open(store(group)?, "/")
+    let group_node = Group::open(store(group, MAX_METADATA_BYTES)?, "/")
         .map_err(|e| malformed(group, "zarr group", e.to_string()))?;
     let attributes = serde_json::Value::Object(group_node.attributes().clone());
     let ome: AnyOmeFields = serde_json::from_value(attributes).map_err(|e| {
@@ -256,9 +289,11 @@ fn finest_that_fits(image: &Image, budget: Option<u64>) -> Result<usize, VolumeE
     let mut sizes = Vec::new();
     let mut within_limits = None;
     for (i, level) in image.levels.iter().enumerate() {
-        let array = open_array(image, level)?;
+        let array = open_array(image, level, MAX_METADATA_BYTES, None)?;
         let dims = spatial_dims(&array);
-        let bytes = dims.iter().product::<u64>() * voxel_bytes(&array);
+        // Saturating: a level's sides may be any u64.
+        let voxels = dims.iter().fold(1u64, |a, &d| a.saturating_mul(d));
+        let bytes = voxels.saturating_mul(voxel_bytes(&array));
         sizes.push(format!(
             "{}: {}x{}x{}, {}",
             level.path,
@@ -267,7 +302,6 @@ fn finest_that_fits(image: &Image, budget: Option<u64>) -> Result<usize, VolumeE
             dims[2],
             human_bytes(bytes)
         ));
-        let voxels: u64 = dims.iter().product();
         if !(dims.iter().all(|&d| d <= u64::from(MAX_DIM)) && voxels <= MAX_VOXELS) {
             continue;
         }
@@ -310,13 +344,13 @@ fn finest_that_fits(image: &Image, budget: Option<u64>) -> Result<usize, VolumeE
 
 /// The array's data type, as Zarr v3 names it (displayed as "<v3 name> / <v2 name>"
 /// where the two differ: the v3 name is first).
-fn dtype_name(array: &Array<FilesystemStore>) -> String {
+fn dtype_name(array: &Array<Store>) -> String {
     let shown = array.data_type().to_string();
     shown.split(" / ").next().unwrap_or_default().to_string()
 }
 
 /// Bytes a voxel of `array` takes once read (16-bit types stay 16-bit).
-fn voxel_bytes(array: &Array<FilesystemStore>) -> u64 {
+fn voxel_bytes(array: &Array<Store>) -> u64 {
     match dtype_name(array).as_str() {
         "uint8" => 1,
         "uint16" | "int16" => 2,
@@ -324,17 +358,29 @@ fn voxel_bytes(array: &Array<FilesystemStore>) -> u64 {
     }
 }
 
-fn open_array(image: &Image, level: &Level) -> Result<Array<FilesystemStore>, VolumeError> {
+/// A level's array, read through a store that reads at most `max_read` bytes at a time
+/// (and, where given, `blosc_chunk_bytes`: see [`BoundedStore::with_blosc_chunks`]).
+fn open_array(
+    image: &Image,
+    level: &Level,
+    max_read: u64,
+    blosc_chunk_bytes: Option<u64>,
+) -> Result<Array<Store>, VolumeError> {
     let path = image.group.join(level.path.trim_matches('/'));
-    Array::open(
-        store(&image.group)?,
-        &format!("/{}", level.path.trim_matches('/')),
-    )
-    .map_err(|e| malformed(&path, "zarr array", e.to_string()))
+    let mut store = store(&image.group, max_read)?;
+    if let Some(bytes) = blosc_chunk_bytes {
+        store = Arc::new(
+            BoundedStore::new(&image.group, max_read)
+                .map_err(|e| malformed(&image.group, "zarr store", e))?
+                .with_blosc_chunks(bytes),
+        );
+    }
+    Array::open(store, &format!("/{}", level.path.trim_matches('/')))
+        .map_err(|e| malformed(&path, "zarr array", e.to_string()))
 }
 
 /// x, y, z sizes of an array whose last three axes are z, y, x.
-fn spatial_dims(array: &Array<FilesystemStore>) -> [u64; 3] {
+fn spatial_dims(array: &Array<Store>) -> [u64; 3] {
     let s = array.shape();
     let n = s.len();
     if n < 3 {
@@ -345,7 +391,7 @@ fn spatial_dims(array: &Array<FilesystemStore>) -> [u64; 3] {
 
 fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, VolumeError> {
     let level = &image.levels[index];
-    let array = open_array(image, level)?;
+    let array = open_array(image, level, MAX_METADATA_BYTES, None)?;
     let shape = array.shape().to_vec();
     let n = image.axes.len();
     if shape.len() != n {
@@ -360,6 +406,13 @@ fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, Volume
         ));
     }
     for (axis, &len) in image.axes.iter().zip(&shape).take(n - 3) {
+        if len == 0 {
+            return Err(malformed(
+                path,
+                "shape",
+                format!("level {}: axis {} has no entries", level.path, axis.name),
+            ));
+        }
         if len > 1 {
             log::warn!(
                 "{}: axis {} has {len} entries; rendering the first",
@@ -368,14 +421,34 @@ fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, Volume
             );
         }
     }
-    let [x, y, z] = spatial_dims(&array);
-    let dims_i64 = [x as i64, y as i64, z as i64];
+    let dims_i64 = spatial_dims(&array).map(|d| i64::try_from(d).unwrap_or(i64::MAX));
     let dims = super::validate_dims(path, dims_i64)?;
-    let ranges: Vec<std::ops::Range<u64>> = shape
+    let dtype = dtype_name(&array);
+    if !["uint8", "uint16", "int16", "float32"].contains(&dtype.as_str()) {
+        return Err(VolumeError::UnsupportedType {
+            path: path.to_path_buf(),
+            datatype: dtype,
+            supported: "uint8, uint16, int16, float32",
+        });
+    }
+    let ranges: Vec<Range<u64>> = shape
         .iter()
         .enumerate()
         .map(|(i, &len)| if i < n - 3 { 0..len.min(1) } else { 0..len })
         .collect();
+    let largest_chunk = check_chunks(path, level, &array, &ranges)?;
+    // Reopened through a store that reads no more than the largest chunk at a time (with
+    // a little over for headers and incompressible data, and a shard's index). A Zarr v2
+    // blosc compressor is decoded by zarrs' own codec: its headers are checked as read.
+    let json = serde_json::to_value(array.metadata()).unwrap_or_default();
+    let v2_blosc = json["zarr_format"] == 2 && json["compressor"]["id"] == "blosc";
+    let largest_read = largest_chunk + largest_chunk / 8 + 16 * MAX_CHUNKS + (1 << 20);
+    let array = open_array(
+        image,
+        level,
+        largest_read.max(MAX_METADATA_BYTES),
+        v2_blosc.then_some(largest_chunk),
+    )?;
     let absent = absent_chunks(&array, &ranges)?;
     if absent > 0 {
         log::warn!(
@@ -384,7 +457,6 @@ fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, Volume
             path.display()
         );
     }
-    let dtype = dtype_name(&array);
     let subset = ranges.as_slice();
     let samples = match dtype.as_str() {
         "uint8" => Samples::U8(read(path, &array, subset)?),
@@ -399,7 +471,7 @@ fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, Volume
             })
         }
     };
-    let mut spacing = [0.0f32; 3];
+    let mut spacing = [0.0f64; 3];
     for (i, s) in spacing.iter_mut().enumerate() {
         // spacing is x, y, z; scale and axes run z, y, x.
         let axis = &image.axes[n - 1 - i];
@@ -410,8 +482,9 @@ fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, Volume
                 format!("axis {}: its unit is not a length", axis.name),
             )
         })?;
-        *s = (level.scale_zyx[2 - i] * mm) as f32;
+        *s = level.scale_zyx[2 - i] * mm;
     }
+    let spacing = validate_spacing(path, "coordinateTransformations (scale)", spacing)?;
     if image.axes[n - 3..].iter().all(|a| a.unit.is_none()) {
         log::info!(
             "{}: the axes have no unit; spacing read as millimetres",
@@ -425,8 +498,8 @@ fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, Volume
 /// The elements of `subset`, decoded, in C order.
 fn read<T: zarrs::array::ElementOwned>(
     path: &Path,
-    array: &Array<FilesystemStore>,
-    subset: &[std::ops::Range<u64>],
+    array: &Array<Store>,
+    subset: &[Range<u64>],
 ) -> Result<Vec<T>, VolumeError> {
     array
         .retrieve_array_subset::<Vec<T>>(&subset)
@@ -435,10 +508,7 @@ fn read<T: zarrs::array::ElementOwned>(
 
 /// How many of the chunks under `ranges` have no stored data. Only the chunks the
 /// ranges touch are visited (time and channel axes past index 0 are not).
-fn absent_chunks(
-    array: &Array<FilesystemStore>,
-    ranges: &[std::ops::Range<u64>],
-) -> Result<u64, VolumeError> {
+fn absent_chunks(array: &Array<Store>, ranges: &[Range<u64>]) -> Result<u64, VolumeError> {
     let chunk: Vec<u64> = array
         .chunk_shape(&vec![0; ranges.len()])
         .map(|s| s.iter().map(|c| c.get()).collect())
@@ -446,7 +516,7 @@ fn absent_chunks(
     if chunk.len() != ranges.len() {
         return Ok(0); // an irregular grid: nothing to count by
     }
-    let spans: Vec<std::ops::Range<u64>> = ranges
+    let spans: Vec<Range<u64>> = ranges
         .iter()
         .zip(&chunk)
         .map(|(r, &c)| r.start / c..r.end.div_ceil(c))
@@ -472,7 +542,362 @@ fn absent_chunks(
     Ok(absent)
 }
 
-fn array_store_has(array: &Array<FilesystemStore>, key: &zarrs::storage::StoreKey) -> bool {
+fn array_store_has(array: &Array<Store>, key: &zarrs::storage::StoreKey) -> bool {
     use zarrs::storage::ReadableStorageTraits;
     array.storage().size_key(key).ok().flatten().is_some()
+}
+
+/// Checks the chunks a read of `ranges` decodes against [`MAX_CHUNKS`],
+/// [`CHUNK_OVER_READ`] and [`MIN_CHUNK_ELEMENTS`], before any is read: the chunk grid's
+/// chunks and, through each `sharding_indexed` codec, the inner chunks of its shards.
+/// Returns the most bytes one chunk or shard holds once decoded.
+fn check_chunks(
+    path: &Path,
+    level: &Level,
+    array: &Array<Store>,
+    ranges: &[Range<u64>],
+) -> Result<u64, VolumeError> {
+    let bad =
+        |problem: String| malformed(path, "chunks", format!("level {}: {problem}", level.path));
+    let read: u64 = ranges.iter().map(|r| r.end - r.start).product();
+    let most_elements = read.saturating_mul(CHUNK_OVER_READ).max(MIN_CHUNK_ELEMENTS);
+    let grid = array
+        .chunks_in_array_subset(&ArraySubset::new_with_ranges(ranges))
+        .ok()
+        .flatten()
+        .ok_or_else(|| bad("the chunk grid does not cover the array".into()))?;
+    let mut chunks = grid
+        .shape()
+        .iter()
+        .try_fold(1u64, |a, &c| a.checked_mul(c))
+        .filter(|&c| c <= MAX_CHUNKS)
+        .ok_or_else(|| {
+            bad(format!(
+                "the volume read spans {:?} chunks, more than {MAX_CHUNKS} (chunks this \
+                 small make reading take minutes)",
+                grid.shape()
+            ))
+        })?;
+    // The largest chunk along each axis (a rectangular grid's differ).
+    let mut shape = Vec::with_capacity(ranges.len());
+    for d in 0..ranges.len() {
+        let mut largest = 0;
+        let mut index = grid.start().to_vec();
+        for i in grid.start()[d]..grid.start()[d] + grid.shape()[d] {
+            index[d] = i;
+            let c = array.chunk_shape(&index).map_err(|e| bad(e.to_string()))?;
+            largest = largest.max(c[d].get());
+        }
+        shape.push(largest);
+    }
+    let json = serde_json::to_value(array.metadata()).unwrap_or_default();
+    let mut largest_elements = 0u64;
+    let mut codecs = json.get("codecs").cloned().unwrap_or_default();
+    loop {
+        let elements = shape
+            .iter()
+            .try_fold(1u64, |a, &c| a.checked_mul(c))
+            .filter(|&e| e <= most_elements)
+            .ok_or_else(|| {
+                bad(format!(
+                    "a chunk of shape {shape:?} holds more than {most_elements} elements \
+                     ({CHUNK_OVER_READ} times the {read} voxels read, or \
+                     {MIN_CHUNK_ELEMENTS}): chunks are decoded whole"
+                ))
+            })?;
+        largest_elements = largest_elements.max(elements);
+        // The next level: the inner chunks of a sharding codec (after the transposes
+        // that reorder the shard's axes before it).
+        let mut inner = None;
+        for codec in codecs.as_array().map(Vec::as_slice).unwrap_or_default() {
+            let config = &codec["configuration"];
+            match codec["name"].as_str() {
+                Some("transpose") => {
+                    let order: Option<Vec<usize>> = config["order"].as_array().and_then(|o| {
+                        o.iter()
+                            .map(|i| i.as_u64().and_then(|i| usize::try_from(i).ok()))
+                            .collect()
+                    });
+                    match order {
+                        Some(o) if o.len() == shape.len() && o.iter().all(|&i| i < shape.len()) => {
+                            shape = o.iter().map(|&i| shape[i]).collect();
+                        }
+                        _ => {
+                            return Err(bad(format!(
+                                "a transpose order {} for {} axes",
+                                config["order"],
+                                shape.len()
+                            )))
+                        }
+                    }
+                }
+                Some("sharding_indexed") => {
+                    let inner_shape: Option<Vec<u64>> = config["chunk_shape"]
+                        .as_array()
+                        .and_then(|s| s.iter().map(serde_json::Value::as_u64).collect());
+                    match inner_shape {
+                        Some(s) if s.len() == shape.len() && s.iter().all(|&c| c > 0) => {
+                            inner = Some((s, config["codecs"].clone()));
+                        }
+                        _ => {
+                            return Err(bad(format!(
+                                "a shard's inner chunk shape {} for {} axes",
+                                config["chunk_shape"],
+                                shape.len()
+                            )))
+                        }
+                    }
+                    break;
+                }
+                _ => {}
+            }
+        }
+        let Some((inner_shape, inner_codecs)) = inner else {
+            break;
+        };
+        let per_shard = shape
+            .iter()
+            .zip(&inner_shape)
+            .try_fold(1u64, |a, (&s, &c)| a.checked_mul(s.div_ceil(c)))
+            .filter(|&n| n <= MAX_CHUNKS)
+            .ok_or_else(|| {
+                bad(format!(
+                    "shards of shape {shape:?} in inner chunks of {inner_shape:?}: more than \
+                     {MAX_CHUNKS} inner chunks per shard"
+                ))
+            })?;
+        chunks = chunks
+            .checked_mul(per_shard)
+            .filter(|&c| c <= MAX_CHUNKS)
+            .ok_or_else(|| {
+                bad(format!(
+                    "the volume read spans more than {MAX_CHUNKS} inner chunks of {inner_shape:?}"
+                ))
+            })?;
+        shape = inner_shape;
+        codecs = inner_codecs;
+    }
+    Ok(largest_elements * voxel_bytes(array))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::volume::{load_within_seconds, make_fifo};
+    use serde_json::json;
+
+    /// An OME-Zarr 0.5 image at `dir/img.zarr` with one level, `0`, of `array` (a Zarr v3
+    /// array's metadata), and `chunks` [(key under `0/`, bytes)].
+    fn image(
+        dir: &Path,
+        axes: &[&str],
+        array: serde_json::Value,
+        chunks: &[(&str, &[u8])],
+    ) -> PathBuf {
+        let root = dir.join("img.zarr");
+        let axes: Vec<_> = axes
+            .iter()
+            .map(|&a| match a {
+                "t" => json!({"name": "t", "type": "time"}),
+                a => json!({"name": a, "type": "space", "unit": "millimeter"}),
+            })
+            .collect();
+        let group = json!({"zarr_format": 3, "node_type": "group", "attributes": {"ome": {
+            "version": "0.5", "multiscales": [{"axes": axes, "datasets": [{"path": "0",
+            "coordinateTransformations": [{"type": "scale", "scale": vec![1.0; axes.len()]}]}]}]}}});
+        std::fs::create_dir_all(root.join("0")).unwrap();
+        std::fs::write(root.join("zarr.json"), group.to_string()).unwrap();
+        std::fs::write(root.join("0/zarr.json"), array.to_string()).unwrap();
+        for (key, bytes) in chunks {
+            let path = root.join("0").join(key);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, bytes).unwrap();
+        }
+        root
+    }
+
+    fn array(shape: &[u64], chunk: &[u64], codecs: serde_json::Value) -> serde_json::Value {
+        json!({"zarr_format": 3, "node_type": "array", "shape": shape, "data_type": "uint8",
+            "chunk_grid": {"name": "regular", "configuration": {"chunk_shape": chunk}},
+            "chunk_key_encoding": {"name": "default"}, "fill_value": 0, "codecs": codecs})
+    }
+
+    fn error(path: &Path) -> String {
+        load_within_seconds(path, 20).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn chunk_sizes_and_counts_are_checked_before_any_chunk_is_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let bytes = json!([{"name": "bytes"}]);
+        // A chunk larger than the volume read (and a 256³ chunk): it would be decoded whole.
+        let e = error(&image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[2, 2, 2], &[1024, 1024, 1024], bytes.clone()),
+            &[],
+        ));
+        assert!(
+            e.contains("img.zarr")
+                && e.contains("[1024, 1024, 1024]")
+                && e.contains("decoded whole"),
+            "{e}"
+        );
+        // 4M chunks of one voxel: minutes of file opens.
+        let e = error(&image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[64, 128, 512], &[1, 1, 1], bytes.clone()),
+            &[],
+        ));
+        assert!(
+            e.contains("[64, 128, 512] chunks") && e.contains("262144"),
+            "{e}"
+        );
+        // A shard of 2^60 inner chunks, whose index would be read whole (zarrs overflowed).
+        let sharded = json!([{"name": "sharding_indexed", "configuration": {"chunk_shape": [1, 1, 1],
+            "codecs": [{"name": "bytes"}], "index_codecs": [{"name": "bytes"}], "index_location": "end"}}]);
+        let e = error(&image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[4, 4, 4], &[1 << 20, 1 << 20, 1 << 20], sharded),
+            &[("c/0/0/0", &[0xff; 64])],
+        ));
+        assert!(e.contains("decoded whole"), "{e}");
+        let sharded = json!([{"name": "sharding_indexed", "configuration": {"chunk_shape": [1, 1, 1],
+            "codecs": [{"name": "bytes"}], "index_codecs": [{"name": "bytes"}], "index_location": "end"}}]);
+        let e = error(&image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[64, 64, 128], &[64, 64, 128], sharded),
+            &[("c/0/0/0", &[0xff; 64])],
+        ));
+        assert!(e.contains("inner chunks per shard"), "{e}");
+        // A shard larger than the array, of a small index (64 inner chunks) but past the
+        // end of its 64-byte file: refused before anything is allocated for it.
+        let sharded = json!([{"name": "sharding_indexed", "configuration": {"chunk_shape": [2, 2, 2],
+            "codecs": [{"name": "bytes"}], "index_codecs": [{"name": "bytes"}], "index_location": "end"}}]);
+        let e = error(&image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[4, 4, 4], &[8, 8, 8], sharded),
+            &[("c/0/0/0", &[0xff; 64])],
+        ));
+        assert!(
+            e.contains("c/0/0/0") && e.contains("asked of a file of 64 bytes"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn decoded_sizes_that_zstd_and_blosc_state_are_checked() {
+        let dir = tempfile::tempdir().unwrap();
+        // 100 bytes of zstd data for a chunk of 8: decoding stops at the 9th byte.
+        let zstd = zstd::bulk::compress(&[7u8; 100], 1).unwrap();
+        let codecs = json!([{"name": "bytes"}, {"name": "zstd", "configuration": {"level": 1, "checksum": false}}]);
+        let e = error(&image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[2, 2, 2], &[2, 2, 2], codecs.clone()),
+            &[("c/0/0/0", &zstd)],
+        ));
+        assert!(
+            e.contains("img.zarr") && e.contains("more than the 8 bytes its chunk holds"),
+            "{e}"
+        );
+        // A frame stating 2^40 bytes (zarrs allocated them): refused by its window.
+        let mut frame = vec![0x28, 0xb5, 0x2f, 0xfd, 0xe0];
+        frame.extend((1u64 << 40).to_le_bytes());
+        frame.extend([1, 0, 0]);
+        let e = error(&image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[2, 2, 2], &[2, 2, 2], codecs),
+            &[("c/0/0/0", &frame)],
+        ));
+        assert!(e.contains("zstd"), "{e}");
+        // A blosc header stating 2 GiB, in Zarr v3 and as a Zarr v2 compressor.
+        let mut blosc = vec![2, 1, 3, 1];
+        blosc.extend(0x7fff_ff00u32.to_le_bytes());
+        blosc.extend(0x1_0000u32.to_le_bytes());
+        blosc.extend(32u32.to_le_bytes());
+        blosc.extend([0; 16]);
+        let codecs = json!([{"name": "bytes"}, {"name": "blosc", "configuration": {"typesize": 1,
+            "cname": "lz4", "clevel": 5, "shuffle": "noshuffle", "blocksize": 0}}]);
+        let e = error(&image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[2, 2, 2], &[2, 2, 2], codecs),
+            &[("c/0/0/0", &blosc)],
+        ));
+        assert!(e.contains("blosc header states 2147483392 bytes"), "{e}");
+        let root = dir.path().join("img.zarr");
+        std::fs::remove_dir_all(&root).unwrap();
+        std::fs::create_dir_all(root.join("0")).unwrap();
+        std::fs::write(root.join(".zgroup"), r#"{"zarr_format": 2}"#).unwrap();
+        std::fs::write(root.join(".zattrs"), json!({"multiscales": [{"version": "0.4",
+            "axes": [{"name": "z", "type": "space"}, {"name": "y", "type": "space"}, {"name": "x", "type": "space"}],
+            "datasets": [{"path": "0", "coordinateTransformations": [{"type": "scale", "scale": [1, 1, 1]}]}]}]}).to_string()).unwrap();
+        std::fs::write(root.join("0/.zarray"), json!({"zarr_format": 2, "shape": [2, 2, 2], "chunks": [2, 2, 2],
+            "dtype": "|u1", "compressor": {"id": "blosc", "cname": "lz4", "clevel": 5, "shuffle": 1},
+            "fill_value": 0, "order": "C", "filters": null}).to_string()).unwrap();
+        std::fs::write(root.join("0/0.0.0"), &blosc).unwrap();
+        let e = error(&root);
+        assert!(
+            e.contains("0/0.0.0") && e.contains("blosc header states 2147483392 bytes"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn odd_shapes_units_and_files_fail_cleanly() {
+        let dir = tempfile::tempdir().unwrap();
+        let bytes = json!([{"name": "bytes"}]);
+        // Sides whose product overflows u64 (this panicked).
+        let e = error(&image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[1 << 62, 1 << 62, 1 << 62], &[1, 1, 1], bytes.clone()),
+            &[],
+        ));
+        assert!(e.contains("no resolution level fits"), "{e}");
+        // A time axis of no entries.
+        let e = error(&image(
+            dir.path(),
+            &["t", "z", "y", "x"],
+            array(&[0, 2, 2, 2], &[1, 2, 2, 2], bytes.clone()),
+            &[],
+        ));
+        assert!(e.contains("axis t has no entries"), "{e}");
+        // A scale past the spacing limits.
+        let root = image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[2, 2, 2], &[2, 2, 2], bytes.clone()),
+            &[],
+        );
+        let group = std::fs::read_to_string(root.join("zarr.json")).unwrap();
+        std::fs::write(
+            root.join("zarr.json"),
+            group.replace("[1.0,1.0,1.0]", "[1e-12,1.0,1.0]"),
+        )
+        .unwrap();
+        let e = error(&root);
+        assert!(
+            e.contains("coordinateTransformations") && e.contains("spacing"),
+            "{e}"
+        );
+        // A chunk that is a FIFO: refused by name, not opened (the read would block).
+        let root = image(
+            dir.path(),
+            &["z", "y", "x"],
+            array(&[2, 2, 2], &[2, 2, 2], bytes),
+            &[],
+        );
+        std::fs::create_dir_all(root.join("0/c/0/0")).unwrap();
+        if make_fifo(&root.join("0/c/0/0/0")) {
+            let e = error(&root);
+            assert!(e.contains("c/0/0/0 is a named pipe (FIFO)"), "{e}");
+        }
+    }
 }
