@@ -75,7 +75,8 @@ driver=$!
 until [ "$(ls {tmp}/farm-killed/reference/*.exr 2>/dev/null | wc -l)" -ge 2 ]; do sleep 0.1; done
 kill -9 $driver
 wait $driver || true
-pkill -9 -f -- '--out {tmp}/farm-killed' || true
+# Anchored at dvr's path: this script's own command line names the folder too.
+pkill -9 -f -- '^{dvr_bin} .*--out {tmp}/farm-killed' || true
 sleep 1
 ls -a {tmp}/farm-killed/reference > {tmp}/killed-left.txt
 {farm} reference --shards 4 --dvr {dvr_bin} --summary {tmp}/rerun.json -- {q(SCENE)} --out {tmp}/farm-killed
@@ -84,7 +85,7 @@ ls -a {tmp}/farm-killed/reference > {tmp}/killed-left.txt
         in_loopback_namespace() + ["bash", "-c", script], capture_output=True, text=True, timeout=600
     )
     shutil.rmtree(ray_tmp, ignore_errors=True)
-    assert run.returncode == 0, f"the farm failed:\n{run.stdout[-3000:]}\n{run.stderr[-6000:]}"
+    assert run.returncode == 0, f"the farm failed (exit {run.returncode}):\n{run.stdout[-3000:]}\n{run.stderr[-6000:]}"
     single = [dvr_bin, "reference", *SCENE, "--out", str(tmp / "one-ref")]
     subprocess.run(single, check=True, capture_output=True)
     return tmp, marker, run.stderr
