@@ -529,6 +529,17 @@ def b_viewer():
     return "\n".join(lines)
 
 
+def b_viewer_line():
+    """README's sentence on the viewer: its first row's frame rate and drag latency."""
+    r = read_csv("viewer", "viewer.csv")[0]
+    return (
+        f"At {r['size'].replace('x', '×')} on {r['device']}, {r['machine']}: it renders "
+        f"{r['render_fps']} frames/s and shows {r['shown_fps']}; a drag shows in the cell "
+        f"{r['latency_ms_median']} ms later (median, {num(r['latency_frames_median']):.1f} "
+        f"frames), measured in JupyterLab by `{r['command'].split(' --out')[0]}`."
+    )
+
+
 def b_soak():
     rows = read_csv("soak", "soak.csv")
     body = [[r["session"], f"{int(r['frames']):,}", r["seconds"],
@@ -621,6 +632,7 @@ BLOCKS = {
     "fuzz": (b_fuzz, ["fuzz/runs.csv"]),
     "rae-training": (b_rae_training, ["../rae/*.json"]),
     "viewer": (b_viewer, ["viewer/viewer.csv", "gpu/h200-profile.csv"]),
+    "viewer-line": (b_viewer_line, ["viewer/viewer.csv"]),
     "soak": (b_soak, ["soak/soak.csv"]),
     "cuts": (b_cuts, ["cuts/summary.csv", "cuts/metrics.csv"]),
     "cut-cost": (b_cut_cost, ["cut-cost/profile.csv"]),
