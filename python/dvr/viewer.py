@@ -148,10 +148,13 @@ class Viewer(anywidget.AnyWidget):
 
     def close(self):
         """Stops the render thread, frees a renderer the viewer made, and closes the
-        widget."""
-        self._stop.set()
-        if threading.current_thread() is not self._thread:
-            self._thread.join(timeout=60)
+        widget. Safe on a viewer whose construction failed part way (the widget's
+        finaliser calls it)."""
+        stop, thread = getattr(self, "_stop", None), getattr(self, "_thread", None)
+        if stop is not None:
+            stop.set()
+        if thread is not None and thread.is_alive() and threading.current_thread() is not thread:
+            thread.join(timeout=60)
         if getattr(self, "_owns", False) and getattr(self, "renderer", None) is not None:
             self.renderer.close()
             self.renderer = None
