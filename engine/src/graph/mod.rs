@@ -556,7 +556,8 @@ impl RenderGraph {
             }
         }
         for slot in &mut self.buffers {
-            if slot.transient && slot.used_in + frames.max(1) <= last {
+            if slot.transient && slot.used_in + frames.max(1) <= last && slot.buffer.is_allocated()
+            {
                 slot.buffer.destroy(ctx);
                 slot.state = ResourceState::default();
             }
