@@ -107,7 +107,7 @@ fn profile_prints_a_table_and_writes_json_and_a_chrome_trace() {
         "--volume-size",
         "32",
         "--denoiser",
-        "ours",
+        "ours,taa",
         "--json",
         json.to_str().expect("utf-8"),
         "--trace",
@@ -136,6 +136,35 @@ fn profile_prints_a_table_and_writes_json_and_a_chrome_trace() {
     assert!(update["gb_per_s"].as_f64().expect("GB/s") > 0.0);
     assert!(update["percent_of_peak"].as_f64().expect("% of peak") > 0.0);
     assert_eq!(p["frames_rendered"], 6);
+    // Each denoiser's cost counts the features it reads: the surface features for both
+    // (taa reprojects with them), the guides for ours alone.
+    let pass_ms = |name: &str| {
+        p["passes"]
+            .as_array()
+            .expect("passes")
+            .iter()
+            .find(|r| r["pass"] == name)
+            .expect(name)["mean_ms"]
+            .as_f64()
+            .expect("ms")
+    };
+    let methods = p["methods"].as_array().expect("methods");
+    let row = |m: &str| methods.iter().find(|r| r["method"] == m).expect(m);
+    let (ours, taa) = (row("ours"), row("taa"));
+    let needed = |r: &serde_json::Value| r["needed_ms"].as_f64().expect("needed_ms");
+    let features = pass_ms("surface_features");
+    assert!((needed(taa) - features).abs() < 1e-9, "{taa}");
+    assert!(
+        (needed(ours) - features - pass_ms("aux_features")).abs() < 1e-9,
+        "{ours}"
+    );
+    for r in [ours, taa] {
+        let cost = r["cost_ms"].as_f64().expect("cost_ms");
+        assert!((cost - needed(r) - r["own_ms"].as_f64().expect("own")).abs() < 1e-9);
+        assert!(r["dispatches"].as_f64().expect("dispatches") >= 2.0, "{r}");
+        assert!(r["bytes_per_pixel"].as_f64().expect("bytes") > 0.0, "{r}");
+    }
+    assert!(table.contains("bytes/pixel"), "{table}");
     let t: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&trace).expect("trace")).expect("parses");
     let events = t["traceEvents"].as_array().expect("events");

@@ -384,30 +384,31 @@ def b_cost():
         except Missing:
             continue
         sources.append(f"{name}.json")
-        own, shared = {}, {}
-        for p in prof["passes"]:
-            owner = p.get("owner")
-            method = owner.get("method") if isinstance(owner, dict) else None
-            med = num(p.get("median_ms")) or 0.0
-            # The guides composited along the ray are shared: charged to the first method
-            # listed that reads them, they count for neither sum here.
-            if method and p["pass"] != "aux_features":
-                own[method] = own.get(method, 0.0) + med
-            else:
-                shared[p["pass"]] = shared.get(p["pass"], 0.0) + med
-        if "ours" in own and "svgf" in own:
-            body.append([prof.get("scene", name), fmt(own["ours"], 1), fmt(own["svgf"], 1),
-                         f"{own['ours'] / own['svgf']:.2f}×",
-                         fmt(shared.get("surface_features"), 1), fmt(shared.get("aux_features"), 1),
-                         fmt(shared.get("path_trace"), 1)])
+        rows = {m["method"]: m for m in prof.get("methods", [])}
+        passes = {p["pass"]: num(p.get("mean_ms")) for p in prof["passes"]}
+        if "ours" in rows and "svgf" in rows:
+            o, s_ = rows["ours"], rows["svgf"]
+            body.append([prof.get("scene", name),
+                         fmt(num(o["own_ms"]), 1), fmt(num(o["cost_ms"]), 1),
+                         fmt(num(s_["own_ms"]), 1), fmt(num(s_["cost_ms"]), 1),
+                         f"{num(o['own_ms']) / num(s_['own_ms']):.2f}×",
+                         f"{num(o['cost_ms']) / num(s_['cost_ms']):.2f}×",
+                         f"{num(o['dispatches']):.1f} / {num(s_['dispatches']):.1f}",
+                         f"{num(o['bytes_per_pixel']):.0f} / {num(s_['bytes_per_pixel']):.0f}",
+                         fmt(passes.get("path_trace"), 1)])
     if not body:
-        raise Missing("assets/results/cost/*.json")
+        raise Missing("assets/results/cost/*.json (with the profile's per-method rows)")
     return "\n".join([
-        "Medians over the frames of each method's own passes, summed, in ms per frame at "
-        "256×256; the shared passes, which neither sum includes, beside them:",
+        "Mean ms per frame at 256×256. *Own* is a method's own passes; *with features* adds "
+        "the passes it needs and would run alone (the surface features and the guides "
+        "composited along the ray, which both read); dispatches and declared bytes per "
+        "pixel per frame count the same passes (a pass run only when the scene changed "
+        "counts by the share of frames it ran in). The path trace, which every method "
+        "shares, beside them:",
         "",
-        table(["scene", "`ours`", "`svgf`", "ours / svgf", "`surface_features`",
-               "`aux_features`", "`path_trace`"], body),
+        table(["scene", "`ours` own", "`ours` with features", "`svgf` own",
+               "`svgf` with features", "ours / svgf, own", "ours / svgf, with features",
+               "dispatches ours / svgf", "bytes per pixel ours / svgf", "`path_trace`"], body),
         "",
         source("cost", sources),
     ])

@@ -11,6 +11,7 @@
 // only the local departure from it must prove itself. Once per stratum, so the update
 // passes read one texel per pixel.
 #include "common.glsl"
+#include "ours_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -25,14 +26,10 @@ layout(push_constant) uniform OursGradientPoolPush {
     uint pad0;
 } pc;
 
-// The widest pool's radius in strata (9×9).
-const int WIDE = 4;
-// A ratio of more than 4× per frame is taken as 4×: the scaled model then starts closer
-// to the new value and the update's jump test takes the rest.
-const float RATIO_MAX = 4.0;
-// Channels darker than this share of the luminance are damped towards no change (their
-// ratios are noise over almost nothing).
-const float DARK_CHANNEL = 0.01;
+// A ratio beyond RATIO_MAX per frame is taken as RATIO_MAX: the scaled model then starts
+// closer to the new value and the update's jump test takes the rest. Channels darker than
+// DARK_CHANNEL of the luminance are damped towards no change (their ratios are noise over
+// almost nothing). (ours_constants.glsl)
 
 struct Pooled {
     float L;       // log luminance ratio
@@ -74,14 +71,14 @@ Pooled pooled(Sums s) {
     o.measured = false;
     float y_new = luminance(s.new_rgb), y_old = luminance(s.old_rgb);
     float y_max = max(y_new, y_old);
-    if (!(y_max > 1e-6 && y_old > 1e-6)) return o;  // nothing lit to compare
+    if (!(y_max > LIT_MIN && y_old > LIT_MIN)) return o;  // nothing lit to compare
     // The ratio's standard error from the strata's scatter about it (a ratio
     // estimator's sandwich variance), as a log: a steady change is a constant.
     float R = y_new / y_old;
     float scatter = max(s.nn - 2.0 * R * s.no + R * R * s.oo, 0.0);
     float var_r = scatter / (y_old * y_old) * (s.n / (s.n - 1.0));
     o.L = log(clamp(R, 1.0 / RATIO_MAX, RATIO_MAX));
-    o.var_l = var_r / (R * R + 1e-12);
+    o.var_l = var_r / (R * R + VARIANCE_FLOOR);
     // Channels far darker than the luminance are damped towards no change.
     float eps = DARK_CHANNEL * y_max;
     vec3 ratio = clamp((s.new_rgb + eps) / (s.old_rgb + eps), vec3(1.0 / RATIO_MAX), vec3(RATIO_MAX));
@@ -93,7 +90,7 @@ Pooled pooled(Sums s) {
 // `L`, `var_l`, shrunk towards `prior`; `kept` the share of the departure kept.
 float shrunk(float L, float var_l, float prior, out float kept) {
     float d = L - prior;
-    kept = d * d / (d * d + pc.shrink * var_l + 1e-12);
+    kept = d * d / (d * d + pc.shrink * var_l + VARIANCE_FLOOR);
     return prior + kept * d;
 }
 
@@ -107,14 +104,14 @@ void main() {
     // lavapipe: 2.5 against 0.7 ms at 256².)
     Sums rings[3];
     for (int i = 0; i < 3; ++i) rings[i] = Sums(vec3(0.0), vec3(0.0), 0.0, 0.0, 0.0, 0.0);
-    for (int dy = -WIDE; dy <= WIDE; ++dy) {
-        for (int dx = -WIDE; dx <= WIDE; ++dx) {
+    for (int dy = -POOL_RADIUS_WIDE; dy <= POOL_RADIUS_WIDE; ++dy) {
+        for (int dx = -POOL_RADIUS_WIDE; dx <= POOL_RADIUS_WIDE; ++dx) {
             ivec2 k = clamp(s + ivec2(dx, dy), ivec2(0), strata - 1);
             vec3 a = imageLoad(gradient_new, k).rgb, b = imageLoad(gradient_old, k).rgb;
             int r = max(abs(dx), abs(dy));
-            if (r <= 1) {
+            if (r <= POOL_RADIUS_NEAR) {
                 rings[0] = add(rings[0], a, b);
-            } else if (r <= 2) {
+            } else if (r <= POOL_RADIUS_MID) {
                 rings[1] = add(rings[1], a, b);
             } else {
                 rings[2] = add(rings[2], a, b);

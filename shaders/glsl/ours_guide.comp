@@ -6,6 +6,7 @@
 // edge between two pixel centres is a blend in the radiance; the tent makes it one in the
 // guides too, and the prior's fit does not draw a staircase.
 #include "common.glsl"
+#include "ours_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -26,15 +27,18 @@ void main() {
     ivec2 size = ivec2(pc.width, pc.height);
     if (p.x >= size.x || p.y >= size.y) return;
     vec3 sa = vec3(0.0), sn = vec3(0.0);
-    for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
+    // The tent's weights: (r + 1 − |dx|)(r + 1 − |dy|), summing to (r + 1)⁴.
+    const int t = FOOTPRINT_RADIUS + 1;
+    const float total = float(t * t * t * t);
+    for (int dy = -FOOTPRINT_RADIUS; dy <= FOOTPRINT_RADIUS; ++dy) {
+        for (int dx = -FOOTPRINT_RADIUS; dx <= FOOTPRINT_RADIUS; ++dx) {
             ivec2 q = clamp(p + ivec2(dx, dy), ivec2(0), size - 1);
             vec3 a = imageLoad(guide, q).rgb, n = imageLoad(normal, q).xyz;
-            float w = float((2 - abs(dx)) * (2 - abs(dy)));
+            float w = float((t - abs(dx)) * (t - abs(dy)));
             sa += w * (all_finite(a) ? a : vec3(0.0));
             sn += w * (all_finite(n) ? n : vec3(0.0));
         }
     }
-    imageStore(footprint, p, vec4(sa / 16.0, 1.0));
-    imageStore(footprint_normal, p, vec4(sn / 16.0, 0.0));
+    imageStore(footprint, p, vec4(sa / total, 1.0));
+    imageStore(footprint_normal, p, vec4(sn / total, 0.0));
 }

@@ -9,6 +9,7 @@
 // shift of the state: it corrects the estimate and adds the correction's uncertainty to
 // the process noise.
 #include "common.glsl"
+#include "ours_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -24,11 +25,9 @@ layout(push_constant) uniform OursLagPush {
 
 // The window's radius (5×5 at 2), a specialisation constant so the loops unroll.
 layout(constant_id = 15) const int LAG_RADIUS = 2;
-// Share of the window that must hold a residual for the mean to count (next to a
-// disocclusion, a few old pixels say little about a region).
-const float MIN_SHARE = 0.5;
-// The variance written where there is no estimate: so large that no mean is significant.
-const float NO_ESTIMATE = 1e30;
+// LAG_MIN_SHARE of the window must hold a residual for the mean to count (next to a
+// disocclusion, a few old pixels say little about a region); where there is no estimate
+// the variance written is NO_ESTIMATE, so large that no mean is significant.
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -49,7 +48,7 @@ void main() {
         }
     }
     // Fewer than half the neighbours with a residual: no estimate (variance infinite).
-    float min_n = MIN_SHARE * float((2 * LAG_RADIUS + 1) * (2 * LAG_RADIUS + 1));
+    float min_n = LAG_MIN_SHARE * float((2 * LAG_RADIUS + 1) * (2 * LAG_RADIUS + 1));
     if (n < min_n) {
         imageStore(lag, p, vec4(0.0, 0.0, 0.0, NO_ESTIMATE));
         return;

@@ -7,6 +7,7 @@
 // luminance is its first moment. The update (ours_update.comp) sums 5 rows of these:
 // the 5×5 neighbourhood in 10 loads instead of 25.
 #include "common.glsl"
+#include "ours_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -25,7 +26,7 @@ void main() {
     ivec2 size = ivec2(pc.width, pc.height);
     if (p.x >= size.x || p.y >= size.y) return;
     vec3 s = vec3(0.0);
-    for (int dx = -2; dx <= 2; ++dx) {
+    for (int dx = -NOISE_RADIUS; dx <= NOISE_RADIUS; ++dx) {
         ivec2 q = ivec2(clamp(p.x + dx, 0, size.x - 1), p.y);
         vec2 m = imageLoad(moments, q).xy;
         if (!all_finite(vec3(m, 0.0))) m = vec2(0.0);

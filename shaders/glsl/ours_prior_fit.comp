@@ -35,7 +35,6 @@ layout(push_constant) uniform OursPriorFitPush {
 // albedo (one material, or only background) or normal (a flat face, no surface) leaves
 // its coefficients undetermined, and the fit falls back on the other features or a
 // constant.
-const float RIDGE = 1e-3;
 
 void main() {
     const int D = PRIOR_FEATURES;
@@ -44,8 +43,8 @@ void main() {
     // The window's sums: the 3×3 blocks around the cell.
     vec4 T[PRIOR_SUM_TEXELS];
     for (int k = 0; k < PRIOR_SUM_TEXELS; ++k) T[k] = vec4(0.0);
-    for (int by = -1; by <= 1; ++by) {
-        for (int bx = -1; bx <= 1; ++bx) {
+    for (int by = -FIT_RADIUS; by <= FIT_RADIUS; ++by) {
+        for (int bx = -FIT_RADIUS; bx <= FIT_RADIUS; ++bx) {
             ivec2 block = cell + ivec2(bx, by);
             if (any(lessThan(block, ivec2(0))) || block.x >= int(pc.cells_x) || block.y >= int(pc.cells_y)) continue;
             [[unroll]] for (int k = 0; k < PRIOR_SUM_TEXELS; ++k) {

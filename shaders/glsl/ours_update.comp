@@ -40,6 +40,7 @@
 #include "common.glsl"
 #include "reproject.glsl"
 #include "ours_change.glsl"
+#include "ours_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -70,21 +71,18 @@ layout(push_constant) uniform OursUpdatePush {
     float outlier_z;      // innovation, in standard deviations, beyond which it is clipped
 } pc;
 
-// Guards against division by zero (radiance² units).
-const float TINY = 1e-12;
-// Motion on screen, in pixels, below which a pixel counts as still.
-const float STILL_PX = 0.01;
-// The residual the lag test pools is a running one: this share of this frame's, the rest
-// last frame's (carried along with the change and less the shift it caused). A lag
-// persists from frame to frame while the noise does not, so at one half the running
-// residual has a third of one frame's noise variance.
-const float LAG_BLEND = 0.5;
+// TINY guards against division by zero (radiance² units).
+const float TINY = VARIANCE_FLOOR;
+// The lag test's running residual (LAG_BLEND of this frame's, the rest last frame's,
+// carried along with the change and less the shift it caused): a lag persists from frame
+// to frame while the noise does not, so at one half the running residual has a third of
+// one frame's noise variance.
 
 // This frame's sums over the 5×5 neighbourhood: x the moments' noise, y the luminance, z
 // its square. ours_noise.comp summed each row's 5 pixels; this sums 5 rows.
 vec3 neighbourhood_sums(ivec2 p, ivec2 size) {
     vec3 s = vec3(0.0);
-    for (int dy = -2; dy <= 2; ++dy) {
+    for (int dy = -NOISE_RADIUS; dy <= NOISE_RADIUS; ++dy) {
         s += imageLoad(noise_rows, ivec2(p.x, clamp(p.y + dy, 0, size.y - 1))).xyz;
     }
     return s;
@@ -98,8 +96,9 @@ vec3 neighbourhood_sums(ivec2 p, ivec2 size) {
 // converged on a low mean, and the à-trous kept it as a dark blotch (static views).
 // `s`: the sums neighbourhood_sums returns.
 float fresh_noise(vec3 s) {
-    if (pc.spp >= 2.0) return s.x / 25.0 + TINY;
-    return max(s.z / 25.0 - (s.y / 25.0) * (s.y / 25.0), 0.0) * 25.0 / 24.0 + TINY;
+    const float n = float(NOISE_TAPS);
+    if (pc.spp >= 2.0) return s.x / n + TINY;
+    return max(s.z / n - (s.y / n) * (s.y / n), 0.0) * n / float(NOISE_TAPS - 1) + TINY;
 }
 
 // The history's estimate resampled by Catmull-Rom over the 4×4 texels around `r.uv`
@@ -116,7 +115,7 @@ vec4 history_fetch_sharp(sampler2D history, Reprojection r) {
     vec2 w[4] = vec2[](f * (-0.5 + f * (1.0 - 0.5 * f)), 1.0 + f * f * (-2.5 + 1.5 * f),
                        f * (0.5 + f * (2.0 - 1.5 * f)), f * f * (-0.5 + 0.5 * f));
     vec3 sum = vec3(0.0);
-    vec3 lo = vec3(1e30), up = vec3(-1e30);
+    vec3 lo = vec3(HUGE), up = vec3(-HUGE);
     // The four central texels are the bilinear footprint: their blend (the same sum
     // history_fetch makes) gives the variance and the fallback.
     vec4 bilinear = vec4(0.0);
@@ -171,7 +170,7 @@ void main() {
         // this frame. A pixel the light is about to reach is dark (x ≈ 0), and its own
         // level would keep Q ≈ 0 while its neighbours brighten: the gain must open
         // there too.
-        float level = max(luminance(max(x, vec3(0.0))), sums.y / 25.0);
+        float level = max(luminance(max(x, vec3(0.0))), sums.y / float(NOISE_TAPS));
         float Q = pc.change_q * sc.change * level;
         Q *= Q;
         if (length(r.motion) > STILL_PX) Q += pc.motion_q * R;

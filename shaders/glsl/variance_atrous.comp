@@ -38,6 +38,11 @@ layout(push_constant) uniform VarianceAtrousPush {
 } pc;
 
 const float B3[3] = float[](3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0);
+// The kernel's radius in taps: B3 spans 5.
+const int KERNEL_RADIUS = 2;
+// A floor under the range term's variance, in radiance² (a guard against dividing by
+// zero where two estimates are exact).
+const float RANGE_FLOOR = 1e-10;
 
 shared vec4 tile[TILE_TEXELS];
 // The prediction's window, read by every tap of a carrying level as the estimates' is;
@@ -79,8 +84,8 @@ void main() {
     vec3 sum = k0 * centre.rgb;
     float var_sum = k0 * k0 * centre.a;
     float wsum = k0;
-    for (int dy = -2; dy <= 2; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
+    for (int dy = -KERNEL_RADIUS; dy <= KERNEL_RADIUS; ++dy) {
+        for (int dx = -KERNEL_RADIUS; dx <= KERNEL_RADIUS; ++dx) {
             ivec2 q = p + ivec2(dx, dy) * pc.step;
             if ((dx == 0 && dy == 0) || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
             vec4 cq = tap(win, q);
@@ -92,7 +97,7 @@ void main() {
                                    max(cq.rgb, centre.rgb));
                 }
             }
-            float range = dot(d, d) / 3.0 / (pc.kappa * pc.kappa * (centre.a + cq.a) + 1e-10);
+            float range = dot(d, d) / 3.0 / (pc.kappa * pc.kappa * (centre.a + cq.a) + RANGE_FLOOR);
             float w = B3[abs(dx)] * B3[abs(dy)] * exp(-range);
             sum += w * cq.rgb;
             var_sum += w * w * cq.a;

@@ -5,7 +5,7 @@
 //! ```text
 //! DIR/bench.json                   device, peak bandwidth, settings, eval wall vs GPU time
 //! DIR/profile.csv                  size,pass,mean_ms,median_ms,p95_ms,mb,gb_per_s,percent_of_peak
-//! DIR/methods.csv                  size,method,own_ms,frame_ms: each denoiser's own passes
+//! DIR/methods.csv                  each denoiser's own passes, those it needs, dispatches, bytes
 //! DIR/profile_<WxH>.json           the full `dvr profile --json` report of each size
 //! DIR/profile_<WxH>.{svg,png}      GPU ms per pass, labelled with its share of the peak
 //! DIR/eval/{metrics,summary,baseline}.csv, DIR/eval/speed_accuracy.{svg,png}
@@ -18,12 +18,11 @@ mod plots;
 
 use crate::args::{RenderArgs, SceneArgs};
 use crate::capture::run_profile;
-use crate::eval::run::{method_gpu_ms, owned_by};
 use crate::eval::EvalArgs;
 use crate::output::{opt, write_text as write};
+use crate::profile::methods::method_rows;
 use crate::profile::{self, Profile};
 use anyhow::{Context, Result};
-use dvr_engine::gpu::timestamps::{gb_per_s, PassTiming};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -237,69 +236,24 @@ fn profile_csv(profiles: &[Profile]) -> String {
     s
 }
 
-/// One denoiser at one size: its own passes and the frame it would make alone.
-pub struct MethodRow {
-    pub method: String,
-    /// Mean GPU ms of the method's own passes.
-    pub own_ms: f64,
-    /// Declared bytes of its own passes per frame.
-    pub own_bytes: f64,
-    /// Their bandwidth's share of the peak.
-    pub own_percent_of_peak: Option<f64>,
-    /// The shared passes (path trace, features, motion) plus its own, as `dvr eval`
-    /// counts a method's GPU time.
-    pub frame_ms: f64,
-}
-
-/// Each profiled denoiser's row, from the profile's per-pass means.
-pub fn method_rows(p: &Profile) -> Vec<MethodRow> {
-    let means: Vec<PassTiming> = p
-        .passes
-        .iter()
-        .map(|r| PassTiming {
-            pass: r.pass.clone(),
-            owner: r.owner.clone(),
-            start_ms: 0.0,
-            ms: r.mean_ms,
-            bytes: r.bytes as u64,
-        })
-        .collect();
-    let peak = p.peak_bandwidth.as_ref().map(|b| b.gb_per_s);
-    p.run
-        .denoisers
-        .iter()
-        .map(|m| {
-            let own: Vec<&PassTiming> = means.iter().filter(|t| owned_by(t, m)).collect();
-            // `+ 0.0`: an empty sum is -0.0, which would print as "-0.0000".
-            let own_ms = own.iter().map(|t| t.ms).sum::<f64>() + 0.0;
-            let own_bytes = own.iter().map(|t| t.bytes as f64).sum::<f64>() + 0.0;
-            let rate = gb_per_s(own_bytes, own_ms);
-            MethodRow {
-                method: m.clone(),
-                own_ms,
-                own_bytes,
-                own_percent_of_peak: peak
-                    .filter(|&b| b > 0.0 && own_ms > 0.0)
-                    .map(|b| 100.0 * rate / b),
-                frame_ms: method_gpu_ms(&means, m),
-            }
-        })
-        .collect()
-}
-
 fn methods_csv(profiles: &[Profile]) -> String {
-    let mut s = String::from("size,method,own_ms,own_mb,own_percent_of_peak,frame_ms\n");
+    let mut s = String::from(
+        "size,method,own_ms,needed_ms,cost_ms,dispatches,bytes_per_pixel,percent_of_peak,frame_ms\n",
+    );
     for p in profiles {
         for r in method_rows(p) {
             let _ = writeln!(
                 s,
-                "{}x{},{},{:.4},{:.3},{},{:.4}",
+                "{}x{},{},{:.4},{:.4},{:.4},{:.2},{:.1},{},{:.4}",
                 p.run.width,
                 p.run.height,
                 r.method,
                 r.own_ms,
-                r.own_bytes / 1e6,
-                opt(r.own_percent_of_peak, 2),
+                r.needed_ms,
+                r.cost_ms,
+                r.dispatches,
+                r.bytes_per_pixel,
+                opt(r.percent_of_peak, 2),
                 r.frame_ms
             );
         }
@@ -310,56 +264,18 @@ fn methods_csv(profiles: &[Profile]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::profile::{RunInfo, Stats, Window};
-    use dvr_engine::gpu::timestamps::PassOwner;
-    use dvr_engine::passes::bandwidth::PeakBandwidth;
+    use crate::profile::methods::tests::two_method_profile;
 
     #[test]
-    fn method_rows_split_own_and_shared_passes() {
-        let t = |pass: &str, ms: f64, bytes: u64| PassTiming {
-            pass: pass.into(),
-            owner: match pass.split_once('.') {
-                Some((m, _)) => PassOwner::Method(m.into()),
-                None => PassOwner::Shared,
-            },
-            start_ms: 0.0,
-            ms,
-            bytes,
-        };
-        let frame = [
-            t("path_trace", 4.0, 0),
-            t("ours.update", 1.0, 3_000_000),
-            t("ours.spatial", 1.0, 1_000_000),
-            t("svgf.temporal", 2.0, 0),
-        ];
-        let mut stats = Stats::new();
-        for _ in 0..4 {
-            stats.add_frame(&frame);
-        }
-        let run = RunInfo {
-            device: "d".into(),
-            scene: "s".into(),
-            width: 8,
-            height: 8,
-            spp: 2,
-            denoisers: vec!["ours".into(), "svgf".into()],
-            shared_tiles: true,
-            volume: "dense volume".into(),
-        };
-        let peak = PeakBandwidth {
-            gb_per_s: 4.0,
-            buffer_bytes: 0,
-            method: "m".into(),
-        };
-        let p = Profile::new(run, &stats, &Window::new(1), Some(peak));
-        let rows = method_rows(&p);
-        assert_eq!(rows[0].method, "ours");
-        assert_eq!(rows[0].own_ms, 2.0);
-        assert_eq!(rows[0].frame_ms, 6.0);
-        // 4 MB in 2 ms = 2 GB/s = 50% of 4 GB/s.
-        assert_eq!(rows[0].own_percent_of_peak, Some(50.0));
-        assert_eq!(rows[1].frame_ms, 6.0);
-        let csv = methods_csv(&[p]);
-        assert!(csv.contains("8x8,ours,2.0000,4.000,50.00,6.0000"), "{csv}");
+    fn methods_csv_has_a_row_per_method() {
+        let csv = methods_csv(&[two_method_profile()]);
+        assert!(
+            csv.starts_with("size,method,own_ms,needed_ms,cost_ms,dispatches,"),
+            "{csv}"
+        );
+        assert!(
+            csv.contains("8x8,ours,2.5000,1.0000,3.5000,3.50,93750.0,42.86,7.5000"),
+            "{csv}"
+        );
     }
 }

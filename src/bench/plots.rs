@@ -2,8 +2,8 @@
 //! bar (with the shared path-tracing passes as the first bar for scale), labelled with
 //! the time and its passes' share of the measured peak bandwidth.
 
-use super::method_rows;
 use crate::eval::report::plots::{method_colour, save, Chart};
+use crate::profile::methods::{method_rows, shared_ms};
 use crate::profile::Profile;
 use anyhow::Result;
 use plotters::coord::Shift;
@@ -64,22 +64,20 @@ impl Chart for MethodBars {
 
 /// Writes `<stem>.svg` and `<stem>.png` for one profile.
 pub fn pass_chart(p: &Profile, stem: &Path) -> Result<()> {
-    let rows = method_rows(p);
-    // The shared passes: any method's frame minus its own passes.
-    let shared = rows.first().map(|r| r.frame_ms - r.own_ms).unwrap_or(0.0);
     let mut bars: Vec<Bar> = vec![(
-        "shared (path trace, features, motion)".into(),
-        shared,
+        "shared (path trace, motion)".into(),
+        shared_ms(p),
         None,
         RGBColor(90, 90, 90),
     )];
-    bars.extend(rows.into_iter().map(|r| {
+    // Each method with the passes it needs (features, guides), as it would run alone.
+    bars.extend(method_rows(p).into_iter().map(|r| {
         let colour = method_colour(&r.method);
-        (r.method, r.own_ms, r.own_percent_of_peak, colour)
+        (r.method, r.cost_ms, r.percent_of_peak, colour)
     }));
     let chart = MethodBars {
         title: format!(
-            "{} {}x{}: own GPU time per denoiser",
+            "{} {}x{}: GPU time per denoiser, with the features it needs",
             p.run.device, p.run.width, p.run.height
         ),
         bars,

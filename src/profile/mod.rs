@@ -7,6 +7,7 @@
 //! [`WINDOW_FRAMES`] frames only ([`Window`]).
 
 pub mod interrupt;
+pub mod methods;
 pub mod stats;
 
 use dvr_engine::gpu::timestamps::PassTiming;
@@ -73,6 +74,9 @@ pub struct Profile {
     pub peak_bandwidth: Option<PeakBandwidth>,
     pub passes: Vec<PassStats>,
     pub total: PassStats,
+    /// Each denoiser's cost: own passes, the passes it needs with others, dispatches and
+    /// bytes per pixel per frame ([`methods`]).
+    pub methods: Vec<methods::MethodRow>,
     /// Index of the first frame in `frames`.
     pub frames_first: usize,
     pub frames_note: String,
@@ -85,7 +89,7 @@ impl Profile {
     /// window.
     pub fn new(run: RunInfo, stats: &Stats, window: &Window, peak: Option<PeakBandwidth>) -> Self {
         let (passes, total) = stats.summary(peak.as_ref().map(|p| p.gb_per_s));
-        Self {
+        let mut p = Self {
             run,
             warmup_frames: WARMUP_FRAMES,
             frames_rendered: stats.frames_seen(),
@@ -93,10 +97,13 @@ impl Profile {
             peak_bandwidth: peak,
             passes,
             total,
+            methods: Vec::new(),
             frames_first: window.first(),
             frames_note: window_note(window, stats.frames_seen()),
             frames: window.frames().cloned().collect(),
-        }
+        };
+        p.methods = methods::method_rows(&p);
+        p
     }
 }
 
@@ -176,6 +183,17 @@ pub fn table(p: &Profile) -> String {
             r.bytes / 1e6,
             r.gb_per_s,
             peak
+        ));
+    }
+    s.push_str(&format!(
+        "\nper denoiser: own passes, the passes it needs with others (features, guides), and \
+         what it adds to the path-traced frame\n{:<28} {:>10} {:>10} {:>10} {:>10} {:>12}\n",
+        "denoiser", "own ms", "needed ms", "cost ms", "dispatches", "bytes/pixel"
+    ));
+    for m in &p.methods {
+        s.push_str(&format!(
+            "{:<28} {:>10.3} {:>10.3} {:>10.3} {:>10.2} {:>12.1}\n",
+            m.method, m.own_ms, m.needed_ms, m.cost_ms, m.dispatches, m.bytes_per_pixel
         ));
     }
     if p.frames_first > 0 {

@@ -24,15 +24,34 @@ const QUERIES_PER_PASS: u32 = 4;
 #[derive(Clone, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PassOwner {
-    /// Work every method of the frame shares (surface features, path trace, motion,
-    /// presentation).
+    /// Work every method of the frame shares (path trace, motion, presentation).
     #[default]
     Shared,
     /// One method's own pass (a denoiser, by its name).
     Method(String),
+    /// A pass that some of the frame's methods need and would each pay for alone (the
+    /// surface features, the guide images): part of each one's cost.
+    Methods(Vec<String>),
     /// Moves data into or out of the frame (uploads, readbacks): part of no method's
     /// rendering cost.
     Transfer,
+}
+
+impl PassOwner {
+    /// Whether the pass is work `method` needs beyond the shared frame: its own, or one
+    /// it needs with others.
+    pub fn serves(&self, method: &str) -> bool {
+        match self {
+            PassOwner::Method(m) => m == method,
+            PassOwner::Methods(ms) => ms.iter().any(|m| m == method),
+            PassOwner::Shared | PassOwner::Transfer => false,
+        }
+    }
+
+    /// Whether the pass is part of `method`'s GPU time: shared work and what it needs.
+    pub fn counts_for(&self, method: &str) -> bool {
+        *self == PassOwner::Shared || self.serves(method)
+    }
 }
 
 /// GPU time of one pass in one frame.

@@ -102,7 +102,13 @@ impl<'f> Frame<'f> {
     /// Runs `add`, recording every pass it adds as `method`'s own (its timings carry the
     /// owner, so reports total a method's GPU time without reading pass names).
     pub fn add_owned<T>(&mut self, method: &str, add: impl FnOnce(&mut Self) -> T) -> T {
-        let outer = std::mem::replace(&mut self.owner, PassOwner::Method(method.to_string()));
+        self.add_for(PassOwner::Method(method.to_string()), add)
+    }
+
+    /// Runs `add`, recording every pass it adds as work for `owner` (a pass several
+    /// methods need is [`PassOwner::Methods`]: each one's cost includes it).
+    pub fn add_for<T>(&mut self, owner: PassOwner, add: impl FnOnce(&mut Self) -> T) -> T {
+        let outer = std::mem::replace(&mut self.owner, owner);
         let result = add(self);
         self.owner = outer;
         result

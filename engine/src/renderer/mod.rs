@@ -21,7 +21,7 @@ use crate::denoise::{
     self, registry, Changes, DenoiseInputs, Denoiser, DenoiserConfig, DenoiserInfo, Retrace,
 };
 use crate::error::{EngineError, Result, VkContext};
-use crate::gpu::timestamps::TimestampPool;
+use crate::gpu::timestamps::{PassOwner, TimestampPool};
 use crate::gpu::GpuContext;
 use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
 use crate::passes::accumulate::Accumulate;
@@ -94,6 +94,15 @@ pub enum SettingsChange {
 struct Method {
     info: &'static DenoiserInfo,
     denoiser: Box<dyn Denoiser>,
+}
+
+/// The names of the methods `needs` picks.
+fn readers(methods: &[Method], needs: impl Fn(&Method) -> bool) -> Vec<String> {
+    methods
+        .iter()
+        .filter(|m| needs(m))
+        .map(|m| m.info.name.to_string())
+        .collect()
 }
 
 struct Passes {
@@ -428,14 +437,14 @@ impl Renderer {
             (&self.ctx, &mut self.graph, &self.passes, self.config.size);
 
         // features → path trace → motion → each denoiser on the same noisy frame.
+        // The features and guide passes are the cost of every method that needs them (a
+        // method alone would pay for them), not of the frame: `none` and `accum` read
+        // neither.
         let motion = self.config.motion_source;
-        let features = if request.features
-            || self
-                .denoisers
-                .iter()
-                .any(|m| m.info.features.needed(motion))
-        {
-            Some(passes.features.add(ctx, graph, &mut frame, &scene, size)?)
+        let feature_readers = readers(&self.denoisers, |m| m.info.features.needed(motion));
+        let features = if request.features || !feature_readers.is_empty() {
+            let owner = PassOwner::Methods(feature_readers);
+            Some(frame.add_for(owner, |f| passes.features.add(ctx, graph, f, &scene, size))?)
         } else {
             None
         };
@@ -475,21 +484,15 @@ impl Renderer {
             }
             _ => None,
         };
-        // The guide images: the albedo for a denoiser that demodulates by it (the pass is
-        // then its own, in its GPU time), both read back for single-frame denoisers
+        // The guide images: the albedo for the denoisers that read it (svgf demodulates by
+        // it, ours' prior fits on it), both read back for single-frame denoisers
         // (`FrameRequest::aux`).
         let aux = match &passes.aux {
             Some(pass) if request.aux || guides => {
-                let reader = self.denoisers.iter().find(|m| m.info.guides());
-                Some(match reader {
-                    Some(m) => {
-                        let normals = request.aux;
-                        frame.add_owned(m.info.name, |f| {
-                            pass.add(ctx, graph, f, &scene, size, normals)
-                        })?
-                    }
-                    None => pass.add(ctx, graph, &mut frame, &scene, size, true)?,
-                })
+                let owner = PassOwner::Methods(readers(&self.denoisers, |m| m.info.guides()));
+                Some(frame.add_for(owner, |f| {
+                    pass.add(ctx, graph, f, &scene, size, request.aux)
+                })?)
             }
             _ => None,
         };

@@ -5,6 +5,7 @@
 // [[unroll]] where a packed array is read or written: unrolled, its indices are constants
 // and it stays in registers (lavapipe otherwise keeps it in memory, at twice the cost).
 #extension GL_EXT_control_flow_attributes : require
+#include "ours_constants.glsl"
 
 // Pixels between two fits' centres and the edge of the blocks their normal equations are
 // summed over (set by the engine, which sizes the grid: its `prior::PRIOR_STRIDE`). A
@@ -28,7 +29,7 @@ vec3 features_hi(vec3 n) { return n; }
 
 // Where there is no fit (no finite estimate in the window): V so large that the prior
 // leaves the pixels near the cell as they are.
-const float NO_FIT = 1e30;
+const float NO_FIT = NO_ESTIMATE;
 
 // Solves (A + ridge·diag(0, 1, …, 1)) β = B for three right-hand sides (the colour
 // channels) by Cholesky; false if that matrix is not positive definite. A is symmetric
@@ -40,7 +41,7 @@ bool solve_ridge(float A[PRIOR_FEATURES][PRIOR_FEATURES], vec3 B[PRIOR_FEATURES]
     for (int j = 0; j < D; ++j) {
         float d = A[j][j] + (j > 0 ? ridge : 0.0);
         for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
-        if (!(d > 1e-20)) return false;
+        if (!(d > PIVOT_MIN)) return false;
         L[j][j] = sqrt(d);
         for (int i = j + 1; i < D; ++i) {
             float s = A[i][j];

@@ -21,7 +21,7 @@ use crate::progress::Progress;
 use crate::setup::Setup;
 use crate::shard::{FolderReport, RunReport};
 use anyhow::{Context, Result};
-use dvr_engine::gpu::timestamps::{PassOwner, PassTiming};
+use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::image_io::{to_rgb, write_exr};
 use dvr_engine::metrics::Rgb32Image;
 use dvr_engine::metrics::{self as score, score, FrameReference};
@@ -56,18 +56,14 @@ pub fn total_units(plan: &Plan, take: impl Fn(usize) -> bool) -> f64 {
         .sum()
 }
 
-/// Whether a pass is one of `method`'s own (the graph records who each pass works for).
-pub fn owned_by(t: &PassTiming, method: &str) -> bool {
-    matches!(&t.owner, PassOwner::Method(m) if m == method)
-}
-
-/// GPU time of `method` in one frame: the passes every method shares (surface
-/// features, path trace, motion, …) plus the method's own; uploads and readbacks are no
-/// method's cost.
+/// GPU time of `method` in one frame: the passes every method shares (path trace,
+/// motion) plus those it needs (the surface features and guide images, when it reads
+/// them, however many other methods read them too) and its own; uploads and readbacks
+/// are no method's cost. The graph records whom each pass works for.
 pub fn method_gpu_ms(timings: &[PassTiming], method: &str) -> f64 {
     timings
         .iter()
-        .filter(|t| t.owner == PassOwner::Shared || owned_by(t, method))
+        .filter(|t| t.owner.counts_for(method))
         .map(|t| t.ms)
         .sum()
 }
@@ -404,10 +400,14 @@ fn dir_file_name(dir: &Path) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use dvr_engine::gpu::timestamps::PassOwner;
 
     fn t(pass: &str, ms: f64) -> PassTiming {
         let owner = match pass.split_once('.') {
             _ if pass.starts_with("upload") || pass.starts_with("readback") => PassOwner::Transfer,
+            _ if pass.ends_with("features") => {
+                PassOwner::Methods(vec!["ours".into(), "rls-nf".into()])
+            }
             Some((method, _)) => PassOwner::Method(method.into()),
             None if pass == "accum" => PassOwner::Method(pass.into()),
             None => PassOwner::Shared,
@@ -426,6 +426,7 @@ mod tests {
         let frame = vec![
             t("upload_tf_diffuse", 100.0),
             t("surface_features", 1.0),
+            t("aux_features", 0.125),
             t("path_trace", 10.0),
             t("motion", 0.5),
             t("accum", 0.25),
@@ -434,10 +435,11 @@ mod tests {
             t("rls-nf.update", 40.0),
             t("readback_ours", 7.0),
         ];
-        assert_eq!(method_gpu_ms(&frame, "none"), 11.5);
-        assert_eq!(method_gpu_ms(&frame, "accum"), 11.75);
-        assert_eq!(method_gpu_ms(&frame, "ours"), 16.5);
-        assert_eq!(method_gpu_ms(&frame, "rls-nf"), 51.5);
+        // The features count for each method that reads them, and for no other.
+        assert_eq!(method_gpu_ms(&frame, "none"), 10.5);
+        assert_eq!(method_gpu_ms(&frame, "accum"), 10.75);
+        assert_eq!(method_gpu_ms(&frame, "ours"), 16.625);
+        assert_eq!(method_gpu_ms(&frame, "rls-nf"), 51.625);
     }
 
     #[test]

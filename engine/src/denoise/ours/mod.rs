@@ -31,6 +31,8 @@
 //! switch one part off each ([`OursVariant`]).
 
 mod atrous;
+#[cfg(test)]
+mod constants;
 mod gradient;
 mod gradient_pool;
 mod lag;
