@@ -41,7 +41,7 @@ layout(push_constant) uniform OursPriorPush {
     uint width;
     uint height;
     float keep;  // relative standard error below which an estimate is kept as it is
-    float pad;
+    uint combine;  // 1: young estimates are combined with the prediction (0: ours-no-prior)
 } pc;
 
 void main() {
@@ -64,7 +64,7 @@ void main() {
     vec4 centre = imageLoad(estimate, p);
     float P = centre.a;
     // A converged estimate is kept (as the à-trous keeps it).
-    if (!fitted || !all_finite(centre.rgb) || !(P >= pc.keep * pc.keep * dot(centre.rgb, centre.rgb) / 3.0) || isinf(P)) {
+    if (pc.combine == 0u || !fitted || !all_finite(centre.rgb) || !(P >= pc.keep * pc.keep * dot(centre.rgb, centre.rgb) / 3.0) || isinf(P)) {
         imageStore(combined, p, centre);
         return;
     }

@@ -69,6 +69,10 @@ layout(push_constant) uniform OursUpdatePush {
     float motion_q;       // process noise of a moving pixel, in units of R
     float lag_z;          // pooled residual, in standard errors, that is a shift
     float outlier_z;      // innovation, in standard deviations, beyond which it is clipped
+    uint shift;           // a significant pooled residual shifts the state (0: ours-no-lag)
+    uint pad0;
+    uint pad1;
+    uint pad2;
 } pc;
 
 // TINY guards against division by zero (radiance² units).
@@ -189,7 +193,7 @@ void main() {
             vec4 lag = history_fetch(lag_prev, r);
             float z2 = dot(lag.rgb, lag.rgb) / 3.0 / max(lag.a, TINY);
             float B = D + Q;
-            shifted = z2 > pc.lag_z * pc.lag_z && B > 0.0;
+            shifted = pc.shift != 0u && z2 > pc.lag_z * pc.lag_z && B > 0.0;
             if (shifted) shift = B / (B + max(lag.a, TINY)) * lag.rgb;
             x += shift;
             Q += dot(shift, shift) / 3.0;

@@ -15,6 +15,23 @@ use glam::{Vec3, Vec4};
 
 pub const LUT: usize = 256;
 
+/// A built-in scene `frames` long at `size`² with a 32³ procedural volume.
+pub fn builtin_setup(
+    name: &str,
+    frames: u32,
+    size: u32,
+) -> dvr_engine::renderer::scene_setup::SceneSetup {
+    let scene = dvr_engine::scene::Scene::builtin(name)
+        .expect("scene")
+        .with_frames(frames)
+        .expect("frames");
+    let extent = Extent {
+        width: size,
+        height: size,
+    };
+    dvr_engine::renderer::scene_setup::SceneSetup::new(scene, extent, None, 32).expect("setup")
+}
+
 pub fn context() -> GpuContext {
     GpuContext::headless().expect("a Vulkan device (install mesa-vulkan-drivers for lavapipe)")
 }

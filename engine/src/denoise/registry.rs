@@ -149,7 +149,7 @@ pub const DENOISERS: &[DenoiserInfo] = &[
         "a per-pixel Kalman filter told by temporal gradients how much the scene changed, with a pooled lag test, a spatial prior on the guide albedo and an à-trous filter",
         OURS,
     ),
-    // Ablations of ours: one part each.
+    // Ablations of ours: one stage each (tests/ablations.rs checks it by the stages' images).
     ours(
         "ours-no-gradient",
         "ours without temporal gradients",
@@ -157,12 +157,12 @@ pub const DENOISERS: &[DenoiserInfo] = &[
     ),
     ours(
         "ours-no-lag",
-        "ours without the pooled lag test",
+        "ours without the pooled lag test's shift of the state",
         OursVariant { lag: false, ..OURS },
     ),
     ours(
         "ours-no-prior",
-        "ours without the spatial prior (young estimates left to the à-trous alone)",
+        "ours without the spatial prior's combination (young estimates go to the à-trous, which still carries by the prior's model)",
         OursVariant { prior: false, ..OURS },
     ),
     ours(
@@ -237,13 +237,10 @@ impl DenoiserInfo {
     }
 
     /// Whether it reads the guide albedo composited along the ray
-    /// ([`DenoiseInputs::guides`](super::DenoiseInputs::guides)): SVGF demodulates by it.
+    /// ([`DenoiseInputs::guides`](super::DenoiseInputs::guides)): SVGF demodulates by it,
+    /// ours and each of its ablations fit the prior's model on it.
     pub fn guides(&self) -> bool {
-        match self.kind {
-            Kind::Svgf => true,
-            Kind::Ours(v) => v.prior,
-            _ => false,
-        }
+        matches!(self.kind, Kind::Svgf | Kind::Ours(_))
     }
 
     /// Builds the denoiser.

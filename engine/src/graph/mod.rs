@@ -176,6 +176,15 @@ impl RenderGraph {
         })
     }
 
+    /// The image named `name` as this frame writes it: a history's `cur`, or the image of
+    /// that name; `None` if the graph has neither.
+    pub fn find_image(&self, name: &str) -> Option<ImageHandle> {
+        match self.histories.get(name) {
+            Some(slot) => Some(slot.images[usize::from(!slot.flip)]),
+            None => self.image_names.get(name).copied(),
+        }
+    }
+
     /// Marks every history whose name starts with `prefix` invalid (a camera cut, a
     /// scene change, a denoiser reset). `""` resets all.
     pub fn reset_history(&mut self, prefix: &str) {

@@ -96,6 +96,27 @@ struct Method {
     denoiser: Box<dyn Denoiser>,
 }
 
+/// The graph image `name` (see [`Renderer::read_back_images`]), checked to be one that
+/// reads back as RGBA32F pixels of the frame.
+fn stage_image(graph: &RenderGraph, name: &str, size: Extent) -> Result<ImageHandle> {
+    let problem = |p: String| EngineError::Resource {
+        resource: name.into(),
+        problem: p,
+    };
+    let h = graph
+        .find_image(name)
+        .ok_or_else(|| problem("no image of that name in the render graph".into()))?;
+    let desc = graph.image_desc(h);
+    let want = [size.width, size.height, 1];
+    if desc.format != vk::Format::R32G32B32A32_SFLOAT || desc.extent != want {
+        return Err(problem(format!(
+            "is {:?} {:?}, not an RGBA32F image of the frame's size {want:?}",
+            desc.format, desc.extent
+        )));
+    }
+    Ok(h)
+}
+
 /// The names of the methods `needs` picks.
 fn readers(methods: &[Method], needs: impl Fn(&Method) -> bool) -> Vec<String> {
     methods
@@ -126,6 +147,9 @@ pub struct Renderer {
     /// After the next frame, release the graph's images it did not use (the denoisers or
     /// the size changed, and nothing older is in flight).
     release_unused: bool,
+    /// Graph images read back with every frame's outputs, by name (see
+    /// [`Renderer::read_back_images`]).
+    extra_readbacks: Vec<String>,
     graph: RenderGraph,
     passes: Passes,
     denoisers: Vec<Method>,
@@ -248,6 +272,7 @@ impl Renderer {
             features,
             pending_reset: false,
             release_unused: false,
+            extra_readbacks: Vec::new(),
             graph,
             passes,
             denoisers,
@@ -338,6 +363,15 @@ impl Renderer {
             .iter()
             .map(|m| m.info.name.to_string())
             .collect()
+    }
+
+    /// From the next frame on, also reads back these graph images by name with the
+    /// methods' outputs (a frame with `readback`): a stage of a denoiser as that frame
+    /// wrote it (`ours.model`, `ours.lag`, `ours.prior`, …; a history's name gives the
+    /// image written this frame), for tests that check a method stage by stage. Each must
+    /// be an RGBA32F image of the frame's size; a frame fails naming one that is not.
+    pub fn read_back_images(&mut self, names: &[&str]) {
+        self.extra_readbacks = names.iter().map(|n| n.to_string()).collect();
     }
 
     /// Replaces the denoisers (the explorer's picker). Waits for the frames in flight
@@ -526,6 +560,11 @@ impl Renderer {
         if let (true, Some(f)) = (request.features, &features) {
             let images = [f.position.cur, f.normal, f.albedo];
             read.extend(FEATURE_IMAGES.iter().map(|n| n.to_string()).zip(images));
+        }
+        if request.readback {
+            for name in &self.extra_readbacks {
+                read.push((name.clone(), stage_image(graph, name, size)?));
+            }
         }
         let readbacks = if request.readback {
             add_readbacks(ctx, graph, &mut frame, slot, &read, size)?

@@ -27,11 +27,10 @@ pub(super) struct LagImages {
 }
 
 impl Ours {
-    /// The pooled lag test, when the variant has it.
+    /// The pooled lag test (every variant runs it: the jump test reads it too; `ours-no-lag`
+    /// only takes no shift from it).
     pub(super) fn add_lag<'f>(&'f self, frame: &mut Frame<'f>, size: Extent, lag: &LagImages) {
-        let Some(pipeline) = &self.lag else {
-            return;
-        };
+        let pipeline = &self.lag;
         let push = OursLagPush {
             width: size.width,
             height: size.height,

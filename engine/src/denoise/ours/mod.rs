@@ -28,7 +28,8 @@
 //! - `<name>.atrous0..1` ([`atrous`], `variance_atrous.comp`): the à-trous spatial filter.
 //!
 //! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-prior`, `ours-no-atrous`)
-//! switch one part off each ([`OursVariant`]).
+//! switch one stage off each ([`OursVariant`]); every other pass runs as in `ours`, and
+//! `tests/ablations.rs` checks by the stages' images that only that stage changed.
 
 mod atrous;
 #[cfg(test)]
@@ -117,19 +118,23 @@ impl OursParams {
     }
 }
 
-/// Which parts run: `ours` has all; each ablation switches exactly one off.
+/// Which stages act: `ours` has all; each ablation switches exactly one off and leaves
+/// every other pass as it is in `ours`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OursVariant {
     /// Temporal gradients: the measured change g_t and its process noise (without them
-    /// g = 1 and Q has no change term).
+    /// g = 1 and Q has no change term; the gradient passes do not run).
     pub gradients: bool,
-    /// The pooled lag test: shifts the neighbourhood's residuals reveal.
+    /// The pooled lag test's shift of the state (without it the lag test still runs, and
+    /// its jump test, the running residual and everything else are as in `ours`; only no
+    /// significant residual shifts the state).
     pub lag: bool,
-    /// The à-trous spatial filter (without it the estimate is the output).
+    /// The à-trous spatial filter (without it the prior's combination is the output).
     pub atrous: bool,
-    /// The spatial prior: each estimate combined with a local linear model of its
-    /// neighbours' on the guide albedo and normal, by their variances (without it the
-    /// à-trous filters the estimates as they are).
+    /// The spatial prior's combination: each young estimate combined with a local linear
+    /// model of its neighbours' on the guide albedo and normal, by their variances
+    /// (without it the estimates go to the à-trous as they are; the model is still
+    /// fitted, and the à-trous still carries neighbours by it).
     pub prior: bool,
 }
 
@@ -148,15 +153,16 @@ pub struct Ours {
     pub params: OursParams,
     /// What the filter reprojects with.
     pub motion: MotionSource,
+    variant: OursVariant,
     gradients: Option<Pipeline<OursGradientPush>>,
     gradient_pool: Option<Pipeline<OursGradientPoolPush>>,
     noise: Pipeline<OursNoisePush>,
     update: Pipeline<OursUpdatePush>,
-    lag: Option<Pipeline<OursLagPush>>,
+    lag: Pipeline<OursLagPush>,
     atrous: Option<Pipeline<VarianceAtrousPush>>,
-    /// The à-trous that carries neighbours by the prior's prediction (with the prior).
+    /// The à-trous that carries neighbours by the prior's prediction (where there is one).
     atrous_carry: Option<Pipeline<VarianceAtrousPush>>,
-    prior: Option<PriorPipelines>,
+    prior: PriorPipelines,
 }
 
 /// The pooled lag test's window radius (5×5).
@@ -182,6 +188,7 @@ impl Ours {
             name: name.to_string(),
             params,
             motion,
+            variant,
             // The gradient pass traces paths: it is specialised like the path tracer.
             gradients: variant
                 .gradients
@@ -193,24 +200,16 @@ impl Ours {
                 .transpose()?,
             noise: ctx.pipeline("ours_noise", &[])?,
             update: ctx.pipeline("ours_update", &[motion_source])?,
-            lag: variant
-                .lag
-                .then(|| {
-                    let radius = SpecValue::I32(LAG_RADIUS);
-                    ctx.pipeline("ours_lag", &[("LAG_RADIUS", radius)])
-                })
-                .transpose()?,
+            lag: ctx.pipeline("ours_lag", &[("LAG_RADIUS", SpecValue::I32(LAG_RADIUS))])?,
             atrous: variant
                 .atrous
                 .then(|| variance_atrous::pipeline(ctx, false))
                 .transpose()?,
-            atrous_carry: (variant.atrous && variant.prior)
+            atrous_carry: variant
+                .atrous
                 .then(|| variance_atrous::pipeline(ctx, true))
                 .transpose()?,
-            prior: variant
-                .prior
-                .then(|| PriorPipelines::new(ctx))
-                .transpose()?,
+            prior: PriorPipelines::new(ctx)?,
         })
     }
 }
@@ -241,10 +240,10 @@ impl Denoiser for Ours {
         let estimate = self.add_update(ctx, graph, frame, input, &gradients, &lag)?;
         self.add_lag(frame, input.size, &lag);
         let normal = input.features.map(|f| f.normal);
-        let (estimate, prediction) = match (&self.prior, input.guides, normal) {
-            (Some(pipelines), Some(albedo), Some(normal)) => {
+        let (estimate, prediction) = match (input.guides, normal) {
+            (Some(albedo), Some(normal)) => {
                 let guides = prior::PriorGuides { albedo, normal };
-                let (e, p) = self.add_prior(pipelines, ctx, graph, frame, estimate, guides)?;
+                let (e, p) = self.add_prior(ctx, graph, frame, estimate, guides)?;
                 (e, Some(p))
             }
             _ => (estimate, None),

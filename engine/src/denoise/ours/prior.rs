@@ -58,7 +58,9 @@ gpu_block! {
         pub width: u32,
         pub height: u32,
         pub keep: f32,
-        pub pad: f32,
+        /// 1: young estimates are combined with the prediction (0 in `ours-no-prior`,
+        /// which keeps the prediction for the à-trous to carry by).
+        pub combine: u32,
     }
 }
 
@@ -96,7 +98,6 @@ impl Ours {
     /// pixel's prediction (rgb, a 1 where there is a fit) for the à-trous to carry by.
     pub(super) fn add_prior<'f>(
         &'f self,
-        pipelines: &'f PriorPipelines,
         ctx: &GpuContext,
         graph: &mut RenderGraph,
         frame: &mut Frame<'f>,
@@ -131,7 +132,7 @@ impl Ours {
             pad0: 0,
             pad1: 0,
         };
-        frame.add_compute(format!("{n}.guide"), &pipelines.guide, push, size, |b| {
+        frame.add_compute(format!("{n}.guide"), &self.prior.guide, push, size, |b| {
             b.read("guide", albedo).read("normal", normal);
             b.write("footprint", footprint)
                 .write("footprint_normal", footprint_normal);
@@ -144,7 +145,7 @@ impl Ours {
         };
         frame.add_compute(
             format!("{n}.prior_sums"),
-            &pipelines.sums,
+            &self.prior.sums,
             push,
             cells,
             |b| {
@@ -153,19 +154,25 @@ impl Ours {
                     .write("sums", sums);
             },
         );
-        frame.add_compute(format!("{n}.prior_fit"), &pipelines.fit, push, cells, |b| {
-            b.read("sums", sums);
-            for &(name, fit) in &fits {
-                b.write(name, fit);
-            }
-        });
+        frame.add_compute(
+            format!("{n}.prior_fit"),
+            &self.prior.fit,
+            push,
+            cells,
+            |b| {
+                b.read("sums", sums);
+                for &(name, fit) in &fits {
+                    b.write(name, fit);
+                }
+            },
+        );
         let push = OursPriorPush {
             width: size.width,
             height: size.height,
             keep: self.params.keep,
-            pad: 0.0,
+            combine: self.variant.prior as u32,
         };
-        frame.add_compute(format!("{n}.prior"), &pipelines.combine, push, size, |b| {
+        frame.add_compute(format!("{n}.prior"), &self.prior.combine, push, size, |b| {
             b.read("estimate", estimate).read("footprint", footprint);
             b.read("footprint_normal", footprint_normal);
             for &(name, fit) in &fits {

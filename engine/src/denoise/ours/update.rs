@@ -41,6 +41,11 @@ gpu_block! {
         pub motion_q: f32,
         pub lag_z: f32,
         pub outlier_z: f32,
+        /// 1: a significant pooled residual shifts the state (0 in `ours-no-lag`).
+        pub shift: u32,
+        pub pad0: u32,
+        pub pad1: u32,
+        pub pad2: u32,
     }
 }
 
@@ -75,7 +80,7 @@ impl Ours {
             height: size.height,
             history_valid: (model.valid && reproj.valid) as u32,
             gradient_valid: gradients.valid as u32,
-            lag_valid: (self.lag.is_some() && lag.pooled.valid) as u32,
+            lag_valid: lag.pooled.valid as u32,
             stratum: p.stratum.max(1),
             spp: input.spp as f32,
             tolerance: crate::denoise::REPROJECTION_TOLERANCE_PX,
@@ -83,6 +88,10 @@ impl Ours {
             motion_q: p.motion_q,
             lag_z: p.lag_z,
             outlier_z: p.outlier_z,
+            shift: self.variant.lag as u32,
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         };
         let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
         let rows_push = OursNoisePush {
