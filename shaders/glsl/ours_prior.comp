@@ -61,7 +61,8 @@ void main() {
     bool fitted = V > 0.0 && V < NO_FIT && all_finite(pred);
     // Every pixel's prediction, for the à-trous to carry neighbours by (a 0: none).
     imageStore(prediction, p, fitted ? vec4(pred, 1.0) : vec4(0.0));
-    vec4 centre = imageLoad(estimate, p);
+    vec4 centre = imageLoad(estimate, p);  // the filter's state
+    centre.rgb = max(centre.rgb, vec3(0.0));  // radiance: a shift may leave it below zero
     float P = centre.a;
     // A converged estimate is kept (as the à-trous keeps it).
     if (pc.combine == 0u || !fitted || !all_finite(centre.rgb) || !(P >= pc.keep * pc.keep * dot(centre.rgb, centre.rgb) / 3.0) || isinf(P)) {

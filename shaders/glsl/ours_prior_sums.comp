@@ -9,7 +9,7 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 0, rgba32f) uniform readonly image2D estimate;   // rgb x, a P
+layout(binding = 0, rgba32f) uniform readonly image2D estimate;   // the filter's state: rgb x, a P
 layout(binding = 1, rgba16f) uniform readonly image2D footprint;         // rgb albedo (ours_guide.comp)
 layout(binding = 3, rgba16f) uniform readonly image2D footprint_normal;  // xyz normal
 layout(binding = 2, rgba32f) uniform writeonly image2D sums;      // PRIOR_SUM_TEXELS per block, side by side
@@ -39,6 +39,7 @@ void main() {
             if (q.x >= size.x || q.y >= size.y) continue;
             vec3 x = imageLoad(estimate, q).rgb;
             if (!all_finite(x)) continue;
+            x = max(x, vec3(0.0));  // radiance: a shift may leave the state below zero
             vec4 lo = features_lo(imageLoad(footprint, q).rgb);
             vec3 hi = features_hi(imageLoad(footprint_normal, q).xyz);
             float f[D] = float[D](lo.x, lo.y, lo.z, lo.w, hi.x, hi.y, hi.z);

@@ -35,8 +35,9 @@
 // the measurement noise R, and D, the part of P that process noise put there: the update
 // splits P = (1 − K)² P⁻ + K² R, so D = (1 − K)² (ḡ² D + Q), the Q of the frames the
 // filter's memory still spans; a filter that restarted (K ≈ 1) carries none).
-// Outputs: the estimate with its variance for the à-trous filter (variance_atrous.comp), and
-// the a-posteriori residual with its variance for the pooled lag test (ours_lag.comp).
+// Outputs: the state itself is the estimate the prior and the à-trous read (each clamps its
+// radiance at zero as it reads it), and the a-posteriori residual with its variance for the
+// pooled lag test (ours_lag.comp).
 #include "common.glsl"
 #include "reproject.glsl"
 #include "ours_change.glsl"
@@ -49,7 +50,6 @@ layout(binding = 2) uniform sampler2D model_prev;
 layout(binding = 3) uniform sampler2D noise_prev;
 layout(binding = 4, rgba32f) uniform writeonly image2D model_cur;
 layout(binding = 5, rg32f) uniform writeonly image2D noise_cur;
-layout(binding = 6, rgba32f) uniform writeonly image2D prediction;  // rgb, a variance
 layout(binding = 7, rgba32f) uniform writeonly image2D residual;    // rgb, a variance (< 0: none)
 layout(binding = 8) uniform sampler2D lag_prev;                      // rgb mean, a variance
 layout(binding = 9, rgba32f) uniform readonly image2D noise_rows;    // ours_noise.comp: row sums of R's measurement
@@ -248,6 +248,5 @@ void main() {
     }
     imageStore(model_cur, p, vec4(x, P));
     imageStore(noise_cur, p, vec4(R, D, 0.0, 0.0));
-    imageStore(prediction, p, vec4(max(x, vec3(0.0)), P));
     imageStore(residual, p, res);
 }

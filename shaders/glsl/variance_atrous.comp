@@ -25,6 +25,9 @@ layout(binding = 1, rgba32f) uniform writeonly image2D color_out; // the same, f
 layout(binding = 2, rgba32f) uniform readonly image2D prediction;  // rgb x̂ (CARRY), a 0 where none
 
 layout(constant_id = 16) const bool CARRY = false;
+// The input is a filter's state, radiance clamped at zero as it is read (ours: the update
+// writes no clamped copy).
+layout(constant_id = 17) const bool NONNEGATIVE = false;
 
 layout(push_constant) uniform VarianceAtrousPush {
     uint width;
@@ -52,7 +55,9 @@ const int PREDICTION_TEXELS = CARRY ? TILE_TEXELS : 1;
 shared vec4 prediction_tile[PREDICTION_TEXELS];
 
 vec4 tap(TileWindow w, ivec2 q) {
-    return w.on ? tile[tile_index(w, q)] : imageLoad(color_in, q);
+    vec4 v = w.on ? tile[tile_index(w, q)] : imageLoad(color_in, q);
+    if (NONNEGATIVE) v.rgb = max(v.rgb, vec3(0.0));
+    return v;
 }
 
 vec4 prediction_tap(TileWindow w, ivec2 q) {

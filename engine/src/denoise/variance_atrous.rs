@@ -23,12 +23,17 @@ gpu_block! {
 
 /// The pass's pipeline (shared-memory tiles where the device gains from them); `carry`:
 /// neighbours are carried to the pixel by a prediction image first (ours' prior).
-pub fn pipeline(ctx: &GpuContext, carry: bool) -> Result<Pipeline<VarianceAtrousPush>> {
+pub fn pipeline(
+    ctx: &GpuContext,
+    carry: bool,
+    nonnegative: bool,
+) -> Result<Pipeline<VarianceAtrousPush>> {
     ctx.pipeline(
         "variance_atrous",
         &[
             ("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles)),
             ("CARRY", SpecValue::Bool(carry)),
+            ("NONNEGATIVE", SpecValue::Bool(nonnegative)),
         ],
     )
 }

@@ -1,7 +1,7 @@
 //! `<name>.atrous0..1` (variance_atrous.comp): the à-trous spatial filter over the
 //! filters' estimates, edge-stopped by their variances: steps 1 and 2 (`ATROUS_LEVELS`),
-//! ping-ponging between the estimate and a scratch image, the last level into the
-//! denoiser's output. Where the spatial prior ran, each neighbour is carried to the pixel
+//! ping-ponging between scratch images (never into the input, which is the filter's state
+//! where the prior did not run), the last level into the denoiser's output. Where the spatial prior ran, each neighbour is carried to the pixel
 //! by the prior's prediction first (`CARRY` in variance_atrous.comp).
 
 use super::Ours;
@@ -29,6 +29,8 @@ impl Ours {
         let n = &self.name;
         let desc = graph.image_desc(estimate);
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
+        // Scratch images of their own: without the prior the input is the filter's state
+        // (a history), and no level may write into it.
         let ping = graph.image(ctx, &format!("{n}.atrous"), desc)?;
         let levels = super::ATROUS_LEVELS;
         let mut src = estimate;
@@ -36,7 +38,7 @@ impl Ours {
             let last = i + 1 == levels;
             let dst = match (last, src == ping) {
                 (true, _) => out,
-                (false, true) => estimate,
+                (false, true) => graph.image(ctx, &format!("{n}.atrous_b"), desc)?,
                 (false, false) => ping,
             };
             let level = Level {

@@ -203,11 +203,11 @@ impl Ours {
             lag: ctx.pipeline("ours_lag", &[("LAG_RADIUS", SpecValue::I32(LAG_RADIUS))])?,
             atrous: variant
                 .atrous
-                .then(|| variance_atrous::pipeline(ctx, false))
+                .then(|| variance_atrous::pipeline(ctx, false, true))
                 .transpose()?,
             atrous_carry: variant
                 .atrous
-                .then(|| variance_atrous::pipeline(ctx, true))
+                .then(|| variance_atrous::pipeline(ctx, true, true))
                 .transpose()?,
             prior: PriorPipelines::new(ctx)?,
         })

@@ -50,7 +50,8 @@ gpu_block! {
 }
 
 impl Ours {
-    /// Adds the update; returns the estimate (rgb) with its variance (a).
+    /// Adds the update; returns the filter's state, the estimate (rgb, unclamped: its
+    /// readers clamp it at zero) with its variance (a).
     pub(super) fn add_update<'f>(
         &'f self,
         ctx: &GpuContext,
@@ -70,7 +71,6 @@ impl Ours {
             ..desc
         };
         let noise = graph.history(ctx, &format!("{n}.noise"), noise_desc)?;
-        let estimate = graph.image(ctx, &format!("{n}.estimate"), desc)?;
         let rows = graph.image(ctx, &format!("{n}.noise_rows"), desc)?;
         let reproj = input.reprojection(n, self.motion)?;
         let p = self.params;
@@ -109,7 +109,6 @@ impl Ours {
                 .read("noise_rows", rows)
                 .read("gradient_ratio", g.ratio)
                 .sampled("lag_prev", lag.pooled.prev)
-                .write("prediction", estimate)
                 .sampled("residual_prev", lag.residual.prev)
                 .write("residual", lag.residual.cur)
                 .sampled("model_prev", model.prev)
@@ -117,6 +116,6 @@ impl Ours {
                 .sampled("noise_prev", noise.prev)
                 .write("noise_cur", noise.cur);
         });
-        Ok(estimate)
+        Ok(model.cur)
     }
 }

@@ -165,7 +165,7 @@ impl Wrls {
         } else {
             Passes::Constant(
                 ctx.pipeline("wrls_constant", &[weighted, motion_source, restart])?,
-                variance_atrous::pipeline(ctx, false)?,
+                variance_atrous::pipeline(ctx, false, false)?,
             )
         };
         let params =
