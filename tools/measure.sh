@@ -83,7 +83,7 @@ for set in "$@"; do
       meta demo "$out" "$secs" "dvr demo --out $out (a fresh folder: references included)"
       ;;
     static)
-      args=(--scene static --size 128x128 --ref-spp 256 --aux --denoiser none,taa,svgf,ours,ours-no-prior)
+      args=(--scene static --size 128x128 --ref-spp 256 --aux --denoiser none,taa,svgf,ours)
       timed "$dvr" eval "${args[@]}" --out "$out"
       oidn "$out"
       KEEP_METRICS=1 keep static "$out"
@@ -98,12 +98,19 @@ for set in "$@"; do
       meta development "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
     validation)
+      # At 2 spp with every method, then ours at 1 spp (the same references: they do not
+      # depend on --spp), to set against oidn-aux at 2 spp.
       args=(--scene validation --size 128x128 --ref-spp 256 --aux
         --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,rae)
       timed "$dvr" eval "${args[@]}" --out "$out"
+      total=$secs
       oidn "$out"
-      keep validation "$out"
-      meta validation "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
+      KEEP_METRICS=1 keep validation "$out"
+      args1=(--scene validation --size 128x128 --ref-spp 256 --spp 1 --denoiser none,ours)
+      timed "$dvr" eval "${args1[@]}" --out "$out"
+      total=$(echo "$total + $secs" | bc)
+      KEEP_METRICS=1 keep validation "$out" spp1
+      meta validation "$out" "$total" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out; dvr eval ${args1[*]} --out $out"
       ;;
     suite)
       args=(--scene suite --frames 48 --size 64x64 --ref-spp 1024 --aux

@@ -189,23 +189,28 @@ def present(rows, methods):
 
 
 def b_headline():
-    rows = read_csv("suite", "summary.csv")
-    meta = read_json("suite", "meta.json")
+    rows = read_csv("validation", "summary.csv")
+    meta = read_json("validation", "meta.json")
     methods = present(rows, ["ours", "svgf", "taa", "rae", "oidn-aux", "oidn"])
     n = len(scenes_of(rows))
     return "\n".join([
-        means_table("suite", rows, methods),
+        means_table("validation", rows, methods),
         "",
-        f"Means over the {n} scenes of the development suite (64×64, 48 frames, 2 spp, "
-        f"1024-spp references), commit {meta['commit']}, on {meta['machine']}. "
-        "OIDN runs on the CPU (no GPU ms); `oidn-aux` is OIDN with the albedo and normal "
-        "guides. Every scene and method: [the results](docs/src/results.md).",
+        f"Means over the {n} scenes of the validation set (never tuned on; 128×128, 48 "
+        f"frames, 2 spp, 256-spp references), commit {meta['commit']}, on {meta['machine']}. "
+        "GPU ms count the shared passes, the features and guides each method reads, and its "
+        "own; OIDN runs on the CPU (no GPU ms); `oidn-aux` is OIDN with the albedo and normal "
+        "guides. Every scene and method, and the development suite: "
+        "[the results](docs/src/results.md).",
     ])
 
 
 def b_suite_means():
     rows = read_csv("suite", "summary.csv")
-    return "\n".join([means_table("suite", rows, None), "", source("suite", ["summary.csv"])])
+    # The ablations' rows are the validation set's (one run of the switches as they are).
+    methods = [m for m in method_order({r["method"] for r in rows}) if not m.startswith("ours-")]
+    return "\n".join([means_table("suite", rows, methods), "",
+                      source("suite", ["summary.csv"])])
 
 
 def b_suite_scenes():
@@ -228,7 +233,7 @@ def b_suite_scenes():
 
 
 def b_ablations():
-    rows = read_csv("suite", "summary.csv")
+    rows = read_csv("validation", "summary.csv")
     m = means(rows)
     base = m["ours"]
     body = []
@@ -239,7 +244,7 @@ def b_ablations():
     return "\n".join([
         table(["ablation", "PSNR dB", "ours − it, dB", "FLIP", "ours − it, FLIP"], body),
         "",
-        source("suite", ["summary.csv"]),
+        source("validation", ["summary.csv"]),
     ])
 
 
@@ -258,7 +263,9 @@ def b_demo():
 
 def b_development():
     rows = read_csv("development", "summary.csv")
-    return "\n".join([means_table("development", rows, None,
+    # The ablations' rows are the validation set's (one run of the switches as they are).
+    methods = [m for m in method_order({r["method"] for r in rows}) if not m.startswith("ours-")]
+    return "\n".join([means_table("development", rows, methods,
                                   ("psnr", "flip", "temporal_error")),
                       "", source("development", ["summary.csv"])])
 
@@ -275,11 +282,109 @@ def b_validation():
     ])
 
 
+def frames_by_scene(metrics):
+    """{scene: {frame: {method: psnr}}} of a metrics.csv."""
+    by = {}
+    for r in metrics:
+        by.setdefault(r["scene"], {}).setdefault(int(r["frame"]), {})[r["method"]] = num(r["psnr"])
+    return by
+
+
+def worst_margin(frames, rivals, after=4):
+    """The frame after `after` where ours is lowest against the best of `rivals` present:
+    (margin dB, frame), or None."""
+    worst = None
+    for f, v in sorted(frames.items()):
+        have = [v[x] for x in rivals if v.get(x) is not None]
+        if f <= after or v.get("ours") is None or not have:
+            continue
+        margin = v["ours"] - max(have)
+        if worst is None or margin < worst[0]:
+            worst = (margin, f)
+    return worst
+
+
+def b_validation_frames():
+    """Per validation scene, ours' worst frame after frame 4 against the best single-frame
+    method (oidn, oidn-aux, rae) and against the better of svgf and taa."""
+    by = frames_by_scene(read_csv("validation", "metrics.csv"))
+    body = []
+    for sc, frames in sorted(by.items()):
+        single = worst_margin(frames, ["oidn", "oidn-aux", "rae"])
+        lag = worst_margin(frames, ["svgf", "taa"])
+        below = sum(1 for f, v in frames.items() if f > 4 and v.get("ours") is not None
+                    and any(v.get(x) is not None for x in ("oidn", "oidn-aux", "rae"))
+                    and v["ours"] < max(v[x] for x in ("oidn", "oidn-aux", "rae")
+                                        if v.get(x) is not None) - 1.0)
+        body.append([sc,
+                     "" if single is None else f"{single[0]:+.2f} (frame {single[1]})",
+                     str(below),
+                     "" if lag is None else f"{lag[0]:+.2f} (frame {lag[1]})"])
+    return "\n".join([
+        "Per scene, after frame 4: `ours`' lowest margin (dB of PSNR) against the best of "
+        "`oidn`, `oidn-aux` and `rae` in the same frame, how many frames it is more than "
+        "1 dB below that best, and its lowest margin against the better of `svgf` and `taa`:",
+        "",
+        table(["scene", "ours − best single-frame, worst frame", "frames > 1 dB below",
+               "ours − max(svgf, taa), worst frame"], body),
+        "",
+        source("validation", ["metrics.csv"]),
+    ])
+
+
+def b_validation_line():
+    """README's sentence on young history in the validation set, frame by frame."""
+    by = frames_by_scene(read_csv("validation", "metrics.csv"))
+    single = ("oidn", "oidn-aux", "rae")
+    frames = [v for fr in by.values() for f, v in fr.items()
+              if f > 4 and v.get("ours") is not None and any(v.get(x) is not None for x in single)]
+    below = sum(1 for v in frames
+                if v["ours"] < max(v[x] for x in single if v.get(x) is not None) - 1.0)
+    worst = [w for w in (worst_margin(f, list(single)) for f in by.values()) if w]
+    low = min(worst, key=lambda w: w[0]) if worst else None
+    return (
+        f"After frame 4, `ours` is more than 1 dB below the best single-frame method "
+        f"(`oidn`, `oidn-aux`, `rae`) in {below} of the validation set's {len(frames)} frames"
+        + (f" (at worst {low[0]:+.2f} dB)" if low else "") +
+        ": where its history is young, after a change the gradients cannot fully measure. "
+        "Per scene: [the results](docs/src/results.md#the-validation-set)."
+    )
+
+
+def b_validation_1spp():
+    """ours at 1 spp against oidn-aux (and ours) at 2 spp, per scene and on the mean."""
+    two = {(r["scene"], r["method"]): r for r in read_csv("validation", "summary.csv")}
+    one = {(r["scene"], r["method"]): r for r in read_csv("validation", "spp1/summary.csv")}
+    scenes = sorted({sc for sc, m in one if m == "ours"})
+    body = []
+    cols = {"ours 1 spp": [], "oidn-aux 2 spp": [], "ours 2 spp": []}
+    for sc in scenes:
+        cells = [sc]
+        for name, src, m in (("ours 1 spp", one, "ours"), ("oidn-aux 2 spp", two, "oidn-aux"),
+                             ("ours 2 spp", two, "ours")):
+            r = src.get((sc, m))
+            v = (num(r["psnr"]), num(r["flip"])) if r else (None, None)
+            cols[name].append(v)
+            cells.append(f"{fmt(v[0], 2)} / {fmt(v[1], 4)}")
+        body.append(cells)
+    body.append(["**mean**"] + [
+        f"{fmt(mean(v[0] for v in cols[n]), 2)} / {fmt(mean(v[1] for v in cols[n]), 4)}"
+        for n in cols])
+    return "\n".join([
+        "PSNR dB / FLIP per scene: `ours` fed 1 sample per pixel per frame, against "
+        "`oidn-aux` and `ours` fed 2 (the same references):",
+        "",
+        table(["scene", "`ours`, 1 spp", "`oidn-aux`, 2 spp", "`ours`, 2 spp"], body),
+        "",
+        source("validation", ["spp1/summary.csv", "summary.csv"]),
+    ])
+
+
 def b_static():
     rows = read_csv("static", "metrics.csv")
     summ = read_csv("static", "summary.csv")
     last = max(int(r["frame"]) for r in rows)
-    methods = present(summ, ["ours", "ours-no-prior", "svgf", "taa", "oidn", "oidn-aux"])
+    methods = present(summ, ["ours", "svgf", "taa", "oidn", "oidn-aux"])
     body = []
     for s in scenes_of(rows):
         vals = {r["method"]: num(r["psnr"]) for r in rows
@@ -304,7 +409,11 @@ def b_static():
                 continue
             top = max(top, v)
             worst = min(worst, v - top)
-        halves.append([s, fmt(early, 2), fmt(late, 2), f"{worst:.2f}"])
+        at8 = {r["method"]: num(r["psnr"]) for r in rows
+               if r["scene"] == s and int(r["frame"]) == 8}
+        lead8 = (f"{at8['ours'] - at8['oidn-aux']:+.2f}"
+                 if at8.get("ours") is not None and at8.get("oidn-aux") is not None else "")
+        halves.append([s, fmt(early, 2), fmt(late, 2), f"{worst:.2f}", lead8])
     return "\n".join([
         f"PSNR (dB) at frame {last}:",
         "",
@@ -313,7 +422,8 @@ def b_static():
         "`ours` over time:",
         "",
         table(["scene", f"mean PSNR, frames 8–{mid - 1}", f"frames {mid}–{last}",
-               "worst frame after 8 against the best so far, dB"], halves),
+               "worst frame after 8 against the best so far, dB",
+               "frame 8: `ours` − `oidn-aux`, dB"], halves),
         "",
         source("static", ["metrics.csv", "summary.csv"]),
     ])
@@ -638,13 +748,17 @@ def b_cut_cost():
 
 
 BLOCKS = {
-    "headline": (b_headline, ["suite/summary.csv"]),
+    "headline": (b_headline, ["validation/summary.csv", "validation/meta.json"]),
     "suite-means": (b_suite_means, ["suite/summary.csv"]),
     "suite-scenes": (b_suite_scenes, ["suite/summary.csv"]),
-    "ablations": (b_ablations, ["suite/summary.csv"]),
+    "ablations": (b_ablations, ["validation/summary.csv"]),
     "demo": (b_demo, ["demo/summary.csv"]),
     "development": (b_development, ["development/summary.csv"]),
     "validation": (b_validation, ["validation/summary.csv"]),
+    "validation-frames": (b_validation_frames, ["validation/metrics.csv"]),
+    "validation-line": (b_validation_line, ["validation/metrics.csv"]),
+    "validation-1spp": (b_validation_1spp, ["validation/spp1/summary.csv",
+                                            "validation/summary.csv"]),
     "static": (b_static, ["static/metrics.csv", "static/summary.csv"]),
     "paper": (b_paper, ["paper/spp{1,2,4}/summary.csv"]),
     "cost": (b_cost, ["cost/*.json"]),
