@@ -41,7 +41,7 @@ def test_results_pages_are_current_and_a_changed_csv_makes_them_stale(root, tmp_
     script = tmp_path / "tools/results.py"
     ok = subprocess.run([sys.executable, str(script), "--check"], capture_output=True, text=True)
     assert ok.returncode == 0, ok.stderr
-    csv = tmp_path / "assets/results/suite/summary.csv"
+    csv = tmp_path / "assets/results/validation/summary.csv"  # README's headline
     rows = csv.read_text().splitlines()
     ours = next(i for i, r in enumerate(rows) if ",ours," in r)
     cells = rows[ours].split(",")
