@@ -17,21 +17,21 @@ const FRAMES: u32 = 10;
 const STAGES: [&str; 5] = ["model", "residual", "lag", "prior_pred", "prior"];
 
 type Pixels = Vec<[f32; 4]>;
-/// Per frame: image name → pixels (the methods' outputs under their own names).
-type Run = Vec<HashMap<String, Pixels>>;
-
-/// A frame's images, with an empty image named `GRADIENTS_RAN` when ours traced
-/// temporal gradients in it.
-fn images(done: dvr_engine::renderer::FrameResult) -> HashMap<String, Pixels> {
-    let ran = done.timings.iter().any(|t| t.pass == "ours.gradient");
-    let mut m: HashMap<String, Pixels> = done.images.into_iter().collect();
-    if ran {
-        m.insert(GRADIENTS_RAN.into(), Vec::new());
-    }
-    m
+/// One frame of a run: image name → pixels (the methods' outputs under their own names),
+/// and whether ours traced temporal gradients in it.
+struct Frame {
+    images: HashMap<String, Pixels>,
+    gradients: bool,
 }
 
-const GRADIENTS_RAN: &str = "(ours traced gradients)";
+type Run = Vec<Frame>;
+
+fn frame(done: dvr_engine::renderer::FrameResult) -> Frame {
+    Frame {
+        gradients: done.timings.iter().any(|t| t.pass == "ours.gradient"),
+        images: done.images.into_iter().collect(),
+    }
+}
 
 /// `ours` and `ablation` on `scene`, every stage of both read back in every frame.
 fn run(scene: &str, ablation: &str) -> Run {
@@ -46,17 +46,15 @@ fn run(scene: &str, ablation: &str) -> Run {
     r.read_back_images(&names.iter().map(String::as_str).collect::<Vec<_>>());
     let request = FrameRequest {
         readback: true,
-        reset: false,
-        aux: false,
-        features: false,
+        ..Default::default()
     };
     let mut frames = Vec::new();
     for f in 0..FRAMES {
         if let Some(done) = r.frame(&setup.frame_inputs(f), &request).expect("frame") {
-            frames.push(images(done));
+            frames.push(frame(done));
         }
     }
-    frames.extend(r.flush().expect("flush").into_iter().map(images));
+    frames.extend(r.flush().expect("flush").into_iter().map(frame));
     assert_eq!(frames.len(), FRAMES as usize);
     frames
 }
@@ -70,7 +68,7 @@ fn same(run: &Run, f: usize, ablation: &str, stage: &str) -> bool {
             format!("{m}.{stage}")
         }
     };
-    let (a, b) = (&run[f][&key("ours")], &run[f][&key(ablation)]);
+    let (a, b) = (&run[f].images[&key("ours")], &run[f].images[&key(ablation)]);
     a.iter()
         .zip(b)
         .all(|(p, q)| p.iter().zip(q).all(|(x, y)| x.to_bits() == y.to_bits()))
@@ -98,7 +96,10 @@ fn without_the_atrous_only_the_output_changes() {
     }
     // Its output is the prior's combination as ours computed it.
     for (f, frame) in run.iter().enumerate() {
-        assert_eq!(frame[ablation], frame["ours.prior"], "frame {f}");
+        assert_eq!(
+            frame.images[ablation], frame.images["ours.prior"],
+            "frame {f}"
+        );
     }
     assert!(differs_somewhere(&run, ablation, ""));
 }
@@ -114,8 +115,8 @@ fn without_the_prior_only_its_combination_changes() {
     }
     // The combination passes each estimate through (its radiance clamped at zero).
     for (f, frame) in run.iter().enumerate() {
-        let combined = &frame[&format!("{ablation}.prior")];
-        let state = &frame[&format!("{ablation}.model")];
+        let combined = &frame.images[&format!("{ablation}.prior")];
+        let state = &frame.images[&format!("{ablation}.model")];
         for (c, x) in combined.iter().zip(state) {
             let want = [x[0].max(0.0), x[1].max(0.0), x[2].max(0.0), x[3]];
             assert_eq!(*c, want, "frame {f}");
@@ -139,10 +140,10 @@ fn without_the_lag_shift_the_state_differs_only_where_ours_shifted() {
     // was significant (the camera is still, so each pixel reads its own).
     let lag_z = dvr_engine::denoise::ours::OursParams::default().lag_z;
     let (ours, theirs) = (
-        &run[first]["ours.model"],
-        &run[first][&format!("{ablation}.model")],
+        &run[first].images["ours.model"],
+        &run[first].images[&format!("{ablation}.model")],
     );
-    let lag = &run[first - 1]["ours.lag"];
+    let lag = &run[first - 1].images["ours.lag"];
     let mut differing = 0;
     for (i, (a, b)) in ours.iter().zip(theirs).enumerate() {
         if a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()) {
@@ -171,12 +172,12 @@ fn without_gradients_nothing_changes_until_a_light_or_the_tf_does() {
     // The light moves every frame: the first frame is the same, the measured change
     // then reaches the state.
     let light = run("mri/point-light", ablation);
-    assert!(!orbit.iter().any(|f| f.contains_key(GRADIENTS_RAN)));
+    assert!(!orbit.iter().any(|f| f.gradients));
     // The light moves every frame: until ours first traces gradients (it needs last
     // frame's radiance) the two are the same; from then on the measured change reaches
     // ours' state and not the ablation's.
     let first = (0..light.len())
-        .find(|&f| light[f].contains_key(GRADIENTS_RAN))
+        .find(|&f| light[f].gradients)
         .expect("ours traced gradients");
     for stage in STAGES {
         assert_same(&light, ablation, stage, 0..first);

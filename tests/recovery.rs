@@ -50,9 +50,7 @@ fn rgb(px: &[[f32; 4]]) -> Rgb32Image {
 fn render_all(r: &mut Renderer, frames: impl Iterator<Item = FrameInputs>) -> Vec<Vec<[f32; 4]>> {
     let request = FrameRequest {
         readback: true,
-        reset: false,
-        aux: false,
-        features: false,
+        ..Default::default()
     };
     let mut outputs = Vec::new();
     for inputs in frames {

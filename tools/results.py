@@ -304,18 +304,31 @@ def worst_margin(frames, rivals, after=4):
     return worst
 
 
+SINGLE_FRAME = ("oidn", "oidn-aux", "rae")
+
+
+def below_best(frames, rivals, by=1.0, after=4):
+    """(frames after `after` more than `by` dB below the best of `rivals` present, frames
+    compared) of one scene's {frame: {method: psnr}}."""
+    n = below = 0
+    for f, v in frames.items():
+        have = [v[x] for x in rivals if v.get(x) is not None]
+        if f <= after or v.get("ours") is None or not have:
+            continue
+        n += 1
+        below += v["ours"] < max(have) - by
+    return below, n
+
+
 def b_validation_frames():
     """Per validation scene, ours' worst frame after frame 4 against the best single-frame
     method (oidn, oidn-aux, rae) and against the better of svgf and taa."""
     by = frames_by_scene(read_csv("validation", "metrics.csv"))
     body = []
     for sc, frames in sorted(by.items()):
-        single = worst_margin(frames, ["oidn", "oidn-aux", "rae"])
+        single = worst_margin(frames, SINGLE_FRAME)
         lag = worst_margin(frames, ["svgf", "taa"])
-        below = sum(1 for f, v in frames.items() if f > 4 and v.get("ours") is not None
-                    and any(v.get(x) is not None for x in ("oidn", "oidn-aux", "rae"))
-                    and v["ours"] < max(v[x] for x in ("oidn", "oidn-aux", "rae")
-                                        if v.get(x) is not None) - 1.0)
+        below = below_best(frames, SINGLE_FRAME)[0]
         body.append([sc,
                      "" if single is None else f"{single[0]:+.2f} (frame {single[1]})",
                      str(below),
@@ -335,16 +348,13 @@ def b_validation_frames():
 def b_validation_line():
     """README's sentence on young history in the validation set, frame by frame."""
     by = frames_by_scene(read_csv("validation", "metrics.csv"))
-    single = ("oidn", "oidn-aux", "rae")
-    frames = [v for fr in by.values() for f, v in fr.items()
-              if f > 4 and v.get("ours") is not None and any(v.get(x) is not None for x in single)]
-    below = sum(1 for v in frames
-                if v["ours"] < max(v[x] for x in single if v.get(x) is not None) - 1.0)
-    worst = [w for w in (worst_margin(f, list(single)) for f in by.values()) if w]
+    counts = [below_best(frames, SINGLE_FRAME) for frames in by.values()]
+    below, n = sum(c[0] for c in counts), sum(c[1] for c in counts)
+    worst = [w for w in (worst_margin(f, SINGLE_FRAME) for f in by.values()) if w]
     low = min(worst, key=lambda w: w[0]) if worst else None
     return (
         f"After frame 4, `ours` is more than 1 dB below the best single-frame method "
-        f"(`oidn`, `oidn-aux`, `rae`) in {below} of the validation set's {len(frames)} frames"
+        f"(`oidn`, `oidn-aux`, `rae`) in {below} of the validation set's {n} frames"
         + (f" (at worst {low[0]:+.2f} dB)" if low else "") +
         ": where its history is young, after a change the gradients cannot fully measure. "
         "Per scene: [the results](docs/src/results.md#the-validation-set)."
@@ -670,21 +680,7 @@ def b_soak():
 def cut_frames(metrics):
     """Per scene: the closest frame after frame 4 of ours to the better of svgf and taa,
     as (margin dB, frame)."""
-    by = {}
-    for r in metrics:
-        by.setdefault(r["scene"], {}).setdefault(int(r["frame"]), {})[r["method"]] = num(r["psnr"])
-    out = {}
-    for sc, frames in by.items():
-        worst = None
-        for f, v in sorted(frames.items()):
-            if f <= 4 or "ours" not in v:
-                continue
-            rival = max(v.get("svgf", -math.inf), v.get("taa", -math.inf))
-            margin = v["ours"] - rival
-            if worst is None or margin < worst[0]:
-                worst = (margin, f)
-        out[sc] = worst
-    return out
+    return {sc: worst_margin(frames, ["svgf", "taa"]) for sc, frames in frames_by_scene(metrics).items()}
 
 
 def b_cuts():

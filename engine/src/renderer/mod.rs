@@ -452,7 +452,8 @@ impl Renderer {
         if present.is_some() && self.passes.present.is_none() {
             self.passes.present = Some(Present::new(&self.ctx)?);
         }
-        let guides = self.denoisers.iter().any(|m| m.info.guides());
+        let guide_readers = readers(&self.denoisers, |m| m.info.guides());
+        let guides = !guide_readers.is_empty();
         if (request.aux || guides) && self.passes.aux.is_none() {
             self.passes.aux = Some(AuxFeatures::new(&self.ctx, self.features.pooled_volume)?);
         }
@@ -523,7 +524,7 @@ impl Renderer {
         // (`FrameRequest::aux`).
         let aux = match &passes.aux {
             Some(pass) if request.aux || guides => {
-                let owner = PassOwner::Methods(readers(&self.denoisers, |m| m.info.guides()));
+                let owner = PassOwner::Methods(guide_readers);
                 Some(frame.add_for(owner, |f| {
                     pass.add(ctx, graph, f, &scene, size, request.aux)
                 })?)
