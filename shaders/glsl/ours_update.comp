@@ -82,27 +82,39 @@ const float TINY = VARIANCE_FLOOR;
 // to frame while the noise does not, so at one half the running residual has a third of
 // one frame's noise variance.
 
-// This frame's sums over the 5×5 neighbourhood: x the moments' noise, y the luminance, z
-// its square. ours_noise.comp summed each row's 5 pixels; this sums 5 rows.
-vec3 neighbourhood_sums(ivec2 p, ivec2 size) {
-    vec3 s = vec3(0.0);
+// This frame's sums over the 5×5 neighbourhood (ours_noise.comp summed each row's 5
+// pixels; this sums 5 rows): x what R is measured from, yzw the colour.
+vec4 neighbourhood_sums(ivec2 p, ivec2 size) {
+    vec4 s = vec4(0.0);
     for (int dy = -NOISE_RADIUS; dy <= NOISE_RADIUS; ++dy) {
-        s += imageLoad(noise_rows, ivec2(p.x, clamp(p.y + dy, 0, size.y - 1))).xyz;
+        s += imageLoad(noise_rows, ivec2(p.x, clamp(p.y + dy, 0, size.y - 1)));
     }
     return s;
 }
 
-// R of a pixel without history, and this frame's measurement of R: the moments' noise
-// over the 5×5 neighbourhood (one pixel's two samples say too little); at 1 spp, which has
-// no moments, the spread of the 5×5 pixels' luminance (signal detail included: an
-// overestimate, which only slows the first frames). Under heavy tails 3×3 was too few:
-// where no bright path landed in 18 samples R came out near zero, the filter looked
-// converged on a low mean, and the à-trous kept it as a dark blotch (static views).
-// `s`: the sums neighbourhood_sums returns.
-float fresh_noise(vec3 s) {
+// R of a pixel without history, and this frame's measurement of R, in the filter's unit
+// (the mean over the channels of each channel's variance): from the moments' luminance
+// noise over the 5×5 neighbourhood (one pixel's two samples say too little), turned into
+// that unit by the neighbourhood's colour m. A pixel's samples share a hue (the TF's
+// colours along one path scale each sample's radiance as a whole), so each channel's
+// noise is its share of the luminance's: Var(y_c) = (m_c / L(m))² Var(L), and the unit's
+// variance is Var(L)·(|m|²/3) / L(m)² (grey: Var(L); a saturated blue: 64 Var(L)). Where
+// the neighbourhood is black the ratio is 1. At 1 spp, which has no moments, the spread of
+// the 5×5 pixels' colours in the same unit (signal detail included: an overestimate,
+// which only slows the first frames). Under heavy tails 3×3 was too few: where no bright
+// path landed in 18 samples R came out near zero, the filter looked converged on a low
+// mean, and the à-trous kept it as a dark blotch (static views). `s`: the sums
+// neighbourhood_sums returns.
+float fresh_noise(vec4 s) {
     const float n = float(NOISE_TAPS);
-    if (pc.spp >= 2.0) return s.x / n + TINY;
-    return max(s.z / n - (s.y / n) * (s.y / n), 0.0) * n / float(NOISE_TAPS - 1) + TINY;
+    vec3 m = s.yzw / n;
+    float level2 = dot(m, m) / 3.0;
+    if (pc.spp >= 2.0) {
+        float L = luminance(m);
+        float hue = L * L > TINY ? level2 / (L * L) : 1.0;
+        return s.x / n * hue + TINY;
+    }
+    return max(s.x / n - level2, 0.0) * n / float(NOISE_TAPS - 1) + TINY;
 }
 
 // The history's estimate resampled by Catmull-Rom over the 4×4 texels around `r.uv`
@@ -146,7 +158,7 @@ void main() {
 
     vec3 y = imageLoad(noisy, p).rgb;
     if (!all_finite(y)) y = vec3(0.0);
-    vec3 sums = neighbourhood_sums(p, size);
+    vec4 sums = neighbourhood_sums(p, size);
     Reprojection r = reproject(p, size, pc.history_valid != 0u, pc.camera.xyz, pc.tolerance);
 
     vec3 x;
@@ -174,7 +186,9 @@ void main() {
         // this frame. A pixel the light is about to reach is dark (x ≈ 0), and its own
         // level would keep Q ≈ 0 while its neighbours brighten: the gain must open
         // there too.
-        float level = max(luminance(max(x, vec3(0.0))), sums.y / float(NOISE_TAPS));
+        vec3 level_x = max(x, vec3(0.0));
+        vec3 level_m = sums.yzw / float(NOISE_TAPS);
+        float level = sqrt(max(dot(level_x, level_x), dot(level_m, level_m)) / 3.0);
         float Q = pc.change_q * sc.change * level;
         Q *= Q;
         if (length(r.motion) > STILL_PX) Q += pc.motion_q * R;
