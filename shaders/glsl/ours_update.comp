@@ -5,31 +5,37 @@
 // pixel mean y_t:
 //     x_t = g_t ∘ x_{t−1} + w_t,   w_t ~ N(0, Q_t)      (the scene changes by g_t)
 //     y_t = x_t + v_t,             v_t ~ N(0, R_t)      (Monte Carlo noise)
-// with one variance per pixel shared by the channels (P for the estimate, Q, R):
+// with one variance per pixel shared by the channels (P for the estimate, Q, R), each in
+// one unit: the mean over the three channels of each channel's variance, E|v|²/3, the
+// unit of the innovation's |y − x⁻|²/3, the lag test's residuals, the à-trous' range term
+// and the prior's V:
 //   - g_t, the measured change: the temporal gradients' ratio of this frame's radiance to
 //     last frame's on re-traced paths (ours_gradient*.comp), 1 where nothing changed;
 //   - Q_t, what the prediction may have missed: (change_q · change · level)² for a
 //     change the gradients measured (their ratio is a neighbourhood's, the pixel's own may
-//     differ in proportion; the level is the larger of the pixel's luminance and its 5×5
-//     neighbourhood's in this frame), motion_q · R for a pixel whose surface moved on
-//     screen (the view-dependent change of a semi-transparent volume), and a shift the
-//     pooled lag test found (its own size);
-//   - R_t, the variance of one frame's pixel mean, estimated from the samples' own
-//     luminance moments over 5×5 pixels (at 1 spp: the 5×5 luminances' spread), scaled
-//     with the radiance by g_t and averaged over the filter's memory; this frame's
-//     measurement joins before the gain uses it, with the weight P⁻ / (P⁻ + R). Where the
-//     lag test shifted the level, the carried R was the old level's: a lower measurement
-//     replaces it (a surface that fell into shadow has no noise left there).
+//     differ in proportion; the level is the larger of the pixel's RMS colour |x|/√3 and
+//     its 5×5 neighbourhood's mean colour's in this frame), motion_q · R for a pixel whose
+//     surface moved on screen (the view-dependent change of a semi-transparent volume),
+//     and a shift the pooled lag test found (its own size, |shift|²/3);
+//   - R_t, the variance of one frame's pixel mean: the samples' luminance moments over
+//     5×5 pixels give Var(L), and a pixel's samples share a hue, so each channel's
+//     variance is (m_c / L(m))² Var(L) with m the neighbourhood's mean colour, and
+//     R = Var(L) (|m|²/3) / L(m)² (at 1 spp: the 5×5 colours' spread, directly in the
+//     unit); scaled with the radiance by g_t and averaged over the filter's memory; this
+//     frame's measurement joins before the gain uses it, with the weight P⁻ / (P⁻ + R).
+//     Where the lag test shifted the level, the carried R was the old level's: a lower
+//     measurement replaces it (a surface that fell into shadow has no noise left there).
 // Predict: x⁻ = g ∘ x, P⁻ = ḡ² P + Q. Update: K = P⁻ / (P⁻ + R), x = x⁻ + K (y − x⁻),
 // P = (1 − K) P⁻. With nothing changing Q = 0 and K = 1/n: the running mean, which only
 // improves.
-// Outliers from the normalised innovation ν² = |y − x⁻|² / 3 / (P⁻ + R): beyond outlier_z
-// standard deviations a sample counts only as far as outlier_z (a Huber weight: R is
-// raised by ν² / outlier_z²). Jumps from the pooled lag test: a residual the neighbourhood
-// shares beyond outlier_z standard errors of its mean is a moved level, and its square is
-// added to P⁻ so the filter follows it. A firefly, however often it repeats in one pixel,
-// is clipped (heavy-tailed noise puts bright paths in a pixel in successive frames); a
-// change of the scene moves a region.
+// Outliers from the normalised innovation ν² = |y − x⁻|² / 3 / (P⁻ + R): beyond
+// z = outlier_z standard deviations R is raised to R ν² / z², so the step K (y − x⁻)
+// falls as 1 / |y − x⁻| (a redescending weight; the residual handed to the lag test is
+// clipped to z deviations, Huber's ψ). Jumps from the pooled lag test: a residual the
+// neighbourhood shares beyond outlier_z standard errors of its mean is a moved level, and
+// its square is added to P⁻ so the filter follows it. A firefly, however often it repeats
+// in one pixel, is weighed down (heavy-tailed noise puts bright paths in a pixel in
+// successive frames); a change of the scene moves a region.
 //
 // State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (rg32f:
 // the measurement noise R, and D, the part of P that process noise put there: the update
@@ -236,7 +242,7 @@ void main() {
         float nu2 = e2 / max(P_prior + R, TINY);
         float z2 = pc.outlier_z * pc.outlier_z;
         bool far = nu2 > z2;
-        // A spike counts as far as outlier_z deviations (a Huber weight).
+        // A spike's step falls as 1 / |e| beyond outlier_z deviations (redescending).
         float R_eff = far ? R * nu2 / z2 : R;
         P = P_prior;
         float K = P / (P + R_eff);
