@@ -111,14 +111,17 @@ vec4 neighbourhood_sums(ivec2 p, ivec2 size) {
 // path landed in 18 samples R came out near zero, the filter looked converged on a low
 // mean, and the à-trous kept it as a dark blotch (static views). `s`: the sums
 // neighbourhood_sums returns.
+// The 5×5 neighbourhood's mean colour, from those sums.
+vec3 neighbourhood_mean(vec4 s) { return s.yzw / float(NOISE_TAPS); }
+
 float fresh_noise(vec4 s) {
     const float n = float(NOISE_TAPS);
-    vec3 m = s.yzw / n;
+    vec3 m = neighbourhood_mean(s);
     float level2 = dot(m, m) / 3.0;
     if (pc.spp >= 2.0) {
         float L = luminance(m);
-        float hue = L * L > TINY ? level2 / (L * L) : 1.0;
-        return s.x / n * hue + TINY;
+        float colour_share = L * L > TINY ? level2 / (L * L) : 1.0;
+        return s.x / n * colour_share + TINY;
     }
     return max(s.x / n - level2, 0.0) * n / float(NOISE_TAPS - 1) + TINY;
 }
@@ -193,7 +196,7 @@ void main() {
         // level would keep Q ≈ 0 while its neighbours brighten: the gain must open
         // there too.
         vec3 level_x = max(x, vec3(0.0));
-        vec3 level_m = sums.yzw / float(NOISE_TAPS);
+        vec3 level_m = neighbourhood_mean(sums);
         float level = sqrt(max(dot(level_x, level_x), dot(level_m, level_m)) / 3.0);
         float Q = pc.change_q * sc.change * level;
         Q *= Q;
