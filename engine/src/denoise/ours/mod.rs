@@ -87,7 +87,7 @@ pub struct OursParams {
 impl Default for OursParams {
     fn default() -> Self {
         Self {
-            stratum: 5,
+            stratum: 3,
             shrink: 4.0,
             change_q: 3.5,
             motion_q: 0.01,
