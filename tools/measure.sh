@@ -65,6 +65,19 @@ keep() {
 
 oidn() { "$py" tools/oidn_eval.py "$1"; }
 
+# share_references SRC DST: DST/<scene>/reference links to SRC's, so a run into DST at
+# another --spp reuses SRC's references (they do not depend on --spp) and leaves SRC's
+# frames as the run that made them wrote them.
+share_references() {
+  local d scene
+  for d in "$1"/*/reference; do
+    [ -d "$d" ] || continue
+    scene=$(basename "$(dirname "$d")")
+    mkdir -p "$2/$scene"
+    ln -sfn "$PWD/$d" "$2/$scene/reference"
+  done
+}
+
 timed() { # timed CMD...: runs it, leaves its wall seconds in $secs
   local t0
   t0=$(date +%s.%N)
@@ -98,8 +111,8 @@ for set in "$@"; do
       meta development "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
     validation)
-      # At 2 spp with every method, then ours at 1 spp (the same references: they do not
-      # depend on --spp), to set against oidn-aux at 2 spp.
+      # At 2 spp with every method, then ours at 1 spp, to set against oidn-aux at 2 spp:
+      # into its own folder, on the same references (share_references).
       args=(--scene validation --size 128x128 --ref-spp 256 --aux
         --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,rae)
       timed "$dvr" eval "${args[@]}" --out "$out"
@@ -107,10 +120,12 @@ for set in "$@"; do
       oidn "$out"
       KEEP_METRICS=1 keep validation "$out"
       args1=(--scene validation --size 128x128 --ref-spp 256 --spp 1 --denoiser none,ours)
-      timed "$dvr" eval "${args1[@]}" --out "$out"
+      out1=$out-spp1
+      share_references "$out" "$out1"
+      timed "$dvr" eval "${args1[@]}" --out "$out1"
       total=$(echo "$total + $secs" | bc)
-      KEEP_METRICS=1 keep validation "$out" spp1
-      meta validation "$out" "$total" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out; dvr eval ${args1[*]} --out $out"
+      KEEP_METRICS=1 keep validation "$out1" spp1
+      meta validation "$out" "$total" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out; dvr eval ${args1[*]} --out $out1"
       ;;
     suite)
       args=(--scene suite --frames 48 --size 64x64 --ref-spp 1024 --aux

@@ -1,18 +1,22 @@
 #version 460
 // ours' noise measurement, first half: per pixel, the sums over the 5 pixels of its row
-// (clamped at the image's edge) of what R is measured from: the variance of each pixel's
-// mean from its samples' luminance moments, and the mean luminance and its square (at 1
-// spp, which has no variance, R comes from their spread; the luminance is also the
-// neighbourhood's level of a change). All from the moments image: the noisy frame's
-// luminance is its first moment. The update (ours_update.comp) sums 5 rows of these:
-// the 5×5 neighbourhood in 10 loads instead of 25.
+// (clamped at the image's edge) of what R is measured from, and of the noisy colour. ours'
+// variances are in one unit throughout, the mean over the colour channels of each
+// channel's variance (the unit of the innovation's |e|²/3, the à-trous' range term and
+// the prior's residuals): at 2 spp or more, x sums the variance of each pixel's mean from
+// its samples' luminance moments, which the update (ours_update.comp) turns into that unit
+// by the neighbourhood's colour; at 1 spp, which has no moments, x sums |y|²/3, and R is
+// the spread of the neighbourhood's colours. yzw sum the colour, the neighbourhood's mean
+// (its chromaticity, and the level of a change). The update sums 5 rows of these: the 5×5
+// neighbourhood in 10 loads instead of 25.
 #include "common.glsl"
 #include "ours_constants.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 1, rgba32f) uniform readonly image2D moments;  // x mean, y 2nd moment of luminance
-layout(binding = 2, rgba32f) uniform writeonly image2D rows;    // x Σ noise, y Σ L, z Σ L²
+layout(binding = 3, rgba32f) uniform readonly image2D noisy;    // rgb this frame's pixel means
+layout(binding = 2, rgba32f) uniform writeonly image2D rows;    // x Σ noise (or Σ |y|²/3), yzw Σ y
 
 layout(push_constant) uniform OursNoisePush {
     uint width;
@@ -25,14 +29,19 @@ void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
     if (p.x >= size.x || p.y >= size.y) return;
-    vec3 s = vec3(0.0);
+    vec4 s = vec4(0.0);
     for (int dx = -NOISE_RADIUS; dx <= NOISE_RADIUS; ++dx) {
         ivec2 q = ivec2(clamp(p.x + dx, 0, size.x - 1), p.y);
-        vec2 m = imageLoad(moments, q).xy;
-        if (!all_finite(vec3(m, 0.0))) m = vec2(0.0);
-        if (pc.spp >= 2.0) s.x += max(m.y - m.x * m.x, 0.0) / max(pc.spp - 1.0, 1.0);
-        s.y += m.x;
-        s.z += m.x * m.x;
+        vec3 y = imageLoad(noisy, q).rgb;
+        if (!all_finite(y)) y = vec3(0.0);
+        if (pc.spp >= 2.0) {
+            vec2 m = imageLoad(moments, q).xy;
+            if (!all_finite(vec3(m, 0.0))) m = vec2(0.0);
+            s.x += max(m.y - m.x * m.x, 0.0) / max(pc.spp - 1.0, 1.0);
+        } else {
+            s.x += dot(y, y) / 3.0;
+        }
+        s.yzw += y;
     }
-    imageStore(rows, p, vec4(s, 0.0));
+    imageStore(rows, p, s);
 }

@@ -5,32 +5,37 @@
 // pixel mean y_t:
 //     x_t = g_t ∘ x_{t−1} + w_t,   w_t ~ N(0, Q_t)      (the scene changes by g_t)
 //     y_t = x_t + v_t,             v_t ~ N(0, R_t)      (Monte Carlo noise)
-// with one variance per pixel shared by the channels (P for the estimate, Q, R):
+// with one variance per pixel shared by the channels (P for the estimate, Q, R), each in
+// one unit: the mean over the three channels of each channel's variance, E|v|²/3, the
+// unit of the innovation's |y − x⁻|²/3, the lag test's residuals, the à-trous' range term
+// and the prior's V:
 //   - g_t, the measured change: the temporal gradients' ratio of this frame's radiance to
 //     last frame's on re-traced paths (ours_gradient*.comp), 1 where nothing changed;
 //   - Q_t, what the prediction may have missed: (change_q · change · level)² for a
 //     change the gradients measured (their ratio is a neighbourhood's, the pixel's own may
-//     differ in proportion; the level is the larger of the pixel's luminance and its 5×5
-//     neighbourhood's in this frame), motion_q · R for a pixel whose surface moved on
-//     screen (the view-dependent change of a semi-transparent volume), and a shift the
-//     pooled lag test found (its own size);
-//   - R_t, the variance of one frame's pixel mean, estimated from the samples' own
-//     luminance moments over 5×5 pixels (at 1 spp: the 5×5 luminances' spread), scaled
-//     with the radiance by g_t and averaged over the filter's memory; this frame's
-//     measurement joins before the gain uses it, with the weight P⁻ / (P⁻ + R). Where the
-//     lag test shifted the level, the carried R was the old level's: a lower measurement
-//     replaces it (a surface that fell into shadow has no noise left there).
+//     differ in proportion; the level is the larger of the pixel's RMS colour |x|/√3 and
+//     its 5×5 neighbourhood's mean colour's in this frame), motion_q · R for a pixel whose
+//     surface moved on screen (the view-dependent change of a semi-transparent volume),
+//     and a shift the pooled lag test found (its own size, |shift|²/3);
+//   - R_t, the variance of one frame's pixel mean: the samples' luminance moments over
+//     5×5 pixels give Var(L), and a pixel's samples share a hue, so each channel's
+//     variance is (m_c / L(m))² Var(L) with m the neighbourhood's mean colour, and
+//     R = Var(L) (|m|²/3) / L(m)² (at 1 spp: the 5×5 colours' spread, directly in the
+//     unit); scaled with the radiance by g_t and averaged over the filter's memory; this
+//     frame's measurement joins before the gain uses it, with the weight P⁻ / (P⁻ + R).
+//     Where the lag test shifted the level, the carried R was the old level's: a lower
+//     measurement replaces it (a surface that fell into shadow has no noise left there).
 // Predict: x⁻ = g ∘ x, P⁻ = ḡ² P + Q. Update: K = P⁻ / (P⁻ + R), x = x⁻ + K (y − x⁻),
 // P = (1 − K) P⁻. With nothing changing Q = 0 and K = 1/n: the running mean, which only
 // improves.
 // Outliers from the normalised innovation ν² = |y − x⁻|² / 3 / (P⁻ + R): beyond
 // z = outlier_z standard deviations R is raised to R ν² / z², so the step K (y − x⁻)
 // falls as 1 / |y − x⁻| (a redescending weight; the residual handed to the lag test is
-// clipped to z deviations, Huber's ψ). Jumps from the pooled lag test: a residual the neighbourhood
-// shares beyond outlier_z standard errors of its mean is a moved level, and its square is
-// added to P⁻ so the filter follows it. A firefly, however often it repeats in one pixel,
-// is clipped (heavy-tailed noise puts bright paths in a pixel in successive frames); a
-// change of the scene moves a region.
+// clipped to z deviations, Huber's ψ). Jumps from the pooled lag test: a residual the
+// neighbourhood shares beyond outlier_z standard errors of its mean is a moved level, and
+// its square is added to P⁻ so the filter follows it. A firefly, however often it repeats
+// in one pixel, is weighed down (heavy-tailed noise puts bright paths in a pixel in
+// successive frames); a change of the scene moves a region.
 //
 // State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (rg32f:
 // the measurement noise R, and D, the part of P that process noise put there: the update
@@ -83,27 +88,42 @@ const float TINY = VARIANCE_FLOOR;
 // to frame while the noise does not, so at one half the running residual has a third of
 // one frame's noise variance.
 
-// This frame's sums over the 5×5 neighbourhood: x the moments' noise, y the luminance, z
-// its square. ours_noise.comp summed each row's 5 pixels; this sums 5 rows.
-vec3 neighbourhood_sums(ivec2 p, ivec2 size) {
-    vec3 s = vec3(0.0);
+// This frame's sums over the 5×5 neighbourhood (ours_noise.comp summed each row's 5
+// pixels; this sums 5 rows): x what R is measured from, yzw the colour.
+vec4 neighbourhood_sums(ivec2 p, ivec2 size) {
+    vec4 s = vec4(0.0);
     for (int dy = -NOISE_RADIUS; dy <= NOISE_RADIUS; ++dy) {
-        s += imageLoad(noise_rows, ivec2(p.x, clamp(p.y + dy, 0, size.y - 1))).xyz;
+        s += imageLoad(noise_rows, ivec2(p.x, clamp(p.y + dy, 0, size.y - 1)));
     }
     return s;
 }
 
-// R of a pixel without history, and this frame's measurement of R: the moments' noise
-// over the 5×5 neighbourhood (one pixel's two samples say too little); at 1 spp, which has
-// no moments, the spread of the 5×5 pixels' luminance (signal detail included: an
-// overestimate, which only slows the first frames). Under heavy tails 3×3 was too few:
-// where no bright path landed in 18 samples R came out near zero, the filter looked
-// converged on a low mean, and the à-trous kept it as a dark blotch (static views).
-// `s`: the sums neighbourhood_sums returns.
-float fresh_noise(vec3 s) {
+// R of a pixel without history, and this frame's measurement of R, in the filter's unit
+// (the mean over the channels of each channel's variance): from the moments' luminance
+// noise over the 5×5 neighbourhood (one pixel's two samples say too little), turned into
+// that unit by the neighbourhood's colour m. A pixel's samples share a hue (the TF's
+// colours along one path scale each sample's radiance as a whole), so each channel's
+// noise is its share of the luminance's: Var(y_c) = (m_c / L(m))² Var(L), and the unit's
+// variance is Var(L)·(|m|²/3) / L(m)² (grey: Var(L); a saturated blue: 64 Var(L)). Where
+// the neighbourhood is black the ratio is 1. At 1 spp, which has no moments, the spread of
+// the 5×5 pixels' colours in the same unit (signal detail included: an overestimate,
+// which only slows the first frames). Under heavy tails 3×3 was too few: where no bright
+// path landed in 18 samples R came out near zero, the filter looked converged on a low
+// mean, and the à-trous kept it as a dark blotch (static views). `s`: the sums
+// neighbourhood_sums returns.
+// The 5×5 neighbourhood's mean colour, from those sums.
+vec3 neighbourhood_mean(vec4 s) { return s.yzw / float(NOISE_TAPS); }
+
+float fresh_noise(vec4 s) {
     const float n = float(NOISE_TAPS);
-    if (pc.spp >= 2.0) return s.x / n + TINY;
-    return max(s.z / n - (s.y / n) * (s.y / n), 0.0) * n / float(NOISE_TAPS - 1) + TINY;
+    vec3 m = neighbourhood_mean(s);
+    float level2 = dot(m, m) / 3.0;
+    if (pc.spp >= 2.0) {
+        float L = luminance(m);
+        float colour_share = L * L > TINY ? level2 / (L * L) : 1.0;
+        return s.x / n * colour_share + TINY;
+    }
+    return max(s.x / n - level2, 0.0) * n / float(NOISE_TAPS - 1) + TINY;
 }
 
 // The history's estimate resampled by Catmull-Rom over the 4×4 texels around `r.uv`
@@ -147,7 +167,7 @@ void main() {
 
     vec3 y = imageLoad(noisy, p).rgb;
     if (!all_finite(y)) y = vec3(0.0);
-    vec3 sums = neighbourhood_sums(p, size);
+    vec4 sums = neighbourhood_sums(p, size);
     Reprojection r = reproject(p, size, pc.history_valid != 0u, pc.camera.xyz, pc.tolerance);
 
     vec3 x;
@@ -175,7 +195,9 @@ void main() {
         // this frame. A pixel the light is about to reach is dark (x ≈ 0), and its own
         // level would keep Q ≈ 0 while its neighbours brighten: the gain must open
         // there too.
-        float level = max(luminance(max(x, vec3(0.0))), sums.y / float(NOISE_TAPS));
+        vec3 level_x = max(x, vec3(0.0));
+        vec3 level_m = neighbourhood_mean(sums);
+        float level = sqrt(max(dot(level_x, level_x), dot(level_m, level_m)) / 3.0);
         float Q = pc.change_q * sc.change * level;
         Q *= Q;
         if (length(r.motion) > STILL_PX) Q += pc.motion_q * R;

@@ -64,7 +64,7 @@ pub struct OursParams {
     pub shrink: f32,
     /// Process noise of a measured change: the pixel's own change may differ from its
     /// neighbourhood's measured one by this share of it (Q = (change_q · change · L)², L
-    /// the larger of the pixel's luminance and its 5×5 neighbourhood's).
+    /// the larger of the pixel's RMS colour and its 5×5 neighbourhood's mean colour's).
     pub change_q: f32,
     /// Process noise of a pixel whose surface moved on screen, in units of its
     /// measurement noise (the view-dependent change of a semi-transparent volume).

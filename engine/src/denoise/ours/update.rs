@@ -101,7 +101,9 @@ impl Ours {
             pad: 0.0,
         };
         frame.add_compute(format!("{n}.noise"), &self.noise, rows_push, size, |b| {
-            b.read("moments", moments).write("rows", rows);
+            b.read("moments", moments)
+                .read("noisy", noisy)
+                .write("rows", rows);
         });
         frame.add_compute(format!("{n}.update"), &self.update, push, size, |b| {
             reproj.bind(b);
