@@ -39,8 +39,9 @@
 //
 // State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (rg32f:
 // the measurement noise R, and D, the part of P that process noise put there: the update
-// splits P = (1 − K)² P⁻ + K² R, so D = (1 − K)² (ḡ² D + Q), the Q of the frames the
-// filter's memory still spans; a filter that restarted (K ≈ 1) carries none).
+// splits P = (1 − K)² P⁻ + K² R, so D = (1 − K)² (ḡ² D + Q + J), J a jump's e² (below),
+// the process noise of the frames the filter's memory still spans; a filter that
+// restarted (K ≈ 1) carries none).
 // Outputs: the state itself is the estimate the prior and the à-trous read (each clamps its
 // radiance at zero as it reads it), and the a-posteriori residual with its variance for the
 // pooled lag test (ours_lag.comp).
