@@ -34,8 +34,8 @@ const FRAMES: u32 = 30;
 const REFERENCE_SPP: u32 = 128;
 /// The bound this test asserts, dB below the restarted filter at the same age. Measured
 /// for `ours-no-prior` (40², 2 spp, 15 frames after the jump, 3×3 strata): tf-jump at
-/// most 0.90 (age 5), light-jump at most 0.13 (age 10), both within the first frames above the restart
-/// (the gradients carry the history over) and below it later.
+/// most 0.90 (age 5), light-jump at most 0.13 (age 10), both within the first frames
+/// above the restart (the gradients carry the history over) and below it later.
 const MAX_DEFICIT_DB: f64 = 1.0;
 
 fn rgb(px: &[[f32; 4]]) -> Rgb32Image {

@@ -145,17 +145,19 @@ for set in "$@"; do
       meta rae "$out" "$secs" "dvr eval ${args[*]} --out $out"
       ;;
     paper)
-      # One reference folder for the three noise levels: references do not depend on --spp.
+      # One folder per noise level (out/paper-sppN), all on out/paper-spp1's references
+      # (share_references: they do not depend on --spp), so each level's frames stay.
       total=0
       for spp in 1 2 4; do
         args=(--scene paper --size 64x64 --spp $spp
           --denoiser none,taa,svgf,wrls-paper,rls-paper,wrls,rls,rae,ours)
-        timed "$dvr" eval "${args[@]}" --out "$out"
+        [ "$spp" = 1 ] || share_references "$out-spp1" "$out-spp$spp"
+        timed "$dvr" eval "${args[@]}" --out "$out-spp$spp"
         total=$(echo "$total + $secs" | bc)
-        oidn "$out"
-        keep paper "$out" "spp$spp"
+        oidn "$out-spp$spp"
+        keep paper "$out-spp$spp" "spp$spp"
       done
-      meta paper "$out" "$total" "for spp in 1 2 4: dvr eval --scene paper --size 64x64 --spp \$spp --denoiser none,taa,svgf,wrls-paper,rls-paper,wrls,rls,rae,ours --out $out && tools/oidn_eval.py $out"
+      meta paper "$out-spp1" "$total" "for spp in 1 2 4: dvr eval --scene paper --size 64x64 --spp \$spp --denoiser none,taa,svgf,wrls-paper,rls-paper,wrls,rls,rae,ours --out $out-spp\$spp && tools/oidn_eval.py $out-spp\$spp"
       ;;
     cost)
       mkdir -p "$out"

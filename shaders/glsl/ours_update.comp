@@ -99,6 +99,9 @@ vec4 neighbourhood_sums(ivec2 p, ivec2 size) {
     return s;
 }
 
+// The 5×5 neighbourhood's mean colour, from the sums neighbourhood_sums returns.
+vec3 neighbourhood_mean(vec4 s) { return s.yzw / float(NOISE_TAPS); }
+
 // R of a pixel without history, and this frame's measurement of R, in the filter's unit
 // (the mean over the channels of each channel's variance): from the moments' luminance
 // noise over the 5×5 neighbourhood (one pixel's two samples say too little), turned into
@@ -112,9 +115,6 @@ vec4 neighbourhood_sums(ivec2 p, ivec2 size) {
 // path landed in 18 samples R came out near zero, the filter looked converged on a low
 // mean, and the à-trous kept it as a dark blotch (static views). `s`: the sums
 // neighbourhood_sums returns.
-// The 5×5 neighbourhood's mean colour, from those sums.
-vec3 neighbourhood_mean(vec4 s) { return s.yzw / float(NOISE_TAPS); }
-
 float fresh_noise(vec4 s) {
     const float n = float(NOISE_TAPS);
     vec3 m = neighbourhood_mean(s);
