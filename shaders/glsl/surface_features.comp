@@ -55,42 +55,46 @@ void main() {
         float t = span.x;
         float prev_alpha = 0.0;
         float mean_t = 0.0;  // Σ t · (contribution of the step to the accumulated opacity)
-        bool found = false;
-        for (int guard = 0; guard < 4096 && !found; ++guard) {
+        float step_len = base_step;  // the step of the brick the march is in
+        float t_hit = 0.0;           // the last step's position
+        for (int guard = 0; guard < 4096 && alpha < threshold; ++guard) {
             float cell_exit = min(grid_walk_exit(w), span.y);
             float m = grid_majorant(w);
             if (m > 0.0) {
                 // Steps short enough that one step's opacity stays below ~0.2 in this
                 // brick (fine where it is dense, up to 4× longer where it is faint).
-                float step_len = clamp(0.2 / m, base_step, 4.0 * base_step);
-                for (; t < cell_exit; t += step_len) {
+                step_len = clamp(0.2 / m, base_step, 4.0 * base_step);
+                for (; t < cell_exit && alpha < threshold; t += step_len) {
                     vec3 p = o + d * t;
                     float a = 1.0 - exp(-extinction_at(p) * step_len);
                     prev_alpha = alpha;
                     alpha += (1.0 - alpha) * a;
                     mean_t += t * (alpha - prev_alpha);
-                    if (alpha >= threshold) {
-                        // Interpolate the crossing inside the last step, so depth and
-                        // position do not terrace at the step length.
-                        float f = (threshold - prev_alpha) / max(alpha - prev_alpha, 1e-6);
-                        float th = t - step_len * (1.0 - clamp(f, 0.0, 1.0));
-                        vec3 ph = o + d * th;
-                        float density = density_at(ph);
-                        vec3 g = density_gradient(ph);
-                        vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
-                        if (cut_entry && th - span.x < CUT_FACE_STEPS * base_step) n = cut_normal;
-                        if (dot(n, d) > 0.0) n = -n;
-                        pos = vec4(ph, 1.0);
-                        nrm = vec4(n, th);
-                        alb = vec4(tf_albedo_opacity(density).rgb, 1.0);
-                        found = true;
-                        break;
-                    }
+                    t_hit = t;
                 }
             } else {
                 t = cell_exit;
             }
-            if (found || t >= span.y || !grid_walk_advance(w)) break;
+            if (alpha >= threshold || t >= span.y || !grid_walk_advance(w)) break;
+        }
+        // The crossing's work (the gradient's six fetches, the albedo) runs once, after the
+        // march: inside the loop a SIMD CPU device (lavapipe) runs a branch's body for
+        // the whole batch at every step, which made the pass four times as slow.
+        bool found = alpha >= threshold;
+        if (found) {
+            // Interpolate the crossing inside the last step, so depth and
+            // position do not terrace at the step length.
+            float f = (threshold - prev_alpha) / max(alpha - prev_alpha, 1e-6);
+            float th = t_hit - step_len * (1.0 - clamp(f, 0.0, 1.0));
+            vec3 ph = o + d * th;
+            float density = density_at(ph);
+            vec3 g = density_gradient(ph);
+            vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
+            if (cut_entry && th - span.x < CUT_FACE_STEPS * base_step) n = cut_normal;
+            if (dot(n, d) > 0.0) n = -n;
+            pos = vec4(ph, 1.0);
+            nrm = vec4(n, th);
+            alb = vec4(tf_albedo_opacity(density).rgb, 1.0);
         }
         if (!found && alpha >= MIN_VISIBLE_OPACITY) {
             pos = vec4(o + d * (mean_t / alpha), 1.0);
