@@ -620,3 +620,72 @@ fn svgf_and_taa_stay_finite_and_bounded_for_50_frames() {
     drop(r);
     assert_validation_clean();
 }
+
+/// The surface features come from the surface pass where no method reads the guides and
+/// from the guides' march where one does (`--aux` here): the two passes find the same
+/// surface, so the features and what reprojects by them are bit-identical either way.
+#[test]
+fn the_guides_march_writes_the_surface_pass_features() {
+    const FRAMES: u32 = 4;
+    let run = |aux: bool| {
+        let setup = builtin_setup("phantom/orbit", FRAMES, 24);
+        let mut r = setup.renderer(context(), &["taa"]).expect("renderer");
+        let request = FrameRequest {
+            readback: true,
+            features: true,
+            aux,
+            ..Default::default()
+        };
+        let mut frames = Vec::new();
+        for f in 0..FRAMES {
+            frames.extend(r.frame(&setup.frame_inputs(f), &request).expect("frame"));
+        }
+        frames.extend(r.flush().expect("flush"));
+        drop(r);
+        assert_validation_clean();
+        frames
+    };
+    let (alone, fused) = (run(false), run(true));
+    assert_eq!(
+        (alone.len(), fused.len()),
+        (FRAMES as usize, FRAMES as usize)
+    );
+    for (a, b) in alone.iter().zip(&fused) {
+        let ran = |res: &dvr_engine::renderer::FrameResult, pass: &str| {
+            res.timings.iter().any(|t| t.pass == pass)
+        };
+        assert!(ran(a, "surface_features") && !ran(a, "aux_features"));
+        assert!(ran(b, "aux_features") && !ran(b, "surface_features"));
+        let image = |res: &dvr_engine::renderer::FrameResult, name: &str| {
+            res.images
+                .iter()
+                .find(|(n, _)| n == name)
+                .unwrap_or_else(|| panic!("frame {}: no {name} readback", res.index))
+                .1
+                .clone()
+        };
+        let mut met = 0;
+        for name in dvr_engine::renderer::FEATURE_IMAGES
+            .iter()
+            .copied()
+            .chain(["taa"])
+        {
+            let (x, y) = (image(a, name), image(b, name));
+            assert!(
+                x.iter()
+                    .zip(&y)
+                    .all(|(p, q)| p.map(f32::to_bits) == q.map(f32::to_bits)),
+                "frame {}: {name} differs between the two passes",
+                a.index
+            );
+            if name == "features.position" {
+                met = x.iter().filter(|p| p[3] > 0.0).count();
+            }
+        }
+        assert!(
+            met > 24 * 24 / 10,
+            "frame {}: the rays met too little ({met})",
+            a.index
+        );
+    }
+}

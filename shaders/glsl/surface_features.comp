@@ -11,14 +11,14 @@
 // invalid there (edge-stopping only trusts threshold surfaces). Where the ray enters the
 // medium through a cut and meets the threshold at once, the surface is the cut face and
 // its normal the cut's.
+// This pass runs where no method of the frame reads the guides; where one does,
+// aux_features.comp finds the same surface in its own march (include/features_march.glsl).
 #include "common.glsl"
 #include "frame.glsl"
 #include "volume.glsl"
+#include "features_march.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-
-// Accumulated opacity below which a ray counts as having met nothing.
-const float MIN_VISIBLE_OPACITY = 0.05;
 
 layout(binding = 7, rgba32f) uniform writeonly image2D feature_position;  // xyz, w valid
 layout(binding = 8, rgba32f) uniform writeonly image2D feature_normal;    // xyz, w depth
@@ -40,66 +40,29 @@ void main() {
     vec3 d = normalize(far_h.xyz / far_h.w - o);
     vec3 cut_normal;
     vec2 span = intersect_medium(o, d, cut_normal);
-    bool cut_entry = any(notEqual(cut_normal, vec3(0.0)));
     float voxel = min(box_size().x / float(frame.dims.x),
                       min(box_size().y / float(frame.dims.y), box_size().z / float(frame.dims.z)));
-    float base_step = voxel * pc.step_voxels;
-    float alpha = 0.0;
+    float step_len = voxel * pc.step_voxels;
     float threshold = frame.params.z;
-    vec4 pos = vec4(0.0);
-    vec4 nrm = vec4(0.0, 0.0, 0.0, 0.0);
-    vec4 alb = vec4(0.0);
+    Crossing c = crossing_begin();
     if (span.x < span.y) {
-        // March the bricks the majorant grid says hold anything; skip empty ones whole.
         GridWalk w = grid_walk_begin(o, d, span.x);
         float t = span.x;
-        float prev_alpha = 0.0;
-        float mean_t = 0.0;  // Σ t · (contribution of the step to the accumulated opacity)
-        float step_len = base_step;  // the step of the brick the march is in
-        float t_hit = 0.0;           // the last step's position
-        for (int guard = 0; guard < 4096 && alpha < threshold; ++guard) {
+        for (int guard = 0; guard < 4096 && !c.found; ++guard) {
             float cell_exit = min(grid_walk_exit(w), span.y);
-            float m = grid_majorant(w);
-            if (m > 0.0) {
-                // Steps short enough that one step's opacity stays below ~0.2 in this
-                // brick (fine where it is dense, up to 4× longer where it is faint).
-                step_len = clamp(0.2 / m, base_step, 4.0 * base_step);
-                for (; t < cell_exit && alpha < threshold; t += step_len) {
-                    vec3 p = o + d * t;
-                    float a = 1.0 - exp(-extinction_at(p) * step_len);
-                    prev_alpha = alpha;
-                    alpha += (1.0 - alpha) * a;
-                    mean_t += t * (alpha - prev_alpha);
-                    t_hit = t;
+            if (grid_majorant(w) > 0.0) {
+                for (; t < cell_exit && !c.found; t += step_len) {
+                    float a = 1.0 - exp(-extinction_at(o + d * t) * step_len);
+                    crossing_step(c, t, a, threshold);
                 }
             } else {
                 t = cell_exit;
             }
-            if (alpha >= threshold || t >= span.y || !grid_walk_advance(w)) break;
-        }
-        // The crossing's work (the gradient's six fetches, the albedo) runs once, after the
-        // march: inside the loop a SIMD CPU device (lavapipe) runs a branch's body for
-        // the whole batch at every step, which made the pass four times as slow.
-        bool found = alpha >= threshold;
-        if (found) {
-            // Interpolate the crossing inside the last step, so depth and
-            // position do not terrace at the step length.
-            float f = (threshold - prev_alpha) / max(alpha - prev_alpha, 1e-6);
-            float th = t_hit - step_len * (1.0 - clamp(f, 0.0, 1.0));
-            vec3 ph = o + d * th;
-            float density = density_at(ph);
-            vec3 g = density_gradient(ph);
-            vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
-            if (cut_entry && th - span.x < CUT_FACE_STEPS * base_step) n = cut_normal;
-            if (dot(n, d) > 0.0) n = -n;
-            pos = vec4(ph, 1.0);
-            nrm = vec4(n, th);
-            alb = vec4(tf_albedo_opacity(density).rgb, 1.0);
-        }
-        if (!found && alpha >= MIN_VISIBLE_OPACITY) {
-            pos = vec4(o + d * (mean_t / alpha), 1.0);
+            if (c.found || t >= span.y || !grid_walk_advance(w)) break;
         }
     }
+    vec4 pos, nrm, alb;
+    crossing_features(c, o, d, span.x, cut_normal, step_len, threshold, pos, nrm, alb);
     imageStore(feature_position, ivec2(pixel), pos);
     imageStore(feature_normal, ivec2(pixel), nrm);
     imageStore(feature_albedo, ivec2(pixel), alb);

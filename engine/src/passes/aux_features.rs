@@ -3,10 +3,12 @@
 //! first scattering event, the "albedo" and "normal" auxiliary images Intel Open Image
 //! Denoise takes. Rendered when a frame asks for them (`dvr eval --aux`) and, albedo
 //! only (a pipeline without the normal's six extra fetches a step), when SVGF reads them
-//! to demodulate (`include/svgf.glsl`, `svgf_demod_factor`).
+//! to demodulate (`include/svgf.glsl`, `svgf_demod_factor`). Its march also finds the
+//! threshold surface and writes the surface features, so a frame that needs both marches
+//! once.
 
 use super::path_trace::volume_specialization;
-use super::surface_features::STEP_VOXELS;
+use super::surface_features::{FeatureImages, STEP_VOXELS};
 use super::SceneBindings;
 use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
@@ -49,7 +51,9 @@ impl AuxFeatures {
     }
 
     /// Adds the pass; returns (albedo: rgb, a opacity; normal: xyz world, w opacity).
-    /// Without `normals` the normal image holds zero and the opacity.
+    /// Without `normals` the normal image holds zero and the opacity. The same march
+    /// writes the surface features into `features`.
+    #[allow(clippy::too_many_arguments)]
     pub fn add(
         &self,
         ctx: &GpuContext,
@@ -58,6 +62,7 @@ impl AuxFeatures {
         scene: &SceneBindings,
         size: Extent,
         normals: bool,
+        features: FeatureImages,
     ) -> Result<(ImageHandle, ImageHandle)> {
         let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
         let albedo = graph.image(ctx, ALBEDO, desc)?;
@@ -76,6 +81,7 @@ impl AuxFeatures {
         frame.add_compute("aux_features", pipeline, push, size, |b| {
             scene.bind_volume(b);
             b.write("aux_albedo", albedo).write("aux_normal", normal);
+            features.bind_written(b);
         });
         Ok((albedo, normal))
     }

@@ -5,7 +5,7 @@ use super::SceneBindings;
 use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline};
 use crate::gpu_block;
-use crate::graph::{Extent, Frame, History, ImageHandle, RenderGraph};
+use crate::graph::{Bindings, Extent, Frame, History, ImageHandle, RenderGraph};
 use crate::passes::path_trace::volume_specialization;
 use ash::vk;
 
@@ -37,6 +37,26 @@ pub struct FeatureImages {
     pub albedo: ImageHandle,
 }
 
+impl FeatureImages {
+    /// The frame's feature images, for whichever pass writes them (this one, or
+    /// [`super::aux_features::AuxFeatures`], whose march finds the same surface).
+    pub fn new(ctx: &GpuContext, graph: &mut RenderGraph, size: Extent) -> Result<Self> {
+        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        Ok(Self {
+            position: graph.history(ctx, "features.position", desc)?,
+            normal: graph.image(ctx, "features.normal", desc)?,
+            albedo: graph.image(ctx, "features.albedo", desc)?,
+        })
+    }
+
+    /// Binds the images as a features pass writes them.
+    pub fn bind_written(&self, b: &mut Bindings) {
+        b.write("feature_position", self.position.cur)
+            .write("feature_normal", self.normal)
+            .write("feature_albedo", self.albedo);
+    }
+}
+
 impl SurfaceFeatures {
     /// `pooled`: the volume is paged through the brick pool.
     pub fn new(ctx: &GpuContext, pooled: bool) -> Result<Self> {
@@ -53,12 +73,7 @@ impl SurfaceFeatures {
         scene: &SceneBindings,
         size: Extent,
     ) -> Result<FeatureImages> {
-        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
-        let out = FeatureImages {
-            position: graph.history(ctx, "features.position", desc)?,
-            normal: graph.image(ctx, "features.normal", desc)?,
-            albedo: graph.image(ctx, "features.albedo", desc)?,
-        };
+        let out = FeatureImages::new(ctx, graph, size)?;
         let push = FeaturesPush {
             width: size.width,
             height: size.height,
@@ -67,9 +82,7 @@ impl SurfaceFeatures {
         };
         frame.add_compute("surface_features", &self.pipeline, push, size, |b| {
             scene.bind_volume(b);
-            b.write("feature_position", out.position.cur)
-                .write("feature_normal", out.normal)
-                .write("feature_albedo", out.albedo);
+            out.bind_written(b);
         });
         Ok(out)
     }

@@ -29,7 +29,7 @@ use crate::passes::aux_features::{self, AuxFeatures};
 use crate::passes::motion::Motion;
 use crate::passes::path_trace::{PathTrace, PathTraceFeatures};
 use crate::passes::present::Present;
-use crate::passes::surface_features::SurfaceFeatures;
+use crate::passes::surface_features::{FeatureImages, SurfaceFeatures};
 use crate::passes::SceneBindings;
 use crate::scene::RenderSettings;
 use crate::shaders::frame::{FrameBlock, FrameParams, SampleStream, MAX_LIGHTS};
@@ -474,14 +474,32 @@ impl Renderer {
         // features → path trace → motion → each denoiser on the same noisy frame.
         // The features and guide passes are the cost of every method that needs them (a
         // method alone would pay for them), not of the frame: `none` and `accum` read
-        // neither.
+        // neither. The guide images: the albedo for the denoisers that read it (svgf
+        // demodulates by it, ours' prior fits on it), both read back for single-frame
+        // denoisers (`FrameRequest::aux`). Their march also finds the threshold surface,
+        // so where they are rendered it writes the surface features too and the surface
+        // pass does not run: one march, the cost of every method that reads either.
         let motion = self.config.motion_source;
         let feature_readers = readers(&self.denoisers, |m| m.info.features.needed(motion));
-        let features = if request.features || !feature_readers.is_empty() {
-            let owner = PassOwner::Methods(feature_readers);
-            Some(frame.add_for(owner, |f| passes.features.add(ctx, graph, f, &scene, size))?)
-        } else {
-            None
+        let want_features = request.features || !feature_readers.is_empty();
+        let (features, aux) = match &passes.aux {
+            Some(pass) if request.aux || guides => {
+                let mut owners = guide_readers;
+                owners.retain(|m| !feature_readers.contains(m));
+                owners.splice(0..0, feature_readers);
+                let images = FeatureImages::new(ctx, graph, size)?;
+                let aux = frame.add_for(PassOwner::Methods(owners), |f| {
+                    pass.add(ctx, graph, f, &scene, size, request.aux, images)
+                })?;
+                (want_features.then_some(images), Some(aux))
+            }
+            _ if want_features => {
+                let owner = PassOwner::Methods(feature_readers);
+                let images =
+                    frame.add_for(owner, |f| passes.features.add(ctx, graph, f, &scene, size))?;
+                (Some(images), None)
+            }
+            _ => (None, None),
         };
         let noisy = passes.path_trace.add(
             ctx,
@@ -516,18 +534,6 @@ impl Renderer {
                     camera_prev: last.camera.position,
                     frame_prev: self.frame_index.wrapping_sub(1) as u32,
                 })
-            }
-            _ => None,
-        };
-        // The guide images: the albedo for the denoisers that read it (svgf demodulates by
-        // it, ours' prior fits on it), both read back for single-frame denoisers
-        // (`FrameRequest::aux`).
-        let aux = match &passes.aux {
-            Some(pass) if request.aux || guides => {
-                let owner = PassOwner::Methods(guide_readers);
-                Some(frame.add_for(owner, |f| {
-                    pass.add(ctx, graph, f, &scene, size, request.aux)
-                })?)
             }
             _ => None,
         };
