@@ -526,7 +526,7 @@ def b_cost():
     return "\n".join([
         "Mean ms per frame at 256×256. *Own* is a method's own passes; *with features* adds "
         "the passes it needs and would run alone (the surface features and the guides "
-        "composited along the ray, which both read); dispatches and declared bytes per "
+        "composited along the ray, which both read, rendered by one march); dispatches and declared bytes per "
         "pixel per frame count the same passes (a pass run only when the scene changed "
         "counts by the share of frames it ran in). The path trace, which every method "
         "shares, beside them:",
