@@ -52,7 +52,7 @@ void main() {
             float cell_exit = min(grid_walk_exit(w), span.y);
             if (grid_majorant(w) > 0.0) {
                 for (; t < cell_exit && !c.found; t += step_len) {
-                    float a = 1.0 - exp(-extinction_at(o + d * t) * step_len);
+                    float a = step_opacity(extinction_at(o + d * t), step_len);
                     crossing_step(c, t, a, threshold);
                 }
             } else {

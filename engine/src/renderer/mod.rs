@@ -484,9 +484,12 @@ impl Renderer {
         let want_features = request.features || !feature_readers.is_empty();
         let (features, aux) = match &passes.aux {
             Some(pass) if request.aux || guides => {
-                let mut owners = guide_readers;
-                owners.retain(|m| !feature_readers.contains(m));
-                owners.splice(0..0, feature_readers);
+                let mut owners = feature_readers;
+                for m in guide_readers {
+                    if !owners.contains(&m) {
+                        owners.push(m);
+                    }
+                }
                 let images = FeatureImages::new(ctx, graph, size)?;
                 let aux = frame.add_for(PassOwner::Methods(owners), |f| {
                     pass.add(ctx, graph, f, &scene, size, request.aux, images)

@@ -24,6 +24,10 @@ struct Crossing {
     bool found;
 };
 
+// The opacity of one step of length step_len through extinction mu: both passes take
+// it from here, so their steps' opacities are the same to the bit.
+float step_opacity(float mu, float step_len) { return 1.0 - exp(-mu * step_len); }
+
 Crossing crossing_begin() { return Crossing(0.0, 0.0, 0.0, 0.0, false); }
 
 // One step at t whose own opacity is a. Only assignments: this runs inside the march
