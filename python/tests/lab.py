@@ -11,6 +11,7 @@ import socket
 import subprocess
 import sys
 import time
+import urllib.error
 import urllib.request
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
@@ -58,7 +59,17 @@ class Lab:
         return f"http://127.0.0.1:{self.port}/lab/tree/{notebook}?reset&token={self.token}"
 
     def kernels(self):
-        return json.loads(urllib.request.urlopen(self.api("kernels"), timeout=5).read())
+        """The server's running kernels. jupyter_server lists a kernel it is still
+        launching before that kernel has a `last_activity`, and answers the listing with a
+        500 (an AttributeError) until it has one: that answer is retried for 10 s."""
+        deadline = time.monotonic() + 10
+        while True:
+            try:
+                return json.loads(urllib.request.urlopen(self.api("kernels"), timeout=5).read())
+            except urllib.error.HTTPError as e:
+                if e.code != 500 or time.monotonic() > deadline:
+                    raise RuntimeError(f"GET /api/kernels answered {e.code}; see {self.log.name}") from e
+                time.sleep(0.1)
 
     def stop(self):
         if self.proc.poll() is None:
