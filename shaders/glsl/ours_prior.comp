@@ -4,14 +4,14 @@
 // (ours_prior_fit.comp) predicts it, and the prediction is combined with the estimate by
 // their variances before the à-trous filter.
 //
-// Model. Around p, x_q = βᵀf_q + ε_q, f_q = (1, a_q, n_q, n_x n_y, n_x n_z, n_y n_z), with
-// a_q the TF albedo composited along q's ray and n_q its surface's gradient normal, both
-// over its footprint (deterministic: ours_guide.comp). The fit's prediction x̂_p = βᵀf_p
-// is given the error variance V, the residuals' mean square over the window: its average
-// error there, with the neighbours' own noise counted in full (which the fit averages
-// down), so the prior is trusted less than it could be where the model holds; where it
-// does not hold at p alone (a fold the window's fit misses) V understates the error. With
-// the estimate's variance P, the two are combined as two measurements of one value:
+// Model. Around p, x_q = βᵀf_q + ε_q, f_q = (1, a_q, n_q), with a_q the TF albedo
+// composited along q's ray and n_q its surface's gradient normal, both over its footprint
+// (deterministic: ours_guide.comp). The fit's prediction x̂_p = βᵀf_p is given the error variance V, the
+// residuals' mean square over the window: its average error there, with the neighbours'
+// own noise counted in full (which the fit averages down), so the prior is trusted less
+// than it could be where the model holds; where it does not hold at p alone (a fold the
+// window's fit misses) V understates the error. With the estimate's variance P, the two are
+// combined as two measurements of one value:
 //     x' = (V x_p + P x̂_p) / (V + P),   P' = V P / (V + P).
 // A young estimate (the first frames, a disocclusion, a change the gradients measured)
 // leans on the albedo's structure (a silhouette, a coloured vessel, a shell's rim) where
@@ -34,9 +34,6 @@ layout(binding = 4) uniform sampler2D fit_g_lo;
 layout(binding = 5) uniform sampler2D fit_g_hi;
 layout(binding = 6) uniform sampler2D fit_b_lo;
 layout(binding = 7) uniform sampler2D fit_b_hi;
-layout(binding = 11) uniform sampler2D fit_r_x;
-layout(binding = 12) uniform sampler2D fit_g_x;
-layout(binding = 13) uniform sampler2D fit_b_x;
 layout(binding = 8, rgba32f) uniform writeonly image2D combined;    // rgb x', a P'
 layout(binding = 9, rgba32f) uniform writeonly image2D prediction;  // rgb x̂, a 1 where there is one
 
@@ -55,12 +52,11 @@ void main() {
     // pixel PRIOR_STRIDE·i + (PRIOR_STRIDE − 1)/2).
     vec2 uv = (vec2(p) + 0.5) / (float(PRIOR_STRIDE) * vec2(textureSize(fit_r_lo, 0)));
     vec4 lo = features_lo(imageLoad(footprint, p).rgb);
-    vec3 n = imageLoad(footprint_normal, p).xyz;
-    vec3 hi = features_hi(n), cx = features_x(n);
+    vec3 hi = features_hi(imageLoad(footprint_normal, p).xyz);
     vec4 r_hi = texture(fit_r_hi, uv);
-    vec3 pred = vec3(dot(texture(fit_r_lo, uv), lo) + dot(r_hi.xyz, hi) + dot(texture(fit_r_x, uv).xyz, cx),
-                     dot(texture(fit_g_lo, uv), lo) + dot(texture(fit_g_hi, uv).xyz, hi) + dot(texture(fit_g_x, uv).xyz, cx),
-                     dot(texture(fit_b_lo, uv), lo) + dot(texture(fit_b_hi, uv).xyz, hi) + dot(texture(fit_b_x, uv).xyz, cx));
+    vec3 pred = vec3(dot(texture(fit_r_lo, uv), lo) + dot(r_hi.xyz, hi),
+                     dot(texture(fit_g_lo, uv), lo) + dot(texture(fit_g_hi, uv).xyz, hi),
+                     dot(texture(fit_b_lo, uv), lo) + dot(texture(fit_b_hi, uv).xyz, hi));
     float V = r_hi.a;
     bool fitted = V > 0.0 && V < NO_FIT && all_finite(pred);
     // Every pixel's prediction, for the à-trous to carry neighbours by (a 0: none).

@@ -1,11 +1,10 @@
 #version 460
 // ours' spatial prior, the fit: a local linear model of the estimates on the guides,
-// x_q = βᵀf_q + ε_q with f_q = (1, albedo r, g, b, normal x, y, z, normal xy, xz, yz) (β
-// per colour channel), fitted by least squares over the window around each cell of a grid
+// x_q = βᵀf_q + ε_q with f_q = (1, albedo r, g, b, normal x, y, z) (β per colour
+// channel), fitted by least squares over the window around each cell of a grid
 // PRIOR_STRIDE pixels apart, with the residuals' mean square V. The albedo tells
 // materials apart (a vessel's hue against the shell), the normal the shading of a
-// surface across the window as the light or the view moves, its cross products that
-// shading's bend (a terminator, a rounded cap under a near light). The prior (ours_prior.comp)
+// surface across the window as the light or the view moves. The prior (ours_prior.comp)
 // interpolates the coefficients between the cells, as the fast guided filter does,
 // instead of fitting at every pixel: a window of 144 pixels moved by PRIOR_STRIDE changes
 // its fit little. The window's normal equations are the sums of its 3×3 blocks'
@@ -17,16 +16,13 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D sums;  // per block (ours_prior_sums.comp)
 // The coefficients per channel: `lo` those of the first four features, `hi` the normal's,
-// with V in a, `x` the normal's cross products'.
+// with V in a.
 layout(binding = 1, rgba32f) uniform writeonly image2D fit_r_lo;
 layout(binding = 2, rgba32f) uniform writeonly image2D fit_r_hi;
 layout(binding = 3, rgba32f) uniform writeonly image2D fit_g_lo;
 layout(binding = 4, rgba32f) uniform writeonly image2D fit_g_hi;
 layout(binding = 5, rgba32f) uniform writeonly image2D fit_b_lo;
 layout(binding = 6, rgba32f) uniform writeonly image2D fit_b_hi;
-layout(binding = 7, rgba32f) uniform writeonly image2D fit_r_x;
-layout(binding = 8, rgba32f) uniform writeonly image2D fit_g_x;
-layout(binding = 9, rgba32f) uniform writeonly image2D fit_b_x;
 
 layout(push_constant) uniform OursPriorFitPush {
     uint width;   // of the image
@@ -88,7 +84,4 @@ void main() {
     imageStore(fit_g_hi, cell, vec4(beta[4].g, beta[5].g, beta[6].g, V));
     imageStore(fit_b_lo, cell, vec4(beta[0].b, beta[1].b, beta[2].b, beta[3].b));
     imageStore(fit_b_hi, cell, vec4(beta[4].b, beta[5].b, beta[6].b, V));
-    imageStore(fit_r_x, cell, vec4(beta[7].r, beta[8].r, beta[9].r, 0.0));
-    imageStore(fit_g_x, cell, vec4(beta[7].g, beta[8].g, beta[9].g, 0.0));
-    imageStore(fit_b_x, cell, vec4(beta[7].b, beta[8].b, beta[9].b, 0.0));
 }

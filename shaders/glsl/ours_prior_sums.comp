@@ -41,9 +41,8 @@ void main() {
             if (!all_finite(x)) continue;
             x = max(x, vec3(0.0));  // radiance: a shift may leave the state below zero
             vec4 lo = features_lo(imageLoad(footprint, q).rgb);
-            vec3 n = imageLoad(footprint_normal, q).xyz;
-            vec3 hi = features_hi(n), cx = features_x(n);
-            float f[D] = float[D](lo.x, lo.y, lo.z, lo.w, hi.x, hi.y, hi.z, cx.x, cx.y, cx.z);
+            vec3 hi = features_hi(imageLoad(footprint_normal, q).xyz);
+            float f[D] = float[D](lo.x, lo.y, lo.z, lo.w, hi.x, hi.y, hi.z);
             for (int i = 0; i < D; ++i) {
                 B[i] += f[i] * x;
                 for (int j = 0; j <= i; ++j) A[i][j] += f[i] * f[j];

@@ -10,11 +10,11 @@
 // Pixels between two fits' centres and the edge of the blocks their normal equations are
 // summed over (set by the engine, which sizes the grid: its `prior::PRIOR_STRIDE`). A
 // fit's window is the 3×3 blocks around its cell: 12×12 pixels hold 144 estimates for the
-// 10 coefficients of each channel.
+// 7 coefficients of each channel.
 layout(constant_id = 0) const int PRIOR_STRIDE = 4;
-// The model's features: 1, the guide albedo's r, g, b, the gradient normal's x, y, z and
-// its cross products xy, xz, yz, from the guides' footprint (ours_guide.comp).
-const int PRIOR_FEATURES = 10;
+// The model's features: 1, the guide albedo's r, g, b and the gradient normal's x, y, z,
+// from the guides' footprint (ours_guide.comp).
+const int PRIOR_FEATURES = 7;
 // The sums of a block (ours_prior_sums.comp), packed: the lower triangle of Σ f fᵀ, then
 // Σ f x (rgb per feature), then Σ x² (rgb).
 const int SUM_A = 0;
@@ -22,11 +22,10 @@ const int SUM_B = PRIOR_FEATURES * (PRIOR_FEATURES + 1) / 2;
 const int SUM_XX = SUM_B + 3 * PRIOR_FEATURES;
 const int PRIOR_SUM_TEXELS = (SUM_XX + 3 + 3) / 4;
 
-// The features of a pixel with footprint albedo a and normal n: the first four, the
-// normal's three, then its cross products.
+// The features of a pixel with footprint albedo a and normal n: the first four, then the
+// normal's three.
 vec4 features_lo(vec3 a) { return vec4(1.0, a); }
 vec3 features_hi(vec3 n) { return n; }
-vec3 features_x(vec3 n) { return vec3(n.x * n.y, n.x * n.z, n.y * n.z); }
 
 // Where there is no fit (no finite estimate in the window): V so large that the prior
 // leaves the pixels near the cell as they are.

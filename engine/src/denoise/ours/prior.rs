@@ -17,16 +17,15 @@ use ash::vk;
 pub const PRIOR_STRIDE: u32 = 4;
 
 /// The fits' images, as both shaders name them: per colour channel the coefficients of
-/// the first four features (1, the albedo's r, g, b), of the normal's three with the
-/// residuals' mean square V, and of the normal's cross products (xy, xz, yz).
-const FITS: [&str; 9] = [
-    "fit_r_lo", "fit_r_hi", "fit_r_x", "fit_g_lo", "fit_g_hi", "fit_g_x", "fit_b_lo", "fit_b_hi",
-    "fit_b_x",
+/// the first four features (1, the albedo's r, g, b), and of the normal's three with the
+/// residuals' mean square V.
+const FITS: [&str; 6] = [
+    "fit_r_lo", "fit_r_hi", "fit_g_lo", "fit_g_hi", "fit_b_lo", "fit_b_hi",
 ];
 
 /// The fit's features (`PRIOR_FEATURES` in include/ours_prior.glsl): 1, the albedo's r,
-/// g, b, the normal's x, y, z and its cross products xy, xz, yz.
-const PRIOR_FEATURES: u32 = 10;
+/// g, b, the normal's x, y, z.
+const PRIOR_FEATURES: u32 = 7;
 
 /// Texels (rgba32f) of one block's sums, `PRIOR_SUM_TEXELS` in include/ours_prior.glsl:
 /// the lower triangle of Σ f fᵀ, Σ f x per channel and Σ x² per channel, four to a texel.
@@ -196,6 +195,6 @@ mod tests {
         assert!(glsl.contains("const int PRIOR_SUM_TEXELS = (SUM_XX + 3 + 3) / 4;"));
         assert!(glsl.contains("const int SUM_B = PRIOR_FEATURES * (PRIOR_FEATURES + 1) / 2;"));
         assert!(glsl.contains("const int SUM_XX = SUM_B + 3 * PRIOR_FEATURES;"));
-        assert_eq!(SUM_TEXELS, 22);
+        assert_eq!(SUM_TEXELS, 13);
     }
 }
