@@ -748,6 +748,38 @@ def b_cut_cost():
     ])
 
 
+def b_experiments_prior():
+    """The experiments page's runs of ours' variants (prior features, gradient pools, seed
+    reuse): each run's mean PSNR and FLIP and its frames more than 1 dB below the best
+    single-frame method, against the same set's base."""
+    rivals = {"development": read_csv("experiments-prior", "rivals-development.csv"),
+              "validation": [r for r in read_csv("validation", "metrics.csv")
+                             if r["method"] in SINGLE_FRAME]}
+    base_val = [r for r in read_csv("validation", "metrics.csv") if r["method"] == "ours"]
+    runs = [("ours as on main", "validation", "main (2cb97d6 code)", base_val)]
+    runs += [(r["change"], r["set"], r["build"],
+              read_csv("experiments-prior", f"{r['run']}-{r['set']}.csv"))
+             for r in read_csv("experiments-prior", "runs.csv")]
+    body = []
+    for change, set_, build, rows in sorted(runs, key=lambda r: r[1]):
+        by_scene = {}
+        for r in rows:
+            by_scene.setdefault(r["scene"], []).append(num(r["psnr"]))
+        frames = frames_by_scene(rows + rivals[set_])
+        below = sum(below_best(f, SINGLE_FRAME)[0] for f in frames.values())
+        body.append([change, set_, build,
+                     fmt(mean(mean(v) for v in by_scene.values()), 3),
+                     fmt(mean(num(r["flip"]) for r in rows), 4), str(below)])
+    meta = read_json("experiments-prior", "meta.json")
+    return "\n".join([
+        table(["change", "set", "build", "PSNR", "FLIP", "frames > 1 dB below"], body),
+        "",
+        f"Source: `assets/results/experiments-prior/` (`runs.csv`, each run's CSV) and "
+        f"`assets/results/validation/metrics.csv`, made by `{meta['command']}` from "
+        f"commit {meta['commit']} ({meta['date']}) on {meta['machine']}.",
+    ])
+
+
 BLOCKS = {
     "headline": (b_headline, ["validation/summary.csv", "validation/meta.json"]),
     "suite-means": (b_suite_means, ["suite/summary.csv"]),
@@ -772,6 +804,8 @@ BLOCKS = {
     "cuts": (b_cuts, ["cuts/summary.csv", "cuts/metrics.csv"]),
     "cuts-line": (b_cuts_line, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json"]),
     "cut-cost": (b_cut_cost, ["cut-cost/profile.csv"]),
+    "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv",
+                                                "validation/metrics.csv"]),
 }
 
 
