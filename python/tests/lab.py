@@ -61,7 +61,8 @@ class Lab:
     def kernels(self):
         """The server's running kernels. jupyter_server lists a kernel it is still
         launching before that kernel has a `last_activity`, and answers the listing with a
-        500 (an AttributeError) until it has one: that answer is retried for 10 s."""
+        500 (a TraitError: `last_activity` is None) until it has one: that answer is
+        retried for 10 s."""
         deadline = time.monotonic() + 10
         while True:
             try:
