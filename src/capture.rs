@@ -43,6 +43,7 @@ pub fn capture(
         video::require_ffmpeg()?;
     }
     let denoisers = crate::setup::denoiser_list(denoisers)?;
+    crate::setup::warn_unused_overrides(&denoisers);
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut session = setup.session(&names)?;
@@ -241,6 +242,7 @@ pub fn run_profile(
     stop: Option<&profile::interrupt::Interrupt>,
 ) -> Result<(Profile, profile::Window)> {
     let denoisers = crate::setup::denoiser_list(denoisers)?;
+    crate::setup::warn_unused_overrides(&denoisers);
     let setup = Setup::new(args)?;
     let names: Vec<&str> = denoisers.iter().map(|s| s.as_str()).collect();
     let mut session = setup.session(&names)?;

@@ -54,6 +54,17 @@ pub fn open_scene(spec: &str) -> Result<Scene> {
 }
 
 /// The methods a `--denoiser` list names: trimmed, each once, each one dvr has.
+/// Warns once for each parameter override in the environment (`DVR_OURS`, …) that none
+/// of `running` reads. Each command says it once, for the methods the user asked for:
+/// not the engine's sessions, of which a command may open several (an eval's reference
+/// sessions run no denoiser, and would warn about an override the run does use).
+pub fn warn_unused_overrides<S: AsRef<str>>(running: &[S]) {
+    let running: Vec<&str> = running.iter().map(AsRef::as_ref).collect();
+    for warning in dvr_engine::denoise::unused_overrides(&running) {
+        log::warn!("{warning}");
+    }
+}
+
 pub fn denoiser_list(names: &[String]) -> Result<Vec<String>> {
     let mut methods: Vec<String> = Vec::new();
     for d in names {

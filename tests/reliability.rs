@@ -474,4 +474,26 @@ fn overrides_of_methods_that_do_not_run_are_warnings_naming_them() {
     );
     assert_status(&o, 0);
     assert!(!stderr(&o).contains("is set but"), "{}", stderr(&o));
+
+    // An eval renders its references in sessions of their own, which run no denoiser:
+    // the run speaks for the methods it was asked for, once, not for each session.
+    let eval_dir = dir.path().join("eval");
+    for (method, warnings) in [("ours", 0), ("taa", 1)] {
+        let mut eval_args = tiny_eval(&eval_dir);
+        eval_args[12] = method;
+        let o = wait_within(
+            spawn(&eval_args, &[("DVR_OURS", "lag_z=3")]),
+            std::time::Duration::from_secs(300),
+        );
+        assert_status(&o, 0);
+        let err = stderr(&o);
+        assert_eq!(
+            err.matches("DVR_OURS is set but").count(),
+            warnings,
+            "{method}: {err}"
+        );
+        if warnings > 0 {
+            assert!(err.contains(&format!("running: {method}")), "{err}");
+        }
+    }
 }

@@ -61,6 +61,7 @@ pub fn eval(args: &EvalArgs) -> Result<timing::Outcome> {
     // Fail before hours of rendering, not after: the plots need a font, videos ffmpeg,
     // and a parameter override must be in range.
     dvr_engine::denoise::check_env_overrides()?;
+    crate::setup::warn_unused_overrides(&methods);
     let names = scenes::select(&args.scene)?;
     let plan = Plan::new(args, &names, &methods)?;
     let timing = timing::Timing::shared();

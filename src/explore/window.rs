@@ -92,7 +92,9 @@ impl Explorer {
             .setup
             .take()
             .context("the window opened twice (the session is made once)")?;
-        let session = Session::new(setup, Arc::clone(&ctx), &self.denoiser_list())?;
+        let denoisers = self.denoiser_list();
+        crate::setup::warn_unused_overrides(&denoisers);
+        let session = Session::new(setup, Arc::clone(&ctx), &denoisers)?;
         self.ui.max_spp = session.renderer()?.samples_per_dispatch();
         self.ui.stats.device = ctx.info.name.clone();
         self.ui.stats.present_mode = format!("{:?}", swapchain.present_mode);

@@ -116,10 +116,6 @@ impl Session {
     ) -> Result<Self> {
         let ctx = ctx.into();
         let denoisers = registry_names(denoisers)?;
-        let running: Vec<&str> = denoisers.iter().map(String::as_str).collect();
-        for warning in crate::denoise::unused_overrides(&running) {
-            log::warn!("{warning}");
-        }
         let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
         let renderer = setup.renderer(Arc::clone(&ctx), &names)?;
         let view = setup.scene.view_at(0);
