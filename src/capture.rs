@@ -127,6 +127,8 @@ pub fn reference(
              (--spp is the noisy input's samples per frame and does not change a reference)"
         );
     }
+    // A reference runs no denoiser: an override set for one does nothing here.
+    crate::setup::warn_unused_overrides(&["none"]);
     let setup = Setup::new(args)?;
     let frames = crate::setup::select_frames(setup.frames, frame_range, shard.shard)?;
     let key = ReferenceKey::new(setup.scene(), args.size, spp, args.render.volume_size)?;

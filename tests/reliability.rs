@@ -496,4 +496,32 @@ fn overrides_of_methods_that_do_not_run_are_warnings_naming_them() {
             assert!(err.contains(&format!("running: {method}")), "{err}");
         }
     }
+    // `dvr reference` runs no denoiser: said once.
+    let reference_dir = dir.path().join("reference");
+    let reference_args = [
+        "reference",
+        "--scene",
+        "cloud/orbit",
+        "--volume-size",
+        "16",
+        "--frames",
+        "1",
+        "--size",
+        "8x8",
+        "--ref-spp",
+        "4",
+        "--out",
+        reference_dir.to_str().expect("utf-8 path"),
+    ];
+    let o = wait_within(
+        spawn(&reference_args, &[("DVR_OURS", "lag_z=3")]),
+        std::time::Duration::from_secs(120),
+    );
+    assert_status(&o, 0);
+    assert_eq!(
+        stderr(&o).matches("DVR_OURS is set but").count(),
+        1,
+        "{}",
+        stderr(&o)
+    );
 }
