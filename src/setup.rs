@@ -53,7 +53,6 @@ pub fn open_scene(spec: &str) -> Result<Scene> {
     Scene::open(spec).with_context(|| format!("opening scene {spec:?}"))
 }
 
-/// The methods a `--denoiser` list names: trimmed, each once, each one dvr has.
 /// Warns once for each parameter override in the environment (`DVR_OURS`, …) that none
 /// of `running` reads. Each command says it once, for the methods the user asked for:
 /// not the engine's sessions, of which a command may open several (an eval's reference
@@ -65,6 +64,7 @@ pub fn warn_unused_overrides<S: AsRef<str>>(running: &[S]) {
     }
 }
 
+/// The methods a `--denoiser` list names: trimmed, each once, each one dvr has.
 pub fn denoiser_list(names: &[String]) -> Result<Vec<String>> {
     let mut methods: Vec<String> = Vec::new();
     for d in names {

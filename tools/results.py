@@ -792,12 +792,15 @@ def b_experiments_strata():
     on main: the runs' scores, then the profiles (two runs of each, alternated): ours'
     cost with its features, svgf's, their ratio, the gradient pass and ours' bytes per
     pixel per frame, each the mean of the runs."""
+    def method(d, m):
+        return next(x for x in d["methods"] if x["method"] == m)
+
+    def gradient(d):
+        return next(x["mean_ms"] for x in d["passes"] if x["pass"] == "ours.gradient")
+
     body = []
     for r in read_csv("experiments-strata", "profiles.csv"):
         runs = [read_json("experiments-strata", f) for f in r["files"].split()]
-        method = lambda d, m: next(x for x in d["methods"] if x["method"] == m)
-        gradient = lambda d: next(x["mean_ms"] for x in d["passes"]
-                                  if x["pass"] == "ours.gradient")
         ours = mean(method(d, "ours")["cost_ms"] for d in runs)
         svgf = mean(method(d, "svgf")["cost_ms"] for d in runs)
         body.append([r["change"], runs[0]["scene"], str(len(runs)),
