@@ -40,13 +40,9 @@ fn two_blobs() -> VolumeUpload {
             }
         }
     }
-    VolumeUpload::from_volume(&Volume {
-        name: "two-blobs".into(),
-        dims: [N; 3],
-        spacing: [1.0; 3],
-        window: [0.0, 1.0],
-        data: VolumeData::U8(data),
-    })
+    VolumeUpload::from_volume(
+        &Volume::new("two-blobs", [N; 3], [1.0; 3], VolumeData::U8(data)).expect("valid volume"),
+    )
 }
 
 /// Opaque, white, above `threshold`; transparent below.

@@ -6,11 +6,8 @@
 //! explorer, the scripted animations and Python drive). CPU-side data (`volume`, `transfer`, `scene`, `metrics`) feeds
 //! them; `assets` says where the shipped files are.
 
-pub mod assets;
-pub mod bytes;
 pub mod denoise;
 pub mod error;
-pub mod files;
 pub mod gpu;
 pub mod graph;
 pub mod image_io;
@@ -21,6 +18,10 @@ pub mod scene;
 pub mod session;
 pub mod shaders;
 pub mod transfer;
-pub mod volume;
 
 pub use error::{EngineError, Result};
+
+// The GPU-free layers, crates of their own that the engine re-exports under the names
+// the applications use.
+pub use dvr_volume as volume;
+pub use dvr_volume::{assets, bytes, files};

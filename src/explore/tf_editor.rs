@@ -274,6 +274,7 @@ mod tests {
     fn tf() -> TransferFunction {
         TransferFunction {
             name: "t".into(),
+            units: Default::default(),
             points: vec![
                 ControlPoint::new(0.2, 0.0, [1.0, 0.0, 0.0]),
                 ControlPoint::new(0.5, 0.5, [0.0, 1.0, 0.0]),

@@ -47,6 +47,7 @@ pub fn constant_volume(n: u32, d: f32) -> VolumeUpload {
         bytes: vec![v; (n * n * n) as usize],
         blocks: None,
         world_size: [1.0, 1.0, 1.0],
+        window: [0.0, 1.0],
         bricks: BrickRanges {
             brick: n,
             grid: [1, 1, 1],

@@ -460,6 +460,7 @@ mod tests {
             bytes: bytes.clone(),
             blocks: None,
             world_size: [1.0; 3],
+            window: [0.0, 1.0],
             bricks: BrickRanges {
                 brick: 8,
                 grid: [5, 1, 1],

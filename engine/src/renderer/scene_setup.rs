@@ -73,11 +73,15 @@ impl SceneSetup {
     }
 
     fn with_upload(
-        scene: Scene,
+        mut scene: Scene,
         volume: VolumeUpload,
         size: Extent,
         spp: Option<u32>,
     ) -> Result<Self, SetupError> {
+        // TFs written in data units (Hounsfield…) meet the volume here, once: everything
+        // after this works in normalised density.
+        scene.tf_a = scene.tf_a.in_density(volume.window);
+        scene.tf_b = scene.tf_b.map(|b| b.in_density(volume.window));
         let mut settings = scene.render;
         if let Some(spp) = spp {
             settings.set_spp(spp)?;

@@ -56,6 +56,8 @@ pub struct VolumeUpload {
     pub blocks: Option<Arc<dyn VoxelBlocks>>,
     /// World-space size of the box (the volume is centred at the origin).
     pub world_size: [f32; 3],
+    /// The physical values at density 0 and 1: what a data-unit TF is mapped through.
+    pub window: [f32; 2],
     pub bricks: BrickRanges,
 }
 
@@ -82,6 +84,7 @@ impl VolumeUpload {
             bytes: v.data.as_bytes().to_vec(),
             blocks: None,
             world_size: extent.map(|e| e / longest),
+            window: v.window,
             bricks: BrickRanges {
                 brick: grid.brick,
                 grid: grid.dims,
@@ -105,6 +108,7 @@ impl VolumeUpload {
             format: VolumeFormat::R16,
             bytes: Vec::new(),
             world_size: dims.map(|d| d as f32 / longest),
+            window: [0.0, 1.0],
             bricks: BrickRanges {
                 brick: Self::BRICK,
                 grid: dims.map(|d| d.div_ceil(Self::BRICK)),

@@ -202,11 +202,14 @@ impl Session {
                 check_light_list(&lights, self.settings().emission(), EDIT_ORIGIN)?;
                 return self.set_lights(lights);
             }
-            Edit::Tf(tf) => {
+            Edit::Tf(mut tf) => {
                 tf.a.validate().map_err(|e| tf_error("transfer.a", e))?;
                 if let Some(b) = &tf.b {
                     b.validate().map_err(|e| tf_error("transfer.b", e))?;
                 }
+                let window = self.setup.volume.window;
+                tf.a = tf.a.in_density(window);
+                tf.b = tf.b.map(|b| b.in_density(window));
                 self.set_tf(tf);
             }
             Edit::Cut(cut) => {

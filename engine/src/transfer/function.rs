@@ -18,6 +18,22 @@ pub struct TransferFunction {
     pub name: String,
     /// Sorted by density, at least two, densities strictly increasing.
     pub points: Vec<ControlPoint>,
+    /// What the points' `density` means: the normalised density, or the volume's data
+    /// units (Hounsfield for CT), converted when the TF meets a volume
+    /// ([`Self::in_density`]).
+    pub units: TfUnits,
+}
+
+/// The units of a TF's densities (`units = "density"` or `"data"` in its file).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TfUnits {
+    /// The volume's normalised density, `[0, 1]` over its window.
+    #[default]
+    Density,
+    /// The volume's physical values: Hounsfield units for CT (from the rescale slope
+    /// and intercept), the stored values otherwise.
+    Data,
 }
 
 /// The TOML layout of one TF file.
@@ -25,6 +41,8 @@ pub struct TransferFunction {
 #[serde(deny_unknown_fields)]
 struct TfFile {
     name: Option<String>,
+    #[serde(default)]
+    units: TfUnits,
     #[serde(default, rename = "point")]
     points: Vec<ControlPoint>,
 }
@@ -62,7 +80,7 @@ impl TransferFunction {
             });
         }
         for (index, p) in file.points.iter().enumerate() {
-            check_point(origin, index, p)?;
+            check_point(origin, index, p, file.units)?;
         }
         // Sort, remembering each point's index in the file for the duplicate message.
         let mut indexed: Vec<(usize, ControlPoint)> = file.points.into_iter().enumerate().collect();
@@ -81,6 +99,7 @@ impl TransferFunction {
         Ok(Self {
             name,
             points: indexed.into_iter().map(|(_, p)| p).collect(),
+            units: file.units,
         })
     }
 
@@ -95,7 +114,7 @@ impl TransferFunction {
             });
         }
         for (index, p) in self.points.iter().enumerate() {
-            check_point(origin, index, p)?;
+            check_point(origin, index, p, self.units)?;
         }
         for (index, w) in self.points.windows(2).enumerate() {
             // `!(a < b)` rather than `a >= b`: also rejects NaN (already caught above).
@@ -167,6 +186,43 @@ impl TransferFunction {
         Self {
             name: format!("{}..{}@{t}", a.name, b.name),
             points,
+            units: a.units,
+        }
+    }
+
+    /// The TF over normalised density for a volume whose `window` (physical values at
+    /// density 0 and 1) is given: a data-unit TF's points are mapped through the window
+    /// and cut to `[0, 1]` (the TF's values at the cuts become end points); a density TF
+    /// is returned as it is.
+    pub fn in_density(&self, window: [f32; 2]) -> Self {
+        if self.units == TfUnits::Density {
+            return self.clone();
+        }
+        let [lo, hi] = window;
+        let span = if hi > lo { hi - lo } else { 1.0 };
+        let to_data = |d: f32| lo + d * span;
+        let mut points: Vec<ControlPoint> = self
+            .points
+            .iter()
+            .map(|p| ControlPoint {
+                density: (p.density - lo) / span,
+                ..*p
+            })
+            .filter(|p| p.density > 0.0 && p.density < 1.0)
+            .collect();
+        for (end, at) in [(0.0f32, 0usize), (1.0, usize::MAX)] {
+            let mut p = self.sample(to_data(end));
+            p.density = end;
+            if at == 0 {
+                points.insert(0, p);
+            } else {
+                points.push(p);
+            }
+        }
+        Self {
+            name: self.name.clone(),
+            points,
+            units: TfUnits::Density,
         }
     }
 
@@ -177,6 +233,9 @@ impl TransferFunction {
         let v3 = |c: [f32; 3]| format!("[{:?}, {:?}, {:?}]", c[0], c[1], c[2]);
         // `write!` to a String cannot fail.
         let _ = writeln!(s, "name = {}", toml_string(&self.name));
+        if self.units == TfUnits::Data {
+            let _ = writeln!(s, "units = \"data\"");
+        }
         for p in &self.points {
             let _ = writeln!(s, "\n[[point]]");
             let _ = writeln!(s, "density = {:?}", p.density);
@@ -190,14 +249,27 @@ impl TransferFunction {
     }
 }
 
-fn check_point(origin: &str, index: usize, p: &ControlPoint) -> Result<(), TransferError> {
-    p.check()
-        .map_err(|(field, message)| TransferError::InvalidPoint {
-            origin: origin.to_string(),
-            index,
-            field,
-            message,
-        })
+fn check_point(
+    origin: &str,
+    index: usize,
+    p: &ControlPoint,
+    units: TfUnits,
+) -> Result<(), TransferError> {
+    let checked = match units {
+        TfUnits::Density => p.check(),
+        // Data units may be any finite value (HU run from -1024 to several thousand).
+        TfUnits::Data if !p.density.is_finite() => Err((
+            "density",
+            format!("{} is not a finite data value", p.density),
+        )),
+        TfUnits::Data => ControlPoint { density: 0.5, ..*p }.check(),
+    };
+    checked.map_err(|(field, message)| TransferError::InvalidPoint {
+        origin: origin.to_string(),
+        index,
+        field,
+        message,
+    })
 }
 
 /// A TOML basic string (quotes and escapes) for any text.

@@ -140,6 +140,7 @@ mod tests {
     fn tf(opacity_at_1: f32, colour: [f32; 3]) -> TransferFunction {
         TransferFunction {
             name: "t".into(),
+            units: Default::default(),
             points: vec![
                 ControlPoint::new(0.0, 0.0, colour),
                 ControlPoint::new(1.0, opacity_at_1, colour),
@@ -164,6 +165,7 @@ mod tests {
     fn shifting_slides_the_table_along_density() {
         let ramp = TransferFunction {
             name: "ramp".into(),
+            units: Default::default(),
             points: vec![
                 ControlPoint::new(0.0, 0.0, [1.0; 3]),
                 ControlPoint::new(0.5, 0.0, [1.0; 3]),

@@ -55,5 +55,5 @@ pub mod preset;
 
 pub use control_point::ControlPoint;
 pub use error::TransferError;
-pub use function::TransferFunction;
+pub use function::{TfUnits, TransferFunction};
 pub use lut::{TfLut, LUT_SIZE};

@@ -54,7 +54,7 @@ mod tests {
     use crate::transfer::LUT_SIZE;
 
     /// The presets the built-in scenes and the docs rely on.
-    const REQUIRED: [&str; 10] = [
+    const REQUIRED: [&str; 15] = [
         "phantom-opaque",
         "phantom-opaque-edit",
         "phantom-layered",
@@ -65,7 +65,15 @@ mod tests {
         "mri-layered-edit",
         "cloud",
         "cloud-edit",
+        "ct-bone",
+        "ct-soft-tissue",
+        "ct-angio",
+        "ct-lung",
+        "ct-skin",
     ];
+
+    /// A 12-bit CT's Hounsfield range: where the data-unit presets are looked at.
+    const CT_WINDOW: [f32; 2] = [-1024.0, 3071.0];
 
     #[test]
     fn all_presets_load_and_are_valid() {
@@ -80,7 +88,7 @@ mod tests {
             let tf = TransferFunction::preset(name).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(&tf.name, name, "preset name must match its file");
             tf.validate().unwrap_or_else(|e| panic!("{e}"));
-            let lut = tf.lut();
+            let lut = tf.in_density(CT_WINDOW).lut();
             assert_eq!(lut.len(), LUT_SIZE);
             assert!(lut.max_opacity() > 0.0, "{name} is invisible");
             // Air (density 0) is transparent in every preset.
@@ -92,8 +100,9 @@ mod tests {
     fn edits_differ_from_their_originals() {
         for r in REQUIRED.iter().filter(|r| r.ends_with("-edit")) {
             let base = r.trim_end_matches("-edit");
-            let a = TransferFunction::preset(base).expect("base preset").lut();
-            let b = TransferFunction::preset(r).expect("edit preset").lut();
+            let a = TransferFunction::preset(base).expect("base preset");
+            let b = TransferFunction::preset(r).expect("edit preset");
+            let (a, b) = (a.in_density(CT_WINDOW).lut(), b.in_density(CT_WINDOW).lut());
             assert!(a.max_abs_diff(&b) > 0.1, "{r} barely changes {base}");
         }
     }

@@ -87,6 +87,7 @@ fn lerp_blends_the_functions() {
     let a = two();
     let b = TransferFunction {
         name: "b".into(),
+        units: Default::default(),
         points: vec![
             ControlPoint::new(0.0, 1.0, [1.0, 1.0, 1.0]),
             ControlPoint::new(0.5, 0.0, [0.0, 0.0, 0.0]),
@@ -168,4 +169,55 @@ fn to_toml_round_trips() {
     tf.points[2].specular = [0.3, 0.3, 0.3];
     let back = TransferFunction::from_toml_str(&tf.to_toml(), "rt.toml").expect("round trip");
     assert_eq!(back, tf);
+}
+
+#[test]
+fn a_ct_preset_in_hounsfield_units_shows_bone_on_ct_windows_of_any_range() {
+    let bone = TransferFunction::preset("ct-bone").expect("ct-bone preset");
+    assert_eq!(bone.units, TfUnits::Data);
+    // Two CTs: one windowed to its data [-1000, 1200] HU, one with metal to 3000 HU.
+    for window in [[-1000.0f32, 1200.0], [-1024.0, 3000.0]] {
+        let tf = bone.in_density(window);
+        tf.validate().expect("converted TF is a density TF");
+        assert_eq!(tf.units, TfUnits::Density);
+        let at = |hu: f32| {
+            tf.sample((hu - window[0]) / (window[1] - window[0]))
+                .opacity
+        };
+        assert_eq!(at(1000.0), 1.0, "cortical bone opaque at window {window:?}");
+        assert_eq!(at(40.0), 0.0, "soft tissue empty at window {window:?}");
+        assert_eq!(at(-1000.0), 0.0, "air empty at window {window:?}");
+        assert!((at(275.0) - 0.5).abs() < 1e-3, "half way up the ramp");
+    }
+    // The same preset read as a density TF would show nothing of that bone on the
+    // wider window: the units are what make it fit.
+    let naive = TransferFunction {
+        units: TfUnits::Density,
+        ..bone.clone()
+    };
+    assert!(
+        naive.validate().is_err(),
+        "HU densities are no normalised densities"
+    );
+}
+
+#[test]
+fn data_units_round_trip_through_toml_and_need_finite_values() {
+    let text = "units = \"data\"\n[[point]]\ndensity = -1000\nopacity = 0\ndiffuse = [1, 1, 1]\n\
+                [[point]]\ndensity = 2000\nopacity = 1\ndiffuse = [1, 1, 1]\n";
+    let tf = TransferFunction::from_toml_str(text, "hu.toml").expect("data TF");
+    assert_eq!(tf.units, TfUnits::Data);
+    let back = TransferFunction::from_toml_str(&tf.to_toml(), "hu.toml").expect("round trip");
+    assert_eq!(back, tf);
+    let bad = text.replace("density = 2000", "density = nan");
+    let err = TransferFunction::from_toml_str(&bad, "hu.toml").unwrap_err();
+    assert!(err.to_string().contains("density"), "{err}");
+    let err = TransferFunction::from_toml_str("units = \"hounsfield\"\n", "u.toml").unwrap_err();
+    assert!(err.to_string().contains("u.toml"), "{err}");
+    // Cut to the window: the ends take the TF's values there.
+    let d = tf.in_density([0.0, 1000.0]);
+    assert_eq!(d.points.first().map(|p| p.density), Some(0.0));
+    let last = d.points.last().expect("points");
+    assert_eq!(last.density, 1.0);
+    assert!((last.opacity - 2.0 / 3.0).abs() < 1e-6, "{}", last.opacity);
 }

@@ -1,8 +1,8 @@
 //! Tests of `nrrd.rs`.
 
 use super::*;
-use crate::volume::write::{self, NrrdData};
-use crate::volume::VolumeData;
+use crate::write::{self, NrrdData};
+use crate::VolumeData;
 
 fn ramp_i16() -> Vec<i16> {
     (0..60).map(|i| i as i16 * 50 - 1000).collect()
@@ -54,8 +54,17 @@ fn detached_header_round_trips_with_space_directions() {
     let v = Volume::load(&path, None).expect("nhdr");
     assert_eq!(v.dims, [2, 3, 4]);
     assert_eq!(v.spacing, [1.0, 2.0, 3.0]);
-    // 0..230 is most of u8: untouched.
-    assert_eq!(v.data, VolumeData::U8(values));
+    // 0..230 is most of u8: untouched, but the header's space is LPS, so in RAS order
+    // x and y run backwards.
+    let ras: Vec<u8> = (0..4)
+        .flat_map(|z| {
+            (0..3)
+                .rev()
+                .flat_map(move |y| (0..2).rev().map(move |x| x + 2 * y + 6 * z))
+        })
+        .map(|i| values[i])
+        .collect();
+    assert_eq!(v.data, VolumeData::U8(ras));
 }
 
 #[test]
@@ -229,7 +238,7 @@ fn detached_data_that_is_a_device_fifo_or_missing_is_refused_at_once() {
     };
     // Used to read /dev/zero until memory ran out (3 GB in 2.5 s).
     let p = header("zero.nhdr", Some("/dev/zero"));
-    let err = crate::volume::load_within_seconds(&p, 5).unwrap_err();
+    let err = crate::load_within_seconds(&p, 5).unwrap_err();
     let msg = err.to_string();
     assert!(
         msg.contains("zero.nhdr") && msg.contains("/dev/zero is a character device"),
@@ -237,9 +246,9 @@ fn detached_data_that_is_a_device_fifo_or_missing_is_refused_at_once() {
     );
     // Used to block forever opening the FIFO.
     let fifo = dir.path().join("pipe.raw");
-    if crate::volume::make_fifo(&fifo) {
+    if crate::make_fifo(&fifo) {
         let p = header("fifo.nhdr", Some("pipe.raw"));
-        let err = crate::volume::load_within_seconds(&p, 5).unwrap_err();
+        let err = crate::load_within_seconds(&p, 5).unwrap_err();
         assert!(err.to_string().contains("FIFO"), "{err}");
     }
     // Used to say "truncated: ... found 0".

@@ -1,9 +1,9 @@
 //! Tests of `raw.rs`.
 
 use super::*;
-use crate::volume::write;
-use crate::volume::VolumeData;
-use crate::volume::{MAX_SPACING_MM, MIN_SPACING_MM};
+use crate::write;
+use crate::VolumeData;
+use crate::{MAX_SPACING_MM, MIN_SPACING_MM};
 
 #[test]
 fn round_trips_with_params_and_sidecars() {

@@ -200,7 +200,7 @@ pub(crate) fn generate(n: u32) -> Vec<u16> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::volume::{Volume, VolumeData};
+    use crate::{Volume, VolumeData};
 
     #[test]
     fn phantom_is_deterministic_and_has_its_tissue_classes() {

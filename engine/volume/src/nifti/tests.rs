@@ -1,8 +1,8 @@
 //! Tests of `nifti.rs`.
 
 use super::*;
-use crate::volume::write::{self, NiftiData};
-use crate::volume::VolumeData;
+use crate::write::{self, NiftiData};
+use crate::VolumeData;
 
 #[test]
 fn nii_and_nii_gz_round_trip() {
@@ -112,10 +112,10 @@ fn bad_files_are_rejected_by_name() {
     });
     assert!(matches!(err, VolumeError::BadDims { .. }), "{err}");
     let err = variant("dt.nii", &|b| {
-        b[70..72].copy_from_slice(&64i16.to_le_bytes())
+        b[70..72].copy_from_slice(&8i16.to_le_bytes())
     });
     assert!(matches!(err, VolumeError::UnsupportedType { .. }), "{err}");
-    assert!(err.to_string().contains("float64"));
+    assert!(err.to_string().contains("int32") && err.to_string().contains("float64"));
     let err = variant("magic.nii", &|b| b[344..348].copy_from_slice(b"xyz\0"));
     assert!(
         matches!(&err, VolumeError::MalformedHeader { field, .. } if field == "magic"),
@@ -158,7 +158,7 @@ fn header_is_checked_before_the_data_is_read() {
         .open(&path)
         .expect("open");
     f.set_len(8 << 30).expect("sparse file");
-    let err = crate::volume::load_within_seconds(&path, 5).unwrap_err();
+    let err = crate::load_within_seconds(&path, 5).unwrap_err();
     assert!(matches!(err, VolumeError::Unsupported { .. }), "{err}");
     assert!(err.to_string().contains("4D NIfTI"), "{err}");
 }
@@ -242,4 +242,28 @@ fn nan_in_float_nifti_is_rejected() {
         "{err}"
     );
     assert!(err.to_string().contains("nan.nii.gz"));
+}
+
+#[test]
+fn float64_loads_as_float32_and_reports_its_type() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("f64.nii");
+    write::nifti(
+        &path,
+        [2, 1, 1],
+        [1.0; 3],
+        &NiftiData::F32(vec![0.0, 0.0]),
+        None,
+    );
+    let mut b = std::fs::read(&path).expect("read back");
+    b[70..72].copy_from_slice(&64i16.to_le_bytes());
+    b[72..74].copy_from_slice(&64i16.to_le_bytes());
+    b.truncate(352);
+    for x in [0.25f64, 0.75] {
+        b.extend_from_slice(&x.to_le_bytes());
+    }
+    std::fs::write(&path, b).expect("rewrite");
+    let v = Volume::load(&path, None).expect("float64");
+    assert_eq!(v.data, VolumeData::F32(vec![0.25, 0.75]));
+    assert_eq!(v.sample_kind, crate::SampleKind::F32);
 }

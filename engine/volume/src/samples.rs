@@ -6,13 +6,15 @@
 //! Keeping that step separate lets [`super::normalise`] apply one windowing rule to all
 //! formats.
 
-/// The sample types the loaders read.
+/// The sample types the loaders read. float64 is held as float32 once decoded (a
+/// renderer's density needs no more), so it never names a volume's samples.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum SampleKind {
+pub enum SampleKind {
     U8,
     U16,
     I16,
     F32,
+    F64,
 }
 
 impl SampleKind {
@@ -22,16 +24,18 @@ impl SampleKind {
             SampleKind::U8 => 1,
             SampleKind::U16 | SampleKind::I16 => 2,
             SampleKind::F32 => 4,
+            SampleKind::F64 => 8,
         }
     }
 
-    /// A short name for messages.
-    pub(crate) fn name(self) -> &'static str {
+    /// Its numpy name (also what messages say).
+    pub fn name(self) -> &'static str {
         match self {
             SampleKind::U8 => "uint8",
             SampleKind::U16 => "uint16",
             SampleKind::I16 => "int16",
             SampleKind::F32 => "float32",
+            SampleKind::F64 => "float64",
         }
     }
 
@@ -41,7 +45,7 @@ impl SampleKind {
             SampleKind::U8 => Some((0.0, 255.0)),
             SampleKind::U16 => Some((0.0, 65535.0)),
             SampleKind::I16 => Some((-32768.0, 32767.0)),
-            SampleKind::F32 => None,
+            SampleKind::F32 | SampleKind::F64 => None,
         }
     }
 }
@@ -92,6 +96,19 @@ impl Samples {
             } else {
                 pairs(&bytes).map(i16::from_le_bytes).collect()
             }),
+            SampleKind::F64 => {
+                let eights = bytes.chunks_exact(8).map(|c| {
+                    let mut b = [0u8; 8];
+                    b.copy_from_slice(c);
+                    b
+                });
+                // Out of f32's range becomes ±inf, which normalisation refuses by name.
+                Samples::F32(if big_endian {
+                    eights.map(|b| f64::from_be_bytes(b) as f32).collect()
+                } else {
+                    eights.map(|b| f64::from_le_bytes(b) as f32).collect()
+                })
+            }
             SampleKind::F32 => {
                 let quads = bytes.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]);
                 Samples::F32(if big_endian {
@@ -154,6 +171,9 @@ pub(crate) struct Stored {
     /// `BitsStored` is 12); `None` for float data.
     pub type_range: Option<(f64, f64)>,
     pub rescale: Rescale,
+    /// Index to patient space as the file states it; `None` for formats with no
+    /// orientation (the index axes are taken as R, A, S).
+    pub orientation: Option<crate::PatientTransform>,
 }
 
 impl Stored {
@@ -163,6 +183,7 @@ impl Stored {
             type_range: samples.kind().full_range(),
             samples,
             rescale: Rescale::Uniform(Affine::IDENTITY),
+            orientation: None,
         }
     }
 }

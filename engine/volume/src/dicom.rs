@@ -17,13 +17,15 @@
 //! Slices are sorted by their position along the slice normal (the cross product of the
 //! orientation's row and column directions); when a slice lacks position or orientation
 //! the series falls back to `InstanceNumber` order and `SpacingBetweenSlices` or
-//! `SliceThickness` for the slice distance. x runs along columns, y along rows.
+//! `SliceThickness` for the slice distance. x runs along columns, y along rows in the
+//! file; the orientation and the sorted positions (LPS) then put the volume in RAS order
+//! (`orientation.rs`), so an axial series is mirrored in x and y against its file order.
 
 use std::path::{Path, PathBuf};
 
 use super::error::VolumeError;
 use super::samples::{Affine, Rescale, SampleKind, Samples, Stored};
-use super::{io, validate_dims, validate_spacing, Volume};
+use super::{io, validate_dims, validate_spacing, PatientTransform, Volume};
 
 const IMPLICIT_LE: &str = "1.2.840.10008.1.2";
 const EXPLICIT_LE: &str = "1.2.840.10008.1.2.1";
@@ -244,8 +246,38 @@ pub(crate) fn load_files(series_path: &Path, files: Vec<PathBuf>) -> Result<Volu
         samples,
         type_range: Some(type_range),
         rescale,
+        orientation: patient_transform(&slices, spacing),
     };
     Volume::from_stored(series_path, name, dims, spacing, stored)
+}
+
+/// The series' index-to-patient transform from ImageOrientationPatient and the sorted
+/// slices' ImagePositionPatient (DICOM's LPS, converted to RAS); `None` when a slice
+/// lacks them (the index axes are then taken as R, A, S).
+fn patient_transform(slices: &[Slice], spacing: [f32; 3]) -> Option<PatientTransform> {
+    let first = slices.first()?;
+    let o = first.orientation?;
+    let p0 = first.position?;
+    if slices.iter().any(|s| s.position.is_none()) {
+        return None;
+    }
+    let [dx, dy, dz] = spacing.map(f64::from);
+    let row = [o[0] * dx, o[1] * dx, o[2] * dx];
+    let col = [o[3] * dy, o[4] * dy, o[5] * dy];
+    // The slice step: from the first slice to the last, as sorted (its length is the
+    // mean gap); one slice: the normal at the slice distance.
+    let step = match slices.last().and_then(|s| s.position) {
+        Some(pn) if slices.len() > 1 => {
+            let n = (slices.len() - 1) as f64;
+            [0, 1, 2].map(|i| (pn[i] - p0[i]) / n)
+        }
+        _ => [
+            (o[1] * o[5] - o[2] * o[4]) * dz,
+            (o[2] * o[3] - o[0] * o[5]) * dz,
+            (o[0] * o[4] - o[1] * o[3]) * dz,
+        ],
+    };
+    Some(PatientTransform::from_lps([row, col, step], p0))
 }
 
 /// A slice gap further than this fraction from the mean spacing is an error.

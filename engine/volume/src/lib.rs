@@ -1,5 +1,7 @@
 //! Density volumes on the CPU: loading, procedural datasets, normalisation and the
-//! majorant grid.
+//! majorant grid. No GPU: this crate builds and tests without a Vulkan loader, and the
+//! engine re-exports it as `dvr_engine::volume` (with `files`, `bytes` and `assets`, the
+//! input/output rules and the shipped files every layer above uses).
 //!
 //! The path tracer samples one scalar density per voxel from a 3D texture (R8/R16 unorm or
 //! R32F) and indexes its transfer functions by that value. This module produces exactly
@@ -8,6 +10,8 @@
 //! GPU layer uploads [`VolumeData::as_bytes`] as is.
 //!
 //! # Sources
+//!
+//! Formats are rows of one table (`formats.rs`: name endings, magic bytes, folder probes).
 //!
 //! | source | how | file |
 //! | --- | --- | --- |
@@ -44,17 +48,22 @@
 //! GPUs this engine targets; Vulkan itself guarantees only 256 (`maxImageDimension3D`),
 //! so the GPU layer still checks the device's limit before uploading.
 
+pub mod assets;
 pub mod blocks;
 mod builtin;
+pub mod bytes;
 mod cloud;
 mod dicom;
 mod error;
+pub mod files;
+mod formats;
 mod io;
 mod majorant;
 mod nifti;
 mod normalise;
 mod nrrd;
 mod ome_tiff;
+mod orientation;
 mod phantom;
 mod procedural;
 mod raw;
@@ -69,7 +78,9 @@ use std::path::Path;
 pub use builtin::BUILTIN_NAMES;
 pub use error::VolumeError;
 pub use majorant::MajorantGrid;
+pub use orientation::PatientTransform;
 pub use raw::{RawFormat, RawParams};
+pub use samples::SampleKind;
 
 use samples::{Samples, Stored};
 
@@ -87,8 +98,15 @@ pub struct Volume {
     pub dims: [u32; 3],
     /// Voxel size in mm along x, y, z.
     pub spacing: [f32; 3],
+    /// Where the voxels lie in patient space (RAS+, mm). The voxels are stored in RAS
+    /// order (x along +R, y along +A, z along +S: see `orientation.rs`), so its axes are
+    /// the spacings along the diagonal; its origin is the first voxel's position.
+    pub to_patient: PatientTransform,
     /// The physical values (after rescale) that map to density 0 and 1.
     pub window: [f32; 2],
+    /// The type the samples were stored as (in the file or the array) before
+    /// normalisation: what a user's `dtype` was.
+    pub sample_kind: SampleKind,
     /// The densities, x fastest, then y, then z.
     pub data: VolumeData,
 }
@@ -185,7 +203,13 @@ impl Volume {
             name: name.to_string(),
             dims,
             spacing,
+            to_patient: PatientTransform::aligned(spacing),
             window: [0.0, 1.0],
+            sample_kind: match data {
+                VolumeData::U8(_) => SampleKind::U8,
+                VolumeData::U16(_) => SampleKind::U16,
+                VolumeData::F32(_) => SampleKind::F32,
+            },
             data,
         })
     }
@@ -193,10 +217,10 @@ impl Volume {
     /// Loads a volume from a file or a DICOM folder.
     ///
     /// With `raw` given the file is read as raw voxels whatever its extension. Otherwise
-    /// the loader is chosen by: a folder with Zarr metadata -> OME-Zarr (the image, or
-    /// one level's array); another folder -> DICOM series; `.nrrd`/`.nhdr` -> NRRD;
-    /// `.nii`/`.nii.gz` -> NIfTI-1; `.tif`/`.tiff` -> OME-TIFF or a page stack; `.dcm` -> a one-slice DICOM series; any file with a
-    /// sidecar `<file>.json`/`<file>.toml` -> raw.
+    /// the table in `formats.rs` picks the loader: a folder by its probe (Zarr metadata
+    /// -> OME-Zarr, any other folder -> a DICOM series), a file by its name's ending,
+    /// then by its magic bytes; last, any file with a sidecar `<file>.json`/`<file>.toml`
+    /// is raw.
     pub fn load(path: &Path, raw: Option<&RawParams>) -> Result<Volume, VolumeError> {
         Self::load_within(path, raw, None)
     }
@@ -211,42 +235,7 @@ impl Volume {
         if let Some(params) = raw {
             return raw::load(path, params);
         }
-        if zarr::is_zarr(path) {
-            return zarr::load(path, budget);
-        }
-        if path.is_dir() {
-            return dicom::load_series(path);
-        }
-        let lower = path
-            .file_name()
-            .map(|n| n.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        if lower.ends_with(".nrrd") || lower.ends_with(".nhdr") {
-            nrrd::load(path)
-        } else if lower.ends_with(".nii") || lower.ends_with(".nii.gz") {
-            nifti::load(path)
-        } else if lower.ends_with(".tif") || lower.ends_with(".tiff") {
-            ome_tiff::load(path)
-        } else if lower.ends_with(".dcm") {
-            dicom::load_files(path, vec![path.to_path_buf()])
-        } else if let Some(params) = raw::read_sidecar(path)? {
-            raw::load(path, &params)
-        } else if [".raw", ".bin", ".dat", ".vol"]
-            .iter()
-            .any(|e| lower.ends_with(e))
-        {
-            Err(VolumeError::MissingRawParams {
-                path: path.to_path_buf(),
-            })
-        } else {
-            Err(VolumeError::Unsupported {
-                path: path.to_path_buf(),
-                reason: "unknown volume format; expected .nrrd, .nhdr, .nii, .nii.gz, \
-                         .ome.tif/.tif, .dcm, a DICOM folder, an OME-Zarr folder, or raw \
-                         data with a <file>.json/.toml sidecar"
-                    .into(),
-            })
-        }
+        formats::load(path, formats::Request { budget })
     }
 
     /// A built-in dataset: `phantom` (CT-like head with thin vessels, U16), `cloud`
@@ -367,7 +356,8 @@ impl Volume {
         )
     }
 
-    /// Normalises decoded samples and wraps them (shared tail of every loader).
+    /// Normalises decoded samples, puts them in RAS order by the file's orientation
+    /// (when it states one) and wraps them: the shared tail of every loader.
     pub(crate) fn from_stored(
         path: &Path,
         name: String,
@@ -375,14 +365,22 @@ impl Volume {
         spacing: [f32; 3],
         stored: Stored,
     ) -> Result<Volume, VolumeError> {
+        let orientation = stored.orientation;
+        let sample_kind = stored.samples.kind();
         let n = normalise::normalise(path, dims, stored)?;
-        Ok(Volume {
+        let v = Volume {
             name,
             dims,
             spacing,
+            to_patient: PatientTransform::aligned(spacing),
             window: n.window,
+            sample_kind,
             data: n.data,
-        })
+        };
+        match orientation {
+            Some(t) => orientation::to_ras(path, v, t),
+            None => Ok(v),
+        }
     }
 }
 

@@ -48,7 +48,7 @@ pub(crate) fn generate(n: u32) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::volume::{Volume, VolumeData};
+    use crate::{Volume, VolumeData};
 
     #[test]
     fn cloud_is_homogeneous_deterministic_and_non_convex() {

@@ -12,10 +12,8 @@ pub const ASSETS_ENV: &str = "DVR_ASSETS";
 pub fn assets_dir() -> PathBuf {
     match std::env::var_os(ASSETS_ENV) {
         Some(dir) if !dir.is_empty() => PathBuf::from(dir),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR"))
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join("assets"),
+        // This crate is `engine/volume/` of the workspace.
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets"),
     }
 }
 

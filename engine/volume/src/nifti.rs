@@ -3,21 +3,23 @@
 //! The 348-byte header is parsed by hand instead of using the `nifti` crate: we need
 //! about a dozen fixed-offset fields, while the crate pulls `ndarray`, `nalgebra` and
 //! friends into every build of the engine. Read: single-file NIfTI-1 (`n+1`) in either
-//! byte order, datatypes uint8, int16, uint16 and float32, `pixdim` for spacing (with the
+//! byte order, datatypes uint8, int16, uint16, float32 and float64 (held as float32), `pixdim` for spacing (with the
 //! `xyzt_units` spatial unit converted to mm), `scl_slope/scl_inter` applied before
 //! normalisation. 4D files are read only when the extra dimensions have size 1. The
-//! orientation (qform/sform) is ignored: voxels keep the file's index order.
+//! orientation is the sform when `sform_code > 0`, else the qform (quaternion, offsets,
+//! `qfac`) when `qform_code > 0`, else none (NIfTI's "method 1": the index axes are R,
+//! A, S); the volume is put in RAS order by it (`orientation.rs`).
 
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
 use super::error::VolumeError;
 use super::samples::{Affine, Rescale, SampleKind, Samples, Stored};
-use super::{io, name_of, validate_dims, validate_spacing, Volume};
+use super::{io, name_of, validate_dims, validate_spacing, PatientTransform, Volume};
 
 /// Size of a NIfTI-1 header.
 pub(crate) const HEADER_LEN: usize = 348;
-const SUPPORTED_TYPES: &str = "uint8 (2), int16 (4), uint16 (512), float32 (16)";
+const SUPPORTED_TYPES: &str = "uint8 (2), int16 (4), uint16 (512), float32 (16), float64 (64)";
 
 /// The header fields the loader uses.
 #[derive(Debug)]
@@ -28,6 +30,7 @@ struct Header {
     spacing: [f32; 3],
     vox_offset: u64,
     rescale: Affine,
+    orientation: Option<PatientTransform>,
 }
 
 /// Loads a `.nii` or `.nii.gz` file. The header is read and checked first; the data
@@ -86,6 +89,7 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         samples: Samples::decode(header.kind, data, header.big_endian),
         type_range: header.kind.full_range(),
         rescale: Rescale::Uniform(header.rescale),
+        orientation: header.orientation,
     };
     Volume::from_stored(path, name_of(path), header.dims, header.spacing, stored)
 }
@@ -194,6 +198,7 @@ fn parse_header(path: &Path, h: &[u8]) -> Result<Header, VolumeError> {
         4 => SampleKind::I16,
         512 => SampleKind::U16,
         16 => SampleKind::F32,
+        64 => SampleKind::F64,
         other => {
             return Err(VolumeError::UnsupportedType {
                 path: path.to_path_buf(),
@@ -246,6 +251,7 @@ fn parse_header(path: &Path, h: &[u8]) -> Result<Header, VolumeError> {
     } else {
         Affine::IDENTITY
     };
+    let orientation = orientation(&f, ndim, to_mm).map_err(|(field, p)| malformed(field, p))?;
     Ok(Header {
         big_endian: big,
         dims,
@@ -253,7 +259,67 @@ fn parse_header(path: &Path, h: &[u8]) -> Result<Header, VolumeError> {
         spacing,
         vox_offset: vox_offset as u64,
         rescale,
+        orientation,
     })
+}
+
+/// The index-to-patient transform the header states (sform before qform), in mm;
+/// `None` when neither code is set. An error names the field that is unusable.
+fn orientation(
+    f: &Fields<'_>,
+    ndim: usize,
+    to_mm: f64,
+) -> Result<Option<PatientTransform>, (&'static str, String)> {
+    let qform_code = f.i16(252);
+    let sform_code = f.i16(254);
+    let mm = |x: f32| f64::from(x) * to_mm;
+    let t = if sform_code > 0 {
+        let row = |at: usize| [0, 1, 2, 3].map(|i| mm(f.f32(at + 4 * i)));
+        (
+            "srow_x/srow_y/srow_z (sform)",
+            PatientTransform::from_rows([row(280), row(296), row(312)]),
+        )
+    } else if qform_code > 0 {
+        let [b, c, d] = [256, 260, 264].map(|at| f64::from(f.f32(at)));
+        let a = (1.0 - (b * b + c * c + d * d)).max(0.0).sqrt();
+        let r = [
+            [
+                a * a + b * b - c * c - d * d,
+                2.0 * (b * c - a * d),
+                2.0 * (b * d + a * c),
+            ],
+            [
+                2.0 * (b * c + a * d),
+                a * a + c * c - b * b - d * d,
+                2.0 * (c * d - a * b),
+            ],
+            [
+                2.0 * (b * d - a * c),
+                2.0 * (c * d + a * b),
+                a * a + d * d - b * b - c * c,
+            ],
+        ];
+        let qfac = if f.f32(76) < 0.0 { -1.0 } else { 1.0 };
+        // pixdim of an axis past dim[0] is meaningless: a 2D file's slice is 1 mm.
+        let pix = [1, 2, 3].map(|i| {
+            if i <= ndim {
+                mm(f.f32(76 + 4 * i)).abs()
+            } else {
+                1.0
+            }
+        });
+        let scale = [pix[0], pix[1], pix[2] * qfac];
+        let axes = [0, 1, 2].map(|col| [0, 1, 2].map(|row| r[row][col] * scale[col]));
+        let origin = [268, 272, 276].map(|at| mm(f.f32(at)));
+        (
+            "quatern_b/c/d, qoffset (qform)",
+            PatientTransform { axes, origin },
+        )
+    } else {
+        return Ok(None);
+    };
+    t.1.check().map_err(|p| (t.0, p))?;
+    Ok(Some(t.1))
 }
 
 fn datatype_name(code: i16) -> &'static str {

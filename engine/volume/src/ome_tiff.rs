@@ -400,7 +400,7 @@ mod tests {
     fn load_error(dir: &Path, bytes: &[u8]) -> String {
         let path = dir.join("x.ome.tif");
         std::fs::write(&path, bytes).unwrap();
-        crate::volume::load_within_seconds(&path, 20)
+        crate::load_within_seconds(&path, 20)
             .unwrap_err()
             .to_string()
     }

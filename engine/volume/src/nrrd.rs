@@ -4,7 +4,8 @@
 //! Hand-parsed: the header is a few `field: value` text lines, and the format features a
 //! volume renderer needs are small. Read: encodings `raw` and `gzip`; types uint8,
 //! uint16, int16 and float; `endian`; spacing from `space directions` (vector lengths) or
-//! `spacings`; `byte skip` and `line skip`; 2D images (one slice) and 4D files whose extra
+//! `spacings`; the orientation from `space`, `space directions` and `space origin` (LPS
+//! and LAS converted to RAS); `byte skip` and `line skip`; 2D images (one slice) and 4D files whose extra
 //! axis has size 1. Multi-file data (`data file: LIST` or a format pattern) and other
 //! encodings are rejected with a message saying so.
 
@@ -14,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 use super::error::VolumeError;
 use super::samples::{SampleKind, Samples, Stored};
-use super::{io, name_of, validate_dims, validate_spacing, Volume};
+use super::{io, name_of, validate_dims, validate_spacing, PatientTransform, Volume};
 
 const SUPPORTED_TYPES: &str = "uint8, uint16, int16, float";
 
@@ -230,7 +231,9 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         }
     };
     io::check_len(&data_path, dims, kind, bytes.len() as u64)?;
-    let stored = Stored::plain(Samples::decode(kind, bytes, big_endian));
+    let mut stored = Stored::plain(Samples::decode(kind, bytes, big_endian));
+    stored.orientation = patient_transform(&header.fields, &axes, spacing)
+        .map_err(|(field, problem)| malformed(field, problem))?;
     Volume::from_stored(path, name_of(path), dims, spacing, stored)
 }
 
@@ -408,6 +411,74 @@ fn parse_spacing(
             .unwrap_or(1.0)
     });
     validate_spacing(path, field, spacing)
+}
+
+/// The index-to-patient transform from `space`, `space directions` and `space origin`,
+/// in RAS. `None` without `space` or `space directions` (the index axes are then taken
+/// as R, A, S). Spaces other than the anatomical ones (`scanner-xyz`, `3D-right-handed`
+/// …) are taken as RAS with a note.
+fn patient_transform(
+    fields: &HashMap<String, String>,
+    axes: &[usize],
+    spacing: [f32; 3],
+) -> Result<Option<PatientTransform>, (&'static str, String)> {
+    let (Some(space), Some(dirs)) = (fields.get("space"), fields.get("space directions")) else {
+        return Ok(None);
+    };
+    // The sign each anatomical space's x and y take in RAS.
+    let sign = match space.trim().to_ascii_lowercase().as_str() {
+        "right-anterior-superior" | "ras" => [1.0, 1.0, 1.0],
+        "left-anterior-superior" | "las" => [-1.0, 1.0, 1.0],
+        "left-posterior-superior" | "lps" => [-1.0, -1.0, 1.0],
+        other => {
+            log::info!("NRRD space `{other}` is not anatomical: its axes are taken as R, A, S");
+            [1.0, 1.0, 1.0]
+        }
+    };
+    let v = parse_directions(dirs).ok_or(("space directions", format!("cannot parse `{dirs}`")))?;
+    let to_ras = |d: &[f64]| -> Option<[f64; 3]> {
+        (d.len() == 3).then(|| [d[0] * sign[0], d[1] * sign[1], d[2] * sign[2]])
+    };
+    let mut out = [[0.0; 3]; 3];
+    for i in 0..3 {
+        let dir = axes
+            .get(i)
+            .and_then(|&a| v.get(a))
+            .and_then(|d| d.as_deref());
+        out[i] = match dir.map(to_ras) {
+            Some(Some(d)) => d,
+            Some(None) => {
+                return Err((
+                    "space directions",
+                    "an orientation needs 3-component vectors".to_string(),
+                ))
+            }
+            // A 2D image's missing third axis: the normal of the other two, 1 voxel deep.
+            None => {
+                let (a, b) = (out[0], out[1]);
+                let n = [
+                    a[1] * b[2] - a[2] * b[1],
+                    a[2] * b[0] - a[0] * b[2],
+                    a[0] * b[1] - a[1] * b[0],
+                ];
+                let len = norm(&n).max(f64::MIN_POSITIVE);
+                n.map(|c| c / len * f64::from(spacing[i]))
+            }
+        };
+    }
+    let origin = match fields.get("space origin") {
+        Some(o) => {
+            let parsed = parse_directions(o)
+                .and_then(|v| v.into_iter().next().flatten())
+                .and_then(|d| to_ras(&d))
+                .ok_or(("space origin", format!("cannot parse `{o}` as (x,y,z)")))?;
+            parsed
+        }
+        None => [0.0; 3],
+    };
+    let t = PatientTransform { axes: out, origin };
+    t.check().map_err(|p| ("space directions", p))?;
+    Ok(Some(t))
 }
 
 /// Parses `(1,0,0) (0,1.5,0) none ...` into vectors (`None` for `none`).

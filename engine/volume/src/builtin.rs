@@ -44,7 +44,7 @@ pub(crate) fn build(name: &str, size: u32) -> Result<Volume, VolumeError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::volume::VolumeData;
+    use crate::VolumeData;
 
     #[test]
     fn mri_loads_with_the_documented_geometry() {
@@ -93,7 +93,7 @@ mod tests {
         }
         let v = Volume::builtin("phantom", 256).expect("builtin");
         let t = std::time::Instant::now();
-        let g = crate::volume::MajorantGrid::build(&v, 8);
+        let g = crate::MajorantGrid::build(&v, 8);
         println!(
             "majorant grid 256^3 / 8: {:.1} ms ({:?} bricks)",
             t.elapsed().as_secs_f64() * 1e3,

@@ -1,13 +1,14 @@
 //! Tests of `normalise.rs`.
 
 use super::*;
-use crate::volume::samples::SampleKind;
+use crate::samples::SampleKind;
 
 fn run(samples: Samples, rescale: Rescale, dims: [u32; 3]) -> Normalised {
     let stored = Stored {
         type_range: samples.kind().full_range(),
         samples,
         rescale,
+        orientation: None,
     };
     normalise(Path::new("t.raw"), dims, stored).expect("normalise")
 }
@@ -151,6 +152,7 @@ fn dicom_bits_stored_range_is_the_type_range() {
         samples: Samples::U16(vec![0, 4095]),
         type_range: Some((0.0, 4095.0)),
         rescale: Rescale::Uniform(Affine::IDENTITY),
+        orientation: None,
     };
     let n = normalise(Path::new("x.dcm"), [2, 1, 1], stored).expect("normalise");
     assert_eq!(n.window, [0.0, 4095.0]);

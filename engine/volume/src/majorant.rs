@@ -116,7 +116,7 @@ fn brick_bounds(v: &Volume, b: [u32; 3], brick: u32) -> (f32, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::volume::VolumeData;
+    use crate::VolumeData;
 
     /// Trilinear sample with clamp-to-edge at continuous voxel position `p` (voxel
     /// centres at i + 0.5), as a GPU sampler computes it (in f64).
@@ -213,7 +213,9 @@ mod tests {
             name: "broken".into(),
             dims: [16, 16, 16],
             spacing: [1.0; 3],
+            to_patient: crate::PatientTransform::aligned([1.0; 3]),
             window: [0.0, 1.0],
+            sample_kind: crate::SampleKind::U8,
             data: VolumeData::U8(vec![255; 100]),
         };
         let g = MajorantGrid::build(&v, 8);

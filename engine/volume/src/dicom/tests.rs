@@ -1,8 +1,8 @@
 //! Tests of `dicom.rs`.
 
 use super::*;
-use crate::volume::write::{self, DicomSlice};
-use crate::volume::VolumeData;
+use crate::write::{self, DicomSlice};
+use crate::VolumeData;
 
 fn slice(z: usize, pixels: Vec<i16>) -> DicomSlice {
     DicomSlice {
@@ -49,10 +49,18 @@ fn three_slice_series_sorts_by_position_and_rescales() {
     };
     let unit = |p: f64| (((p + 1024.0) / 1624.0) * 65535.0).round() as u16;
     // z=0 is the ramp (file c.dcm), z=1 physical 0 (a.dcm), z=2 physical 600 (b.dcm).
-    assert_eq!(d[0], 0);
-    assert_eq!(d[11], unit(-474.0));
+    // The series is axial in LPS, so in RAS order x and y run backwards: the ramp's
+    // last pixel comes first.
+    assert_eq!(d[0], unit(-474.0));
+    assert_eq!(d[11], 0);
     assert_eq!(d[12], unit(0.0));
     assert_eq!(d[24], 65535);
+    // The first voxel in RAS order is the file's last column and row of the first
+    // slice: LPS (-10 + 3 * 0.6, -20 + 2 * 0.7, 5), negated in x and y.
+    let o = v.to_patient.origin;
+    for (got, want) in o.iter().zip([8.2, 18.6, 5.0]) {
+        assert!((got - want).abs() < 1e-6, "{o:?}");
+    }
 }
 
 #[test]

@@ -1,5 +1,5 @@
 use super::*;
-use crate::volume::{load_within_seconds, make_fifo};
+use crate::{load_within_seconds, make_fifo};
 use serde_json::json;
 
 /// An OME-Zarr 0.5 image at `dir/img.zarr` with one level, `0`, of `array` (a Zarr v3

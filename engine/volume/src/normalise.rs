@@ -251,6 +251,7 @@ fn apply_window(stored: Stored, slice_len: usize, window: (f64, f64)) -> VolumeD
         samples,
         type_range,
         rescale,
+        ..
     } = stored;
     let identity = rescale == Rescale::Uniform(Affine::IDENTITY);
     let untouched = identity && type_range == samples.kind().full_range();

@@ -255,7 +255,7 @@ mod tests {
         let err = open_regular(dir.path()).unwrap_err();
         assert!(err.to_string().contains("a folder"), "{err}");
         let fifo = dir.path().join("pipe");
-        if crate::volume::make_fifo(&fifo) {
+        if crate::make_fifo(&fifo) {
             // Opening a FIFO for reading would block this test forever.
             let err = open_regular(&fifo).unwrap_err();
             assert!(err.to_string().contains("FIFO"), "{err}");

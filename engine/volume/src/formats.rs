@@ -1,0 +1,258 @@
+//! The table of volume formats: how each is recognised (a folder probe, name endings,
+//! magic bytes) and which function reads it. [`crate::Volume::load`] walks this table
+//! and nothing else, so a new format is its module and one row here.
+//!
+//! Order matters where two rows could claim one input: folder probes run in table order
+//! (an OME-Zarr folder before "any other folder is a DICOM series"), then name endings,
+//! then magic bytes (a file named for no format, whose first bytes say what it is).
+
+use std::io::Read;
+use std::path::Path;
+
+use crate::{dicom, nifti, nrrd, ome_tiff, raw, zarr, Volume, VolumeError};
+
+/// What a load asks beyond the path.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Request {
+    /// Bytes a renderer has for its volume: multiscale formats read the finest level
+    /// that fits.
+    pub budget: Option<u64>,
+}
+
+/// Bytes at a fixed offset that identify a format.
+pub(crate) struct Magic {
+    pub offset: usize,
+    pub bytes: &'static [u8],
+}
+
+/// One format: its name in messages, how it is recognised, how it is read.
+pub(crate) struct Format {
+    pub name: &'static str,
+    /// Lower-case name endings that select it (`.nii.gz` before `.gz` would matter).
+    pub extensions: &'static [&'static str],
+    /// Leading bytes that select it when no ending does.
+    pub magic: &'static [Magic],
+    /// For a format stored as a folder: whether this folder holds one.
+    pub folder: Option<fn(&Path) -> bool>,
+    pub load: fn(&Path, Request) -> Result<Volume, VolumeError>,
+}
+
+/// Every format `Volume::load` reads, in the order it tries them.
+pub(crate) const FORMATS: &[Format] = &[
+    Format {
+        name: "OME-Zarr",
+        extensions: &[".zarr"],
+        magic: &[],
+        folder: Some(zarr::is_zarr),
+        load: |p, r| zarr::load(p, r.budget),
+    },
+    Format {
+        name: "DICOM series",
+        extensions: &[".dcm"],
+        magic: &[Magic {
+            offset: 128,
+            bytes: b"DICM",
+        }],
+        folder: Some(|p| p.is_dir()),
+        load: |p, _| {
+            if p.is_dir() {
+                dicom::load_series(p)
+            } else {
+                dicom::load_files(p, vec![p.to_path_buf()])
+            }
+        },
+    },
+    Format {
+        name: "NRRD",
+        extensions: &[".nrrd", ".nhdr"],
+        magic: &[Magic {
+            offset: 0,
+            bytes: b"NRRD000",
+        }],
+        folder: None,
+        load: |p, _| nrrd::load(p),
+    },
+    Format {
+        name: "NIfTI-1",
+        extensions: &[".nii", ".nii.gz"],
+        magic: &[
+            Magic {
+                offset: 344,
+                bytes: b"n+1\0",
+            },
+            Magic {
+                offset: 344,
+                bytes: b"ni1\0",
+            },
+        ],
+        folder: None,
+        load: |p, _| nifti::load(p),
+    },
+    Format {
+        name: "OME-TIFF / TIFF stack",
+        extensions: &[".ome.tif", ".ome.tiff", ".tif", ".tiff"],
+        magic: &[
+            Magic {
+                offset: 0,
+                bytes: b"II*\0",
+            },
+            Magic {
+                offset: 0,
+                bytes: b"MM\0*",
+            },
+        ],
+        folder: None,
+        load: |p, _| ome_tiff::load(p),
+    },
+];
+
+/// Name endings of raw data, which need a sidecar or explicit parameters.
+pub(crate) const RAW_EXTENSIONS: &[&str] = &[".raw", ".bin", ".dat", ".vol"];
+
+/// The format that reads `path`, by folder probe, name ending, then magic bytes.
+pub(crate) fn format_of(path: &Path) -> Option<&'static Format> {
+    if path.is_dir() {
+        return FORMATS
+            .iter()
+            .find(|f| f.folder.is_some_and(|probe| probe(path)));
+    }
+    let lower = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if let Some(f) = FORMATS
+        .iter()
+        .find(|f| f.extensions.iter().any(|e| lower.ends_with(e)))
+    {
+        return Some(f);
+    }
+    // Only regular files are sniffed: a FIFO or device must not be opened here (the
+    // loaders refuse those with their own error).
+    if !path.is_file() {
+        return None;
+    }
+    let head = leading_bytes(path)?;
+    FORMATS.iter().find(|f| {
+        f.magic.iter().any(|m| {
+            head.get(m.offset..m.offset + m.bytes.len())
+                .is_some_and(|b| b == m.bytes)
+        })
+    })
+}
+
+/// The first bytes of a file, enough for every magic in the table.
+fn leading_bytes(path: &Path) -> Option<Vec<u8>> {
+    let need = FORMATS
+        .iter()
+        .flat_map(|f| f.magic.iter().map(|m| m.offset + m.bytes.len()))
+        .max()
+        .unwrap_or(0);
+    let mut head = Vec::with_capacity(need);
+    std::fs::File::open(path)
+        .ok()?
+        .take(need as u64)
+        .read_to_end(&mut head)
+        .ok()?;
+    Some(head)
+}
+
+/// Reads `path` with the format the table picks (see [`format_of`]), or raw data
+/// described by a sidecar `<file>.json` / `<file>.toml`.
+pub(crate) fn load(path: &Path, request: Request) -> Result<Volume, VolumeError> {
+    if let Some(format) = format_of(path) {
+        log::debug!("{}: read as {}", path.display(), format.name);
+        return (format.load)(path, request);
+    }
+    if let Some(params) = raw::read_sidecar(path)? {
+        return raw::load(path, &params);
+    }
+    let lower = path.to_string_lossy().to_ascii_lowercase();
+    if RAW_EXTENSIONS.iter().any(|e| lower.ends_with(e)) {
+        return Err(VolumeError::MissingRawParams {
+            path: path.to_path_buf(),
+        });
+    }
+    Err(VolumeError::Unsupported {
+        path: path.to_path_buf(),
+        reason: format!(
+            "unknown volume format; expected {}, a DICOM or OME-Zarr folder, or raw data \
+             with a <file>.json/.toml sidecar",
+            known_endings()
+        ),
+    })
+}
+
+/// Every name ending of the table, for messages: ".zarr, .dcm, .nrrd, …".
+pub(crate) fn known_endings() -> String {
+    FORMATS
+        .iter()
+        .flat_map(|f| f.extensions.iter().copied())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_row_is_reachable_and_endings_are_unique() {
+        let mut seen = std::collections::HashSet::new();
+        for f in FORMATS {
+            assert!(
+                !f.extensions.is_empty() || f.folder.is_some() || !f.magic.is_empty(),
+                "{} cannot be selected",
+                f.name
+            );
+            for e in f.extensions {
+                assert!(e.starts_with('.') && *e == e.to_ascii_lowercase(), "{e}");
+                assert!(seen.insert(*e), "{e} names two formats");
+            }
+        }
+        for e in RAW_EXTENSIONS {
+            assert!(!seen.contains(e), "{e} is both raw and a format");
+        }
+    }
+
+    #[test]
+    fn files_named_for_no_format_are_read_by_their_magic() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let cases: [(&str, Vec<u8>, &str); 3] = [
+            ("a", b"NRRD0004\ntype: uint8\n".to_vec(), "NRRD"),
+            (
+                "b",
+                [b"II*\0".as_slice(), &[0u8; 60]].concat(),
+                "OME-TIFF / TIFF stack",
+            ),
+            (
+                "c",
+                [vec![0u8; 128], b"DICM".to_vec(), vec![0u8; 400]].concat(),
+                "DICOM series",
+            ),
+        ];
+        for (name, bytes, want) in cases {
+            let p = dir.path().join(name);
+            std::fs::write(&p, bytes).expect("write");
+            assert_eq!(format_of(&p).map(|f| f.name), Some(want), "{name}");
+        }
+        let mut nifti = vec![0u8; 352];
+        nifti[344..348].copy_from_slice(b"n+1\0");
+        let p = dir.path().join("d.img");
+        std::fs::write(&p, nifti).expect("write");
+        assert_eq!(format_of(&p).map(|f| f.name), Some("NIfTI-1"));
+        let p = dir.path().join("e.bin");
+        std::fs::write(&p, [1u8, 2, 3]).expect("write");
+        assert!(format_of(&p).is_none());
+    }
+
+    #[test]
+    fn the_unknown_format_error_lists_the_tables_endings() {
+        let err = load(Path::new("/nonexistent/picture.png"), Request::default()).unwrap_err();
+        let msg = err.to_string();
+        for f in FORMATS {
+            for e in f.extensions {
+                assert!(msg.contains(e), "{msg} lacks {e}");
+            }
+        }
+    }
+}
