@@ -24,7 +24,7 @@
 use anyhow::{bail, Context, Result};
 use dvr_engine::scene::transfer_ref::is_path;
 use dvr_engine::scene::{Cut, MAX_CLIP_PLANES};
-use dvr_engine::session::Edit;
+use dvr_engine::session::{Anatomical, Edit};
 use dvr_engine::transfer::TransferFunction;
 use glam::DVec3;
 use winit::event::MouseButton;
@@ -35,6 +35,8 @@ use winit::keyboard::{Key as WinitKey, NamedKey};
 pub enum Key {
     Reset,
     Fit,
+    /// Look from one side of the patient (keys 1–6).
+    View(Anatomical),
     /// Every cut off, or back on.
     Cut,
     Help,
@@ -49,6 +51,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("wheel", "zoom"),
     ("R", "reset the camera"),
     ("F", "fly to fit the volume"),
+    (
+        "1 – 6",
+        "view from the anterior, posterior, left, right, superior, inferior side",
+    ),
     ("C", "cuts (clip planes, crop box) off / on"),
     ("H / F1", "this help"),
     ("F12", "screenshot (PNG of the window, EXR of the frame)"),
@@ -75,7 +81,11 @@ impl Key {
             "h" | "f1" => Some(Key::Help),
             "f12" => Some(Key::Screenshot),
             "tab" => Some(Key::ToggleUi),
-            _ => None,
+            d @ ("1" | "2" | "3" | "4" | "5" | "6") => {
+                let i = d.parse::<usize>().ok()? - 1;
+                Some(Key::View(Anatomical::ALL[i]))
+            }
+            other => Anatomical::from_name(other).map(Key::View),
         }
     }
 }
@@ -168,6 +178,7 @@ pub fn camera_edit(command: &Command) -> Option<Edit> {
         Command::Zoom(steps) => Edit::Zoom { steps },
         Command::Key(Key::Reset) => Edit::ResetCamera,
         Command::Key(Key::Fit) => Edit::FitCamera,
+        Command::Key(Key::View(side)) => Edit::ViewFrom(side),
         _ => return None,
     })
 }
@@ -392,5 +403,21 @@ mod tests {
             ]
         );
         assert_eq!(camera_edit(&Command::Key(Key::Help)), None);
+    }
+
+    #[test]
+    fn keys_one_to_six_and_side_names_are_the_anatomical_views() {
+        let cmd = Script::parse("key:1@0;key:4@0;key:6@0;key:superior@0").expect("parses");
+        let edits: Vec<Option<Edit>> = cmd.at(0).map(camera_edit).collect();
+        assert_eq!(
+            edits,
+            vec![
+                Some(Edit::ViewFrom(Anatomical::Anterior)),
+                Some(Edit::ViewFrom(Anatomical::Right)),
+                Some(Edit::ViewFrom(Anatomical::Inferior)),
+                Some(Edit::ViewFrom(Anatomical::Superior)),
+            ]
+        );
+        assert_eq!(Key::from_name("7"), None);
     }
 }

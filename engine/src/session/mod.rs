@@ -19,7 +19,7 @@
 
 pub mod orbit;
 
-pub use orbit::OrbitCamera;
+pub use orbit::{Anatomical, OrbitCamera};
 
 use crate::denoise::registry;
 use crate::error::EngineError;
@@ -72,6 +72,8 @@ pub enum Edit {
     ResetCamera,
     /// Fly to fit the volume, keeping the viewing direction.
     FitCamera,
+    /// Look from one side of the patient ([`OrbitCamera::view_from`]).
+    ViewFrom(Anatomical),
     /// The lights, in order.
     Lights(Vec<Light>),
     /// The transfer function (a single one: [`TfState::single`]).
@@ -193,6 +195,7 @@ impl Session {
             Edit::Pan { dx, dy } => self.move_camera(|c, h| c.pan(dx, dy, h))?,
             Edit::Zoom { steps } => self.move_camera(|c, _| c.zoom(steps))?,
             Edit::ResetCamera => self.move_camera(|c, _| c.reset())?,
+            Edit::ViewFrom(side) => self.move_camera(|c, _| c.view_from(side))?,
             Edit::FitCamera => {
                 let half = glam::Vec3::from(self.setup.volume.world_size).as_dvec3() * 0.5;
                 let aspect = f64::from(self.view_size.aspect());

@@ -35,6 +35,59 @@ pub struct OrbitCamera {
     home: (DVec3, f64, f64, f64, f64),
 }
 
+/// The six views of the patient a medical viewer offers: the side the camera is on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Anatomical {
+    Anterior,
+    Posterior,
+    Left,
+    Right,
+    Superior,
+    Inferior,
+}
+
+impl Anatomical {
+    /// Every view, in the order the explorer's keys 1–6 take them.
+    pub const ALL: [Anatomical; 6] = [
+        Anatomical::Anterior,
+        Anatomical::Posterior,
+        Anatomical::Left,
+        Anatomical::Right,
+        Anatomical::Superior,
+        Anatomical::Inferior,
+    ];
+
+    /// Its name as the explorer, scripts and Python write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Anatomical::Anterior => "anterior",
+            Anatomical::Posterior => "posterior",
+            Anatomical::Left => "left",
+            Anatomical::Right => "right",
+            Anatomical::Superior => "superior",
+            Anatomical::Inferior => "inferior",
+        }
+    }
+
+    /// The view named `name` (case-insensitive; `None` for any other word).
+    pub fn from_name(name: &str) -> Option<Anatomical> {
+        let lower = name.to_ascii_lowercase();
+        Self::ALL.into_iter().find(|a| a.name() == lower)
+    }
+
+    /// The unit vector from the patient towards the camera, in RAS world space.
+    pub fn direction(self) -> DVec3 {
+        match self {
+            Anatomical::Anterior => DVec3::Y,
+            Anatomical::Posterior => DVec3::NEG_Y,
+            Anatomical::Left => DVec3::NEG_X,
+            Anatomical::Right => DVec3::X,
+            Anatomical::Superior => DVec3::Z,
+            Anatomical::Inferior => DVec3::NEG_Z,
+        }
+    }
+}
+
 /// An orthonormal basis (e1, e2) of the plane normal to `up`, with e1 × e2 = up.
 fn basis(up: DVec3) -> (DVec3, DVec3) {
     let reference = if up.cross(DVec3::X).length_squared() > 1e-6 {
@@ -120,6 +173,23 @@ impl OrbitCamera {
             / viewport_height.max(1.0);
         let (right, view_up) = self.view_axes();
         self.target += (-dx * right + dy * view_up) * world_per_pixel;
+    }
+
+    /// Looks at the target from `side` of the patient, keeping the distance: world
+    /// space is patient RAS (see `dvr_volume`'s `orientation.rs`), so `Anterior` puts
+    /// the camera on +y. Views along `up` stop at the pitch limit, a hair off the pole.
+    pub fn view_from(&mut self, side: Anatomical) {
+        let dir = side.direction();
+        let (e1, e2) = basis(self.up);
+        let planar = dir - self.up * dir.dot(self.up);
+        if planar.length_squared() > 1e-12 {
+            self.yaw = planar.dot(e2).atan2(planar.dot(e1));
+        }
+        self.pitch = dir
+            .dot(self.up)
+            .clamp(-1.0, 1.0)
+            .asin()
+            .clamp(-PITCH_LIMIT, PITCH_LIMIT);
     }
 
     /// Wheel steps: positive zooms in.
@@ -218,6 +288,36 @@ mod tests {
         c.pan(3.0, 4.0, 100.0);
         c.reset();
         assert_eq!(c, cam());
+    }
+
+    #[test]
+    fn each_anatomical_view_puts_the_camera_on_that_side() {
+        for side in Anatomical::ALL {
+            let mut c = cam();
+            c.orbit(123.0, -45.0);
+            let before = c.distance;
+            c.view_from(side);
+            let towards_camera = (c.position() - c.target).normalize();
+            assert!(
+                towards_camera.dot(side.direction()) > 0.999,
+                "{side:?}: camera towards {towards_camera}"
+            );
+            assert_eq!(c.distance, before, "{side:?} keeps the distance");
+            assert_eq!(
+                Anatomical::from_name(&side.name().to_uppercase()),
+                Some(side)
+            );
+        }
+        assert_eq!(Anatomical::from_name("front"), None);
+        // An anterior view of RAS space has the patient's right on the image's left.
+        let mut c = cam();
+        c.view_from(Anatomical::Anterior);
+        let vp = c.spec().camera().view_proj(1.0);
+        let right = vp.project_point3(glam::Vec3::new(0.3, 0.0, 0.0));
+        assert!(
+            right.x < 0.0,
+            "the patient's right is on the image's left: {right}"
+        );
     }
 
     #[test]

@@ -70,7 +70,7 @@ impl PatientTransform {
 
     /// The length of each axis's step: the voxel spacing in mm.
     pub fn spacing(&self) -> [f64; 3] {
-        self.axes.map(|v| norm(v))
+        self.axes.map(norm)
     }
 
     /// Checks that the axes are finite, non-zero and span space.
