@@ -202,6 +202,12 @@ class Renderer:
         """Flies to fit the volume, keeping the viewing direction."""
         self._r.fit()
 
+    def view_from(self, side):
+        """Looks at the volume from one side of the patient: ``"anterior"``,
+        ``"posterior"``, ``"left"``, ``"right"``, ``"superior"`` or ``"inferior"``
+        (world space is patient RAS), keeping the target and the distance."""
+        self._r.view_from(str(side))
+
     # The rest.
 
     def histogram(self) -> np.ndarray:

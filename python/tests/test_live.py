@@ -250,6 +250,21 @@ def test_orbit_pan_and_zoom_move_the_camera_as_the_explorers_mouse_does():
     assert np.allclose(r.camera.position, p0) and np.allclose(r.camera.target, t0)
 
 
+def test_view_from_puts_the_camera_on_that_side_of_the_patient():
+    r = dvr.Renderer(dvr.Scene.builtin("phantom/orbit"), size=(16, 16), denoisers=["taa"])
+    t0 = np.array(r.camera.target)
+    d0 = np.linalg.norm(np.array(r.camera.position) - t0)
+    sides = {"anterior": (0, 1, 0), "posterior": (0, -1, 0), "left": (-1, 0, 0),
+             "right": (1, 0, 0), "superior": (0, 0, 1), "inferior": (0, 0, -1)}
+    for side, towards in sides.items():
+        r.view_from(side)
+        offset = np.array(r.camera.position) - np.array(r.camera.target)
+        assert np.isclose(np.linalg.norm(offset), d0), side
+        assert np.dot(offset / d0, towards) > 0.999, (side, offset)
+    with pytest.raises(ValueError, match="anterior, posterior"):
+        r.view_from("front")
+
+
 def _digest(out):
     return hashlib.sha256(b"".join(np.ascontiguousarray(out[k]).tobytes() for k in sorted(out))).hexdigest()
 
