@@ -3,7 +3,7 @@
 //! `gpu` (device, memory, pipelines, timestamps) → `graph` (explicit render graph) →
 //! `passes` (one GPU pass per file) and `denoise` (each denoiser's passes and history) →
 //! `renderer` (the frame) → `session` (a live view: edits in, frames out; what the
-//! explorer, the scripted animations and Python drive). CPU-side data (`volume`, `transfer`, `scene`, `metrics`) feeds
+//! explorer, the scripted animations and Python drive). CPU-side data (`volume` and `metrics`, crates of their own, `transfer`, `scene`) feeds
 //! them; `assets` says where the shipped files are.
 
 pub mod denoise;
@@ -11,7 +11,6 @@ pub mod error;
 pub mod gpu;
 pub mod graph;
 pub mod image_io;
-pub mod metrics;
 pub mod passes;
 pub mod renderer;
 pub mod scene;
@@ -23,5 +22,6 @@ pub use error::{EngineError, Result};
 
 // The GPU-free layers, crates of their own that the engine re-exports under the names
 // the applications use.
+pub use dvr_metrics as metrics;
 pub use dvr_volume as volume;
 pub use dvr_volume::{assets, bytes, files};

@@ -58,7 +58,7 @@ fn colormap_endpoints() {
 }
 
 fn fixture_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/flip")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/fixtures/flip")
 }
 
 fn load_png(path: &std::path::Path) -> Rgb32Image {
