@@ -193,11 +193,12 @@ class Renderer:
         self._r.resize(*_size(size))
 
     def orbit(self, degrees_x, degrees_y=0.0):
-        """Orbits the camera about its target by ``degrees_x`` about the up axis and
-        ``degrees_y`` of elevation, in degrees as :meth:`Scene.orbit` (the direction a
-        left drag to the right and down turns it in the explorer)."""
+        """Orbits the camera about its target by ``degrees_x`` about the up axis, the
+        way :meth:`Scene.orbit`'s positive degrees turn it (counter-clockwise seen from
+        above), and ``degrees_y`` of elevation (positive as a downward drag moves it)."""
         scale = np.radians(1.0) / _RADIANS_PER_PIXEL
-        self._r.orbit(float(degrees_x) * scale, float(degrees_y) * scale)
+        # A drag to the right turns the other way round from the scene's orbit.
+        self._r.orbit(-float(degrees_x) * scale, float(degrees_y) * scale)
 
     def orbit_pixels(self, dx, dy=0.0):
         """Orbits as a left drag of (dx, dy) pixels in the explorer does (0.01 radians

@@ -195,8 +195,8 @@ impl Volume {
 
     /// Index `[z, y, x]` to patient space (RAS+, mm) as a 4×4 affine: `p = A @ (z, y,
     /// x, 1)`. The voxels are stored in RAS order whatever the file's orientation (x
-    /// along +Right, y +Anterior, z +Superior), so its 3×3 part is diagonal: the
-    /// spacings, reversed to the array's axis order.
+    /// along +Right, y +Anterior, z +Superior), so its 3×3 part is the spacings on the
+    /// anti-diagonal: array axis 0 (z) steps along S, axis 2 (x) along R.
     #[getter]
     fn to_patient<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let t = &self.inner.to_patient;
@@ -223,7 +223,7 @@ impl Volume {
     /// A mistyped attribute names the ones that exist (as cameras, lights and scenes do).
     fn __getattr__(&self, name: &str) -> PyResult<()> {
         Err(pyo3::exceptions::PyAttributeError::new_err(format!(
-            "Volume has no field {name:?} (fields: {})",
+            "Volume has no field '{name}' (fields: {})",
             FIELDS.join(", ")
         )))
     }
@@ -232,7 +232,7 @@ impl Volume {
         let what = if FIELDS.contains(&name) {
             format!("Volume.{name} cannot be assigned: a volume is immutable")
         } else {
-            format!("Volume has no field {name:?} (fields: {})", FIELDS.join(", "))
+            format!("Volume has no field '{name}' (fields: {})", FIELDS.join(", "))
         };
         Err(pyo3::exceptions::PyAttributeError::new_err(what))
     }

@@ -54,7 +54,8 @@ def test_an_ome_zarrs_extra_channel_and_time_point_are_python_warnings(tmp_path)
     v, dropped = _load_warned(path)
     assert np.array_equal(v.data, dvr.Volume(data[0, 0]).data)
     text = " ".join(str(w.message) for w in dropped)
-    assert dropped and "channel" in text and "time" in text, text
+    assert len(dropped) == 2 and "axis c has 2 entries" in text and "axis t has 2 entries" in text, text
+    assert all("tc.zarr" in str(w.message) for w in dropped)
 
 
 def test_dropped_data_shows_under_w_always_and_errors_under_w_error(tmp_path):

@@ -56,6 +56,10 @@ def test_the_wheel_carries_its_assets_and_stays_small():
     # Only the three folders the engine reads, not assets/ whole (results, gallery, scenes).
     assert not [n for n in names if n.startswith("dvr/assets/") and n.split("/")[2] not in ("transfer", "volumes", "rae")]
     assert wheel.stat().st_size < 60 << 20
+    # python/dvr/assets links file by file: a new preset or network needs its link.
+    shipped = {f"dvr/assets/{p.relative_to(ROOT / 'assets')}" for d in ("transfer", "rae", "volumes")
+               for p in (ROOT / "assets" / d).iterdir() if p.name != "README.md"}
+    assert not shipped - set(names), f"not linked under python/dvr/assets: {sorted(shipped - set(names))}"
 
 
 def test_an_installed_wheel_renders_with_the_checkout_out_of_reach(tmp_path):
