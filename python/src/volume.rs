@@ -8,7 +8,9 @@ use crate::warnings;
 use dvr_engine::renderer::scene_setup::DEFAULT_VOLUME_SIZE;
 use dvr_engine::scene::parse_gpu_memory;
 use dvr_engine::volume::{SampleKind, Volume as EngineVolume, VolumeData, Voxels};
-use numpy::{PyArray2, PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
+use numpy::{
+    PyArray2, PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
 use std::path::PathBuf;
@@ -124,16 +126,27 @@ impl Volume {
         gpu_memory: Option<String>,
         _stacklevel: i32,
     ) -> PyResult<Self> {
-        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy")) {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
+        {
             // numpy's own format, read by numpy (no pickles: a .npy is data, not code);
             // it states no voxel size, so 1 mm as for an array.
             let array = py
                 .import("numpy")?
                 .getattr("load")?
-                .call((path.as_os_str(),), Some(&[("allow_pickle", false)].into_py_dict(py)?))
+                .call(
+                    (path.as_os_str(),),
+                    Some(&[("allow_pickle", false)].into_py_dict(py)?),
+                )
                 .map_err(|e| value_error(format!("{}: {e}", path.display())))?;
             let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
-            return Self::new(py, &array, (1.0, 1.0, 1.0), stem.as_deref().unwrap_or("npy"));
+            return Self::new(
+                py,
+                &array,
+                (1.0, 1.0, 1.0),
+                stem.as_deref().unwrap_or("npy"),
+            );
         }
         let budget = gpu_memory
             .map(|s| parse_gpu_memory(&s).map_err(|e| value_error(format!("gpu_memory: {e}"))))
@@ -232,7 +245,10 @@ impl Volume {
         let what = if FIELDS.contains(&name) {
             format!("Volume.{name} cannot be assigned: a volume is immutable")
         } else {
-            format!("Volume has no field '{name}' (fields: {})", FIELDS.join(", "))
+            format!(
+                "Volume has no field '{name}' (fields: {})",
+                FIELDS.join(", ")
+            )
         };
         Err(pyo3::exceptions::PyAttributeError::new_err(what))
     }
