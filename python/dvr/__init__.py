@@ -8,7 +8,7 @@ linear radiance, scores from :mod:`dvr.metrics` equal to what ``dvr eval`` repor
     r = dvr.Renderer(dvr.Scene(vol, tf="phantom-opaque"), size=(128, 128), denoisers=["ours", "svgf"])
     for _ in range(16):
         out = r.render()          # a still view keeps refining
-    r.orbit(40, 0)                # an edit: the next frames reproject it
+    r.orbit(20, 0)                # an edit (degrees): the next frames reproject it
     r.lights[0].intensity = 30
     out = r.render()
     ref = r.reference(spp=256)    # of the current view
@@ -18,8 +18,19 @@ A scripted animation renders with ``r.render(frame=k)`` for k in order, as ``dvr
 does; :class:`dvr.Viewer` shows a live renderer in a notebook cell.
 """
 
-from . import _native, metrics
-from ._native import Volume
+import pathlib as _pathlib
+
+from . import _native
+
+# The wheel carries the presets, the MRI and the RAE networks (python/dvr/assets links
+# to the repository's assets/, followed when the wheel is built): the engine reads them
+# from here, not from the checkout it was built in. $DVR_ASSETS still overrides.
+_PACKAGED_ASSETS = _pathlib.Path(__file__).resolve().parent / "assets"
+if (_PACKAGED_ASSETS / "transfer").is_dir():
+    _native.set_assets_dir(str(_PACKAGED_ASSETS))
+
+from . import metrics  # noqa: E402
+from ._native import DataDroppedWarning, Volume  # noqa: E402
 from .scene import (
     AreaLight,
     Camera,
@@ -31,7 +42,7 @@ from .scene import (
     TransferFunction,
     builtin_scenes,
 )
-from .live import CameraView, LightsView, LightView, SettingsView
+from .live import CameraView, FieldError, LightsView, LightView, SettingsView
 from .renderer import Renderer, denoisers
 
 __all__ = [
@@ -40,6 +51,8 @@ __all__ = [
     "CameraView",
     "ClipPlane",
     "CropBox",
+    "DataDroppedWarning",
+    "FieldError",
     "EnvironmentLight",
     "LightView",
     "LightsView",
@@ -49,6 +62,7 @@ __all__ = [
     "SettingsView",
     "TransferFunction",
     "Viewer",
+    "assets_dir",
     "Volume",
     "builtin_scenes",
     "denoisers",
@@ -66,10 +80,19 @@ def __getattr__(name):
     raise AttributeError(f"module 'dvr' has no attribute {name!r}")
 
 
+def assets_dir() -> _pathlib.Path:
+    """The folder the presets, the bundled MRI and the RAE networks are read from: the
+    wheel's own copy, or ``$DVR_ASSETS`` when set."""
+    return _pathlib.Path(_native.assets_dir())
+
+
 def load_volume(path, gpu_memory=None) -> Volume:
     """Load a volume file as the CLI does: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr),
-    DICOM (a folder or a .dcm file), OME-Zarr (an image folder: its finest level that
+    DICOM (a folder or a .dcm file), numpy's .npy (1 mm voxels), OME-Zarr (an image folder: its finest level that
     a volume in memory holds and, with ``gpu_memory`` ("512M"), that fits that budget;
     or one level's folder inside it) or raw data with a ``<file>.json``/``.toml``
-    sidecar."""
-    return Volume.load(str(path), None if gpu_memory is None else str(gpu_memory))
+    sidecar. The voxels come back in RAS order (x along +Right, y +Anterior, z
+    +Superior, whatever the file's orientation: a flipped affine renders mirrored).
+    What a loader drops (extra channels or time points) raises a
+    :class:`DataDroppedWarning`."""
+    return Volume.load(str(path), None if gpu_memory is None else str(gpu_memory), _stacklevel=2)

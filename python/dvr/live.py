@@ -12,7 +12,21 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["CameraView", "ClipView", "ClipsView", "CropView", "LightView", "LightsView", "SettingsView"]
+__all__ = ["FieldError", "CameraView", "ClipView", "ClipsView", "CropView", "LightView", "LightsView", "SettingsView"]
+
+
+class FieldError(AttributeError, ValueError):
+    """A field that does not exist (a mistyped attribute of a volume, scene, camera or
+    light, or key of a TF point): an ``AttributeError`` that names the fields there
+    are, also a ``ValueError`` where a dict's key was the bad input."""
+
+
+# The keys each kind of [[light]] takes (engine/src/scene/light.rs, LightFile).
+LIGHT_FIELDS = {
+    "point": ("kind", "position", "colour", "intensity"),
+    "area": ("kind", "position", "target", "normal", "size", "colour", "intensity"),
+    "environment": ("kind", "mode", "colour", "top", "bottom", "map", "intensity"),
+}
 
 
 def _frozen(value):
@@ -68,7 +82,7 @@ class _Section:
 
     def _check_field(self, name):
         if self._fields and name not in self._fields:
-            raise AttributeError(f"{self._what} has no field {name!r} (fields: {', '.join(self._fields)})")
+            raise FieldError(f"{self._what} has no field {name!r} (fields: {', '.join(self._fields)})")
 
     def __getattr__(self, name):
         if name.startswith("_"):
@@ -78,7 +92,8 @@ class _Section:
             return _frozen(d[name])
         if name in self._fields:
             return None
-        raise AttributeError(f"{self._what} has no field {name!r} (it has: {', '.join(d)})")
+        fields = self._fields or tuple(d)
+        raise FieldError(f"{self._what} has no field {name!r} (fields: {', '.join(fields)})")
 
     def __setattr__(self, name, value):
         self.update(**{name: value})
@@ -124,10 +139,19 @@ class LightView(_Section):
     ``intensity``; an area light's ``target``, ``normal``, ``size``; an environment's
     ``mode``, ``top``, ``bottom``, ``map``)."""
 
+    @property
+    def _fields(self):
+        # A light's fields depend on its kind: a point light has no `size`.
+        return LIGHT_FIELDS.get(self._get().get("kind"), ())
+
     def update(self, **fields):
         if "color" in fields:
             fields["colour"] = fields.pop("color")
         d = dict(self._get())
+        allowed = LIGHT_FIELDS.get(fields.get("kind", d.get("kind")), ())
+        for k in fields:
+            if allowed and k not in allowed:
+                raise FieldError(f"{self._what} ({d.get('kind')} light) has no field {k!r} (fields: {', '.join(allowed)})")
         d.update({k: _plain(v) for k, v in fields.items()})
         self._put(d)
 

@@ -9,6 +9,9 @@ from . import _native
 from .live import CameraView, ClipsView, CropView, LightsView, SettingsView, _as_dict, _plain
 from .scene import Scene, TransferFunction
 
+# The explorer's left drag turns the camera 0.01 radians per pixel (engine/src/session).
+_RADIANS_PER_PIXEL = 0.01
+
 __all__ = ["Renderer", "denoisers"]
 
 
@@ -19,7 +22,8 @@ def denoisers() -> dict:
 
 
 class Renderer:
-    """Renders ``scene`` at ``size`` = (width, height) with ``spp`` samples per pixel per
+    """Renders ``scene`` (a :class:`Scene`, a :class:`Volume` or a 3-D numpy array, both
+    with :class:`Scene`'s defaults, a built-in scene name or a scene file) at ``size`` = (width, height) with ``spp`` samples per pixel per
     frame (default: the scene's) and runs each of ``denoisers`` on the same noisy
     frames. ``motion`` is what the temporal denoisers reproject with (``"features"`` or
     ``"first-hit"``, as the CLI's ``--motion``).
@@ -48,11 +52,19 @@ class Renderer:
     """
 
     def __init__(
-        self, scene: Scene, size=(128, 128), spp=None, denoisers=("ours",), motion="features", device=None,
+        self, scene, size=(128, 128), spp=None, denoisers=("ours",), motion="features", device=None,
         gpu_memory=None,
     ):
         if isinstance(scene, str):
             scene = Scene.builtin(scene) if scene in _native.builtin_scene_names() else Scene.load(scene)
+        elif isinstance(scene, (np.ndarray, _native.Volume)):
+            # A volume alone is a scene with the defaults (Scene checks an array is 3-D).
+            scene = Scene(scene)
+        elif not isinstance(scene, Scene):
+            raise TypeError(
+                f"Renderer: expected a Scene, a Volume, a 3-D numpy array, a built-in scene name or a scene "
+                f"file, got {type(scene).__name__}"
+            )
         if isinstance(denoisers, str):
             denoisers = [denoisers]
         size = _size(size)
@@ -152,7 +164,7 @@ class Renderer:
         path, a :class:`dvr.TransferFunction` or an ``(N, 5)`` array of ``density, r,
         g, b, opacity`` rows to change it; ``r.tf.copy()`` is an editable copy)."""
         d = self._r.tf()
-        return TransferFunction._frozen(d["a"]["point"], d["a"].get("name", "tf"))
+        return TransferFunction._frozen(d["a"]["point"], d["a"].get("name", "tf"), d["a"].get("units", "density"))
 
     @tf.setter
     def tf(self, tf):
@@ -180,9 +192,17 @@ class Renderer:
     def size(self, size):
         self._r.resize(*_size(size))
 
-    def orbit(self, dx, dy=0.0):
-        """Orbits the camera about its target as a left-drag of (dx, dy) pixels in the
-        explorer does (0.01 radians per pixel)."""
+    def orbit(self, degrees_x, degrees_y=0.0):
+        """Orbits the camera about its target by ``degrees_x`` about the up axis, the
+        way :meth:`Scene.orbit`'s positive degrees turn it (counter-clockwise seen from
+        above), and ``degrees_y`` of elevation (positive as a downward drag moves it)."""
+        scale = np.radians(1.0) / _RADIANS_PER_PIXEL
+        # A drag to the right turns the other way round from the scene's orbit.
+        self._r.orbit(-float(degrees_x) * scale, float(degrees_y) * scale)
+
+    def orbit_pixels(self, dx, dy=0.0):
+        """Orbits as a left drag of (dx, dy) pixels in the explorer does (0.01 radians
+        per pixel): what a mouse-driven view (:class:`dvr.Viewer`) calls."""
         self._r.orbit(float(dx), float(dy))
 
     def pan(self, dx, dy):

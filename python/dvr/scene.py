@@ -8,9 +8,10 @@ import types
 import numpy as np
 
 from . import _native
-from .live import CameraView, ClipsView, CropView, LightsView, _as_dict
+from .live import CameraView, ClipsView, CropView, FieldError, LightsView, _as_dict
 
 __all__ = [
+    "FieldError",
     "AreaLight",
     "Camera",
     "ClipPlane",
@@ -21,6 +22,19 @@ __all__ = [
     "TransferFunction",
     "builtin_scenes",
 ]
+
+
+# The keys of a TF file's [[point]] (engine/src/transfer/control_point.rs).
+POINT_FIELDS = ("density", "opacity", "diffuse", "specular", "emissive", "roughness")
+
+
+def _check_points(points):
+    for i, p in enumerate(points):
+        if not isinstance(p, dict):
+            raise TypeError(f"transfer function point {i}: expected a dict, got {type(p).__name__}")
+        for k in p:
+            if k not in POINT_FIELDS:
+                raise FieldError(f"transfer function point {i} has no field {k!r} (fields: {', '.join(POINT_FIELDS)})")
 
 
 def _vec(v, n, name):
@@ -36,7 +50,9 @@ def builtin_scenes() -> list:
 
 
 class TransferFunction:
-    """Control points mapping normalised density in [0, 1] to opacity and colour.
+    """Control points mapping normalised density in [0, 1] (or, with
+    ``units="data"``, the volume's data units: Hounsfield for CT, as the ``ct-*``
+    presets are written) to opacity and colour.
 
     Build one from a preset (:meth:`preset`), a TF file (:meth:`load`) or an ``(N, 5)``
     array of ``density, r, g, b, opacity`` rows (:meth:`from_array`). ``points`` is the
@@ -44,16 +60,20 @@ class TransferFunction:
     and optionally ``specular``, ``emissive``, ``roughness``), editable in place.
     """
 
-    def __init__(self, points, name="python"):
+    def __init__(self, points, name="python", units="density"):
         self.name = name
+        if units not in ("density", "data"):
+            raise ValueError(f"transfer function units: expected 'density' or 'data', got {units!r}")
+        self.units = units
+        _check_points(points)
         self.points = [dict(p) for p in points]
         _native.check_tf(self.to_dict())
 
     @classmethod
-    def _frozen(cls, points, name):
+    def _frozen(cls, points, name, units="density"):
         """An immutable TF (what a renderer hands out: its TF changes only by
         assignment, so an edit of a copy must not look as if it applied)."""
-        tf = cls(points, name)
+        tf = cls(points, name, units)
         tf.points = tuple(types.MappingProxyType(dict(p)) for p in tf.points)
         object.__setattr__(tf, "_immutable", True)
         return tf
@@ -68,7 +88,7 @@ class TransferFunction:
 
     def copy(self) -> "TransferFunction":
         """An editable copy."""
-        return TransferFunction([dict(p) for p in self.points], self.name)
+        return TransferFunction([dict(p) for p in self.points], self.name, self.units)
 
     @classmethod
     def coerce(cls, tf) -> "TransferFunction":
@@ -84,7 +104,7 @@ class TransferFunction:
         if isinstance(tf, dict):
             if "point" not in tf:
                 raise ValueError("transfer function: a TF dict needs a 'point' list")
-            return cls(tf["point"], tf.get("name", "python"))
+            return cls(tf["point"], tf.get("name", "python"), tf.get("units", "density"))
         if hasattr(tf, "__fspath__"):
             return cls.load(tf)
         if isinstance(tf, (list, tuple, np.ndarray)):
@@ -98,13 +118,13 @@ class TransferFunction:
     def preset(cls, name: str) -> "TransferFunction":
         """A shipped preset (see :meth:`presets`)."""
         d = _native.tf_preset(name)
-        return cls(d["point"], d.get("name", name))
+        return cls(d["point"], d.get("name", name), d.get("units", "density"))
 
     @classmethod
     def load(cls, path) -> "TransferFunction":
         """A TF file (TOML, as in ``assets/transfer/``)."""
         d = _native.tf_file(str(path))
-        return cls(d["point"], d.get("name", str(path)))
+        return cls(d["point"], d.get("name", str(path)), d.get("units", "density"))
 
     @classmethod
     def from_array(cls, array, name="python") -> "TransferFunction":
@@ -125,10 +145,16 @@ class TransferFunction:
         return list(_native.tf_preset_names())
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "point": [dict(p) for p in self.points]}
+        d = {"name": self.name, "point": [dict(p) for p in self.points]}
+        if self.units == "data":
+            # Densities in the volume's data units (Hounsfield for CT): the engine maps
+            # them through the volume's window when the scene is set up.
+            d["units"] = "data"
+        return d
 
     def __repr__(self):
-        return f"TransferFunction({self.name!r}, {len(self.points)} points)"
+        units = ", units='data'" if self.units == "data" else ""
+        return f"TransferFunction({self.name!r}, {len(self.points)} points{units})"
 
 
 class Camera:
@@ -244,6 +270,8 @@ class Scene:
     """A volume, a transfer function, a camera, lights, render settings and an
     animation: what a scene file holds.
 
+    ``volume`` is a :class:`Volume`, a 3-D numpy array indexed ``[z, y, x]`` (as
+    :class:`Volume` takes it, 1 mm voxels), a built-in dataset name or a volume file.
     ``Scene(volume)`` gives sensible defaults (a camera framing the volume, a key light
     and a soft environment, the ``phantom-opaque`` TF when none is given, one frame).
     ``Scene.builtin("phantom/orbit")`` and ``Scene.load("my.toml")`` open the CLI's
@@ -254,6 +282,9 @@ class Scene:
     def __init__(self, volume, tf=None, camera=None, lights=None, frames=1, density_scale=150.0, render=None, name="python"):
         from ._native import Volume
 
+        if isinstance(volume, np.ndarray):
+            # Volume checks the array (3-D, a volume dtype) and says what is wrong.
+            volume = Volume(volume)
         self.volume = None
         if isinstance(volume, Volume):
             self.volume = volume
@@ -389,6 +420,20 @@ class Scene:
 
     def _engine_dict(self) -> dict:
         return copy.deepcopy(self.data)
+
+    # What a scene has; assigning anything else is a mistyped field, not a new one.
+    _FIELDS = ("volume", "tf", "data", "name", "frames", "camera", "lights", "clip", "crop", "render_settings")
+
+    def __setattr__(self, name, value):
+        if name not in Scene._FIELDS:
+            raise FieldError(f"Scene has no field {name!r} (fields: {', '.join(Scene._FIELDS)})")
+        object.__setattr__(self, name, value)
+
+    def __getattr__(self, name):
+        # Only reached when normal lookup fails: a mistyped field.
+        if name.startswith("_"):
+            raise AttributeError(name)
+        raise FieldError(f"Scene has no field {name!r} (fields: {', '.join(Scene._FIELDS)})")
 
     def __repr__(self):
         return f"Scene({self.name!r}, frames={self.frames})"

@@ -11,12 +11,20 @@ mod metrics;
 mod renderer;
 mod scene;
 mod volume;
+mod warnings;
 
 use pyo3::prelude::*;
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    warnings::install();
+    m.add(
+        "DataDroppedWarning",
+        m.py().get_type::<warnings::DataDroppedWarning>(),
+    )?;
     m.add_class::<volume::Volume>()?;
+    m.add_function(wrap_pyfunction!(set_assets_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(assets_dir, m)?)?;
     m.add_class::<renderer::Renderer>()?;
     m.add_function(wrap_pyfunction!(renderer::denoiser_names, m)?)?;
     m.add_function(wrap_pyfunction!(renderer::unused_overrides, m)?)?;
@@ -42,4 +50,17 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[pyfunction]
 fn validation_messages() -> usize {
     dvr_engine::gpu::validation::message_count()
+}
+
+/// Makes `path` the assets folder (presets, the MRI, RAE networks) unless `$DVR_ASSETS`
+/// is set: the package calls it at import with the copy its wheel carries.
+#[pyfunction]
+fn set_assets_dir(path: std::path::PathBuf) {
+    dvr_engine::assets::set_assets_dir(path);
+}
+
+/// The assets folder in effect.
+#[pyfunction]
+fn assets_dir() -> std::path::PathBuf {
+    dvr_engine::assets::assets_dir()
 }

@@ -4,12 +4,28 @@
 //! `spacing` is given in the same axis order as the array's shape.
 
 use crate::convert::value_error;
+use crate::warnings;
 use dvr_engine::renderer::scene_setup::DEFAULT_VOLUME_SIZE;
 use dvr_engine::scene::parse_gpu_memory;
-use dvr_engine::volume::{Volume as EngineVolume, VolumeData, Voxels};
-use numpy::{PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
+use dvr_engine::volume::{SampleKind, Volume as EngineVolume, VolumeData, Voxels};
+use numpy::{
+    PyArray2, PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
+use pyo3::types::IntoPyDict;
 use std::path::PathBuf;
+
+/// The attributes a volume has (named when a mistyped one is asked for).
+const FIELDS: &[&str] = &[
+    "name",
+    "shape",
+    "spacing",
+    "window",
+    "dtype",
+    "stored_as",
+    "to_patient",
+    "data",
+];
 
 #[pyclass(module = "dvr._native", frozen)]
 pub struct Volume {
@@ -25,8 +41,8 @@ fn voxels_of<T: numpy::Element + Copy>(a: &Bound<'_, PyUntypedArray>) -> PyResul
 
 #[pymethods]
 impl Volume {
-    /// A volume from a 3-D numpy array indexed `[z, y, x]` (uint8, uint16, int16 or
-    /// float32) with `spacing` (mm) in the same order. Values are normalised to density
+    /// A volume from a 3-D numpy array indexed `[z, y, x]` (uint8, uint16, int16,
+    /// float32, or float64, held as float32) with `spacing` (mm) in the same order. Values are normalised to density
     /// by the rule the file loaders follow: float32 in [0, 1] is density as it is,
     /// anything else is windowed to its range.
     #[new]
@@ -74,31 +90,73 @@ impl Volume {
             Voxels::I16(voxels_of::<i16>(a)?)
         } else if dtype.is_equiv_to(&numpy::dtype::<f32>(py)) {
             Voxels::F32(voxels_of::<f32>(a)?)
+        } else if dtype.is_equiv_to(&numpy::dtype::<f64>(py)) {
+            // The GPU holds float32 at most; float64 is what numpy computes in, so it is
+            // common input and narrowing it is what a user would do by hand.
+            let wide = voxels_of::<f64>(a)?;
+            Voxels::F32(wide.into_iter().map(|x| x as f32).collect())
         } else {
             return Err(value_error(format!(
-                "{name}: dtype {dtype} is not a volume type (uint8, uint16, int16 or float32; \
-                 convert with .astype(numpy.float32))"
+                "{name}: dtype {dtype} is not a volume type (uint8, uint16, int16, float32 or \
+                 float64; convert with .astype(numpy.float32))"
             )));
         };
+        let wide = dtype.is_equiv_to(&numpy::dtype::<f64>(py));
         let spacing = [spacing.2 as f32, spacing.1 as f32, spacing.0 as f32];
-        let inner = py
+        let mut inner = py
             .detach(|| EngineVolume::from_voxels(name, dims, spacing, voxels))
             .map_err(value_error)?;
+        if wide {
+            // `dtype` reports what the user handed over, not the narrowed copy.
+            inner.sample_kind = SampleKind::F64;
+        }
         Ok(Self { inner })
     }
 
     /// Loads a volume file: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), DICOM (a folder or
-    /// a .dcm file) or raw data with a `<file>.json`/`.toml` sidecar, as the CLI does.
+    /// a .dcm file), numpy's .npy (a 3-D array `[z, y, x]`, 1 mm voxels) or raw data with a `<file>.json`/`.toml` sidecar, as the CLI does.
     /// `gpu_memory` ("512M"): of an OME-Zarr image's levels, the finest that fits it.
     #[staticmethod]
-    #[pyo3(signature = (path, gpu_memory = None))]
-    fn load(py: Python<'_>, path: PathBuf, gpu_memory: Option<String>) -> PyResult<Self> {
+    /// `_stacklevel`: whose line a dropped-data warning names (2 from `dvr.load_volume`,
+    /// so it is the user's line there too).
+    #[pyo3(signature = (path, gpu_memory = None, _stacklevel = 1))]
+    fn load(
+        py: Python<'_>,
+        path: PathBuf,
+        gpu_memory: Option<String>,
+        _stacklevel: i32,
+    ) -> PyResult<Self> {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("npy"))
+        {
+            // numpy's own format, read by numpy (no pickles: a .npy is data, not code);
+            // it states no voxel size, so 1 mm as for an array.
+            let array = py
+                .import("numpy")?
+                .getattr("load")?
+                .call(
+                    (path.as_os_str(),),
+                    Some(&[("allow_pickle", false)].into_py_dict(py)?),
+                )
+                .map_err(|e| value_error(format!("{}: {e}", path.display())))?;
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+            return Self::new(
+                py,
+                &array,
+                (1.0, 1.0, 1.0),
+                stem.as_deref().unwrap_or("npy"),
+            );
+        }
         let budget = gpu_memory
             .map(|s| parse_gpu_memory(&s).map_err(|e| value_error(format!("gpu_memory: {e}"))))
             .transpose()?;
-        let inner = py
-            .detach(|| EngineVolume::load_within(&path, None, budget))
-            .map_err(value_error)?;
+        // What the loader drops (extra channels, time points) it logs; the user sees it
+        // as a DataDroppedWarning rather than a line on stderr.
+        let (loaded, dropped) =
+            py.detach(|| warnings::capture(|| EngineVolume::load_within(&path, None, budget)));
+        let inner = loaded.map_err(value_error)?;
+        warnings::issue(py, &dropped, _stacklevel)?;
         Ok(Self { inner })
     }
 
@@ -141,9 +199,63 @@ impl Volume {
         (self.inner.window[0], self.inner.window[1])
     }
 
-    /// How the GPU stores it: `uint8`, `uint16` or `float32`.
+    /// The type the samples had in the array or file: `uint8`, `uint16`, `int16`,
+    /// `float32` or `float64`.
     #[getter]
     fn dtype(&self) -> &'static str {
+        self.inner.sample_kind.name()
+    }
+
+    /// Index `[z, y, x]` to patient space (RAS+, mm) as a 4×4 affine: `p = A @ (z, y,
+    /// x, 1)`. The voxels are stored in RAS order whatever the file's orientation (x
+    /// along +Right, y +Anterior, z +Superior), so its 3×3 part is the spacings on the
+    /// anti-diagonal: array axis 0 (z) steps along S, axis 2 (x) along R.
+    #[getter]
+    fn to_patient<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let t = &self.inner.to_patient;
+        let mut m = [[0.0f64; 4]; 4];
+        for (r, row) in m.iter_mut().take(3).enumerate() {
+            for (c, cell) in row.iter_mut().take(3).enumerate() {
+                // Array axis c is the engine's axis 2 - c.
+                *cell = t.axes[2 - c][r];
+            }
+            row[3] = t.origin[r];
+        }
+        m[3][3] = 1.0;
+        let array = numpy::ndarray::Array2::from_shape_fn((4, 4), |(r, c)| m[r][c]);
+        PyArray2::from_owned_array(py, array)
+    }
+
+    /// The normalised densities in [0, 1] as a float32 array indexed `[z, y, x]` (a
+    /// copy; the same as `to_numpy()`).
+    #[getter]
+    fn data<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f32>> {
+        self.to_numpy(py)
+    }
+
+    /// A mistyped attribute names the ones that exist (as cameras, lights and scenes do).
+    fn __getattr__(&self, name: &str) -> PyResult<()> {
+        Err(pyo3::exceptions::PyAttributeError::new_err(format!(
+            "Volume has no field '{name}' (fields: {})",
+            FIELDS.join(", ")
+        )))
+    }
+
+    fn __setattr__(&self, name: &str, _value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let what = if FIELDS.contains(&name) {
+            format!("Volume.{name} cannot be assigned: a volume is immutable")
+        } else {
+            format!(
+                "Volume has no field '{name}' (fields: {})",
+                FIELDS.join(", ")
+            )
+        };
+        Err(pyo3::exceptions::PyAttributeError::new_err(what))
+    }
+
+    /// How the GPU stores it: `uint8`, `uint16` (int16 is shifted into it) or `float32`.
+    #[getter]
+    fn stored_as(&self) -> &'static str {
         match self.inner.data {
             VolumeData::U8(_) => "uint8",
             VolumeData::U16(_) => "uint16",

@@ -236,11 +236,13 @@ def test_orbit_pan_and_zoom_move_the_camera_as_the_explorers_mouse_does():
     r = dvr.Renderer(dvr.Scene.builtin("phantom/orbit"), size=(32, 32), denoisers=["taa"])
     p0, t0 = np.array(r.camera.position), np.array(r.camera.target)
     d0 = np.linalg.norm(p0 - t0)
-    r.orbit(40, 0)  # 0.4 rad about +z, target and distance kept
+    r.orbit_pixels(40, 0)  # the explorer's drag: 0.4 rad about +z, target and distance kept
     p1 = np.array(r.camera.position)
     assert np.allclose(r.camera.target, t0) and np.isclose(np.linalg.norm(p1 - t0), d0)
     a0, a1 = np.arctan2(*(p0 - t0)[1::-1]), np.arctan2(*(p1 - t0)[1::-1])
     assert np.isclose((a0 - a1 + np.pi) % (2 * np.pi) - np.pi, 0.4)
+    r.orbit(np.degrees(0.4))  # degrees, as the scene's orbit turns: back to the start
+    assert np.allclose(r.camera.position, p0)
     r.zoom(2)
     assert np.isclose(np.linalg.norm(np.array(r.camera.position) - t0), d0 / 1.21)
     r.pan(0, 32)  # a full view height: the target moves by the view's height at its depth
