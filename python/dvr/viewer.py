@@ -62,7 +62,8 @@ _interrupt_installed = False
 # What the page's "view" buttons may ask for (dvr.Renderer.view_from's sides).
 _SIDES = tuple(Renderer.VIEWS)
 # The raw path-traced input, offered beside the denoisers: the renderer always returns
-# it (as "noisy"), and the engine's pass-through denoiser is "none".
+# it (as "noisy"); a renderer asked for the engine's pass-through, "none", runs no
+# denoiser at all (its `denoisers` is then empty).
 NOISY = "noisy"
 
 
@@ -127,7 +128,7 @@ class Viewer(anywidget.AnyWidget):
             if not isinstance(source, (Scene, str)):
                 source = Scene(source)
             names = _run_names(denoisers[0], split or "") + [d for d in denoisers[1:] if d != NOISY]
-            renderer, self._owns = Renderer(source, size=size, denoisers=list(dict.fromkeys(names)), **kwargs), True
+            renderer, self._owns = Renderer(source, size=size, denoisers=list(dict.fromkeys(names)) or ["none"], **kwargs), True
             shown = denoisers
         counts = renderer.histogram().astype(np.float64)
         info = panel.volume_info(renderer)
@@ -276,7 +277,10 @@ class Viewer(anywidget.AnyWidget):
 
         if self._display_id is None:
             self._display_id = f"dvr-viewer-{id(self):x}-{time.monotonic_ns():x}"
-        display(self._repr_mimebundle_(), raw=True, display_id=self._display_id)
+        bundle = self._repr_mimebundle_()
+        # ipywidgets hands back (data, metadata); older versions the data alone.
+        data, metadata = bundle if isinstance(bundle, tuple) else (bundle, {})
+        display(data, metadata=metadata, raw=True, display_id=self._display_id)
 
     def _leave_last_frame(self):
         """Replaces the widget in the cell's output with its last frame as a PNG (the
@@ -284,6 +288,7 @@ class Viewer(anywidget.AnyWidget):
         last, display_id = getattr(self, "_last", None), getattr(self, "_display_id", None)
         if last is None or display_id is None:
             return
+        self._display_id = None  # once: a second close (the finaliser's) leaves it be
         try:
             from IPython.display import update_display
 
@@ -509,9 +514,8 @@ def _send_frame(viewer, renderer, image, names, camera, seq, shown_at, seconds):
 
 def _run_names(left, right):
     """The denoisers a renderer runs to show `left` and `right`: "noisy" needs none (the
-    renderer always returns its input; "none" is the engine's pass-through)."""
-    names = [n for n in dict.fromkeys((left, right)) if n and n != NOISY]
-    return names or ["none"]
+    renderer always returns its input)."""
+    return [n for n in dict.fromkeys((left, right)) if n and n != NOISY]
 
 
 def _apply(renderer, edits):
@@ -521,7 +525,7 @@ def _apply(renderer, edits):
         if "denoisers" in edits:
             names = _run_names(*edits["denoisers"])
             if tuple(names) != renderer.denoisers:
-                renderer.denoisers = names
+                renderer.denoisers = names or ["none"]
         if "spp" in edits and edits["spp"] != renderer.spp:
             renderer.settings.spp = edits["spp"]
         if "preset" in edits:
@@ -533,7 +537,7 @@ def _apply(renderer, edits):
         if "crop" in edits:
             renderer.crop = edits["crop"] or None
         if edits.get("reset"):
-            renderer.reset_camera()
+            _reset_camera(renderer)
         if edits.get("fit"):
             renderer.fit()
         if "view" in edits:
@@ -547,6 +551,17 @@ def _apply(renderer, edits):
     except (ValueError, TypeError, RuntimeError) as e:
         return str(e)
     return ""
+
+
+def _reset_camera(renderer):
+    """The engine's reset (its orbit camera's home: target, distance, yaw, pitch, field
+    of view), then the scene's up vector where the view had another: the engine keeps
+    the current up through a reset, so after a superior or inferior view its reset
+    alone would not be the starting view."""
+    renderer.reset_camera()
+    home = renderer.scene.data.get("camera") if hasattr(renderer.scene, "data") else None
+    if home and "up" in home and not np.allclose(renderer.camera.up, home["up"]):
+        renderer.camera = dict(renderer.camera.to_dict(), **home)
 
 
 def _compose(out, left, right, position):

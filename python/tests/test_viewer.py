@@ -150,7 +150,7 @@ def test_bad_viewer_arguments_are_errors():
         dvr.Viewer("cloud/orbit", quality=0)
     with pytest.raises(ValueError, match="denoisers"):
         dvr.Viewer("cloud/orbit", denoisers=[])
-    assert viewer_module._tf_points("no") is None
+    assert viewer_module.panel.tf_points("no") is None
     # The half-made widgets' finalisers (close) run without an error of their own.
     gc.collect()
 
@@ -189,7 +189,7 @@ def test_the_tf_editor_follows_the_renderers_tf_by_any_road_and_keeps_every_fiel
     # A preset picked in the page, then an assignment from Python: each shows.
     v.preset = "phantom-vessels"
     wait_for("the page's preset applied", lambda: v.renderer.tf.name == "phantom-vessels")
-    v.renderer.tf = dvr.TransferFunction([{"density": 0.0, "opacity": 0.0}, {"density": 1.0, "opacity": 0.3}], "mine")
+    v.renderer.tf = dvr.TransferFunction.from_array([[0.0, 1, 1, 1, 0.0], [1.0, 1, 1, 1, 0.3]], "mine")
     wait_for("Python's TF in the panel", lambda: len(v.tf_points) == 2 and v.preset == "")
     # A TF the engine refuses leaves the panel showing the renderer's, not the refused.
     v.tf_points = [{"density": 0.0, "opacity": 7.0}, {"density": 1.0, "opacity": 0.0}]
@@ -199,14 +199,22 @@ def test_the_tf_editor_follows_the_renderers_tf_by_any_road_and_keeps_every_fiel
     assert viewer_module.panel.tf_points([{"density": 0, "opacity": 0, "glow": 1}]) is None
 
 
-def test_noisy_is_offered_as_a_denoiser_and_in_the_split(viewer):
+def test_noisy_is_offered_as_a_denoiser_and_in_the_split(viewer, monkeypatch):
     v, sent = viewer
+    # Every change of the renderer's denoisers, counted (each restarts the histories).
+    changes = []
+    prop = dvr.Renderer.denoisers
+    monkeypatch.setattr(dvr.Renderer, "denoisers", property(prop.fget, lambda r, names: (changes.append(list(names)), prop.fset(r, names))))
     assert v.methods[0] == "noisy" and "ours" in v.methods and "none" not in v.methods
     v.denoiser, v.split = "noisy", "ours"
     wait_for("the split of noisy and ours", lambda: frames_after(sent, v, len(sent.frames))[0]["names"] == ["noisy", "ours"])
     assert v.renderer.denoisers == ("ours",), "noisy needs no denoiser run"
     v.split = ""
-    wait_for("noisy alone", lambda: v.renderer.denoisers == ("none",))
+    wait_for("noisy alone: no denoiser runs", lambda: v.renderer.denoisers == ())
+    # Asked once, not again each frame (that would restart the histories each frame).
+    n = v.renderer.frames_rendered
+    wait_for("frames", lambda: v.renderer.frames_rendered > n + 3)
+    assert changes == [["none"]], changes
     content, _ = frames_after(sent, v, len(sent.frames))
     assert content["names"] == ["noisy"]
     # Shown alone, the frame is the renderer's raw input.
@@ -286,7 +294,8 @@ def test_reset_fit_and_side_buttons_move_the_camera(viewer):
     content, _ = frames_after(sent, v, len(sent.frames))
     assert content["orientation"]["top"] == "P" and content["orientation"]["left"] == "R"
     v._on_message(v, {"type": "reset"}, [])
-    wait_for("the camera reset", lambda: v.renderer.camera.to_dict() == start)
+    # Back to the start, up vector and all (the engine's own reset keeps the current up).
+    wait_for("the camera reset", lambda: v.renderer.camera.position == pytest.approx(start["position"]) and v.renderer.camera.up == pytest.approx(start["up"]))
     v._on_message(v, {"type": "zoom", "steps": 5}, [])
     wait_for("zoomed", lambda: v.renderer.camera.position != start["position"])
     zoomed = v.renderer.camera.to_dict()
@@ -322,6 +331,9 @@ def test_screenshot_is_a_lossless_png_at_render_size(viewer, tmp_path):
 
     v, sent = viewer
     frames_after(sent, v, 0)
+    # The render thread stopped, so the shown frame stays the one compared with.
+    v._stop.set()
+    v._thread.join()
     path = v.screenshot(tmp_path / "shot.png")
     w, h, rows = decode_png(path.read_bytes())
     assert (w, h) == (16, 16) and len(rows) == 16
@@ -330,6 +342,10 @@ def test_screenshot_is_a_lossless_png_at_render_size(viewer, tmp_path):
     assert v.captures[-1] == {"kind": "screenshot", "path": str(path.resolve())}
     content, buffers = next((c, b) for c, b in reversed(sent.frames) if c["type"] == "capture")
     assert content["mime"] == "image/png" and bytes(buffers[0]) == path.read_bytes()
+    # A second screenshot without a path goes to the captures folder.
+    v._capture_dir = tmp_path / "captures"
+    default = v.screenshot()
+    assert default.parent == tmp_path / "captures" and default.read_bytes() == path.read_bytes()
 
 
 def test_movie_is_an_orbit_mp4_and_the_camera_comes_back(viewer, tmp_path):
@@ -386,7 +402,7 @@ def test_a_closed_viewer_leaves_its_last_frame_in_the_output(monkeypatch):
     monkeypatch.setattr(IPython.display, "update_display", lambda *a, **k: updated.append((a, k)))
     v = dvr.Viewer("cloud/orbit", size=(12, 10), denoisers=["ours"])
     v._ipython_display_()
-    (bundle,), kw = shown[0]
+    (bundle,), kw = shown[-1]
     assert "application/vnd.jupyter.widget-view+json" in bundle and kw["display_id"]
     wait_for("a frame", lambda: v._last is not None)
     v.close()
