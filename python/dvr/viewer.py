@@ -263,12 +263,12 @@ class Viewer(anywidget.AnyWidget):
         """Lists a capture in the panel and sends its bytes for the page's download
         link (a movie only when small enough for one message)."""
         path = pathlib.Path(path).resolve()
-        self.captures = self.captures + [{"kind": kind, "path": str(path)}]
-        size = path.stat().st_size
-        if size <= 32 << 20:
+        # The bytes first: the page lists the capture with its link in one go.
+        if path.stat().st_size <= 32 << 20:
             mime = "image/png" if kind == "screenshot" else "video/mp4"
             self.send({"type": "capture", "kind": kind, "path": str(path), "name": path.name, "mime": mime},
                       buffers=[path.read_bytes()])
+        self.captures = self.captures + [{"kind": kind, "path": str(path)}]
 
     # The cell's output: the widget, and its last frame once closed.
 

@@ -144,7 +144,9 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
     shot.wait_for(timeout=60_000)
     png = pathlib.Path(shot.get_attribute("data-path"))
     assert decode_png(png.read_bytes())[:2] == (48, 48)
-    assert shot.locator("a[download]").count() == 1
+    # The download link holds the file's bytes.
+    href = shot.locator("a[download]").get_attribute("href", timeout=30_000)
+    assert page.evaluate("async (u) => (await (await fetch(u)).arrayBuffer()).byteLength", href) == png.stat().st_size
     page.click(".dvr-movie")
     movie = page.locator(".dvr-capture-movie")
     movie.wait_for(timeout=300_000)
