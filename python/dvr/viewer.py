@@ -398,20 +398,26 @@ class Viewer(anywidget.AnyWidget):
         changed = {k: v for k, v in state.items() if self._shown.get(k) != v}
         if not changed:
             return
+        # (No hold_sync here: its flag is the widget's, shared with the kernel's thread
+        # applying the page's changes; each trait goes in a message of its own.)
         self._local.syncing = True
         try:
-            with self.hold_sync():
-                if "tf" in changed:
-                    points, name = changed["tf"]
-                    self.tf_points = [dict(p) for p in points]
-                    self.preset = name if name in self.presets else ""
-                if "clip" in changed:
-                    self.clip_planes = changed["clip"]
-                if "crop" in changed:
-                    crop = changed["crop"]
-                    self.crop_box = {k: crop[k] for k in ("min", "max", "enabled") if k in crop} if crop.get("units", "box") == "box" else {}
-                if "spp" in changed:
-                    self.spp = changed["spp"]
+            if "tf" in changed:
+                points, name = changed["tf"]
+                self.tf_points = [dict(p) for p in points]
+                self.preset = name if name in self.presets else ""
+            if "clip" in changed:
+                self.clip_planes = changed["clip"]
+            if "crop" in changed:
+                crop = changed["crop"]
+                if crop.get("units", "box") == "box":
+                    self.crop_box = {k: crop[k] for k in ("min", "max", "enabled") if k in crop}
+                else:
+                    # The sliders are in the box's units; a crop in voxels stays Python's.
+                    self.crop_box = {}
+                    self.status = "the crop box is in voxels: the sliders show none (edit it from Python, or move one to replace it)"
+            if "spp" in changed:
+                self.spp = changed["spp"]
         finally:
             self._local.syncing = False
         self._shown.update(changed)
