@@ -76,11 +76,13 @@ class Movie:
 
     def finish(self):
         """Waits for ffmpeg; the movie is at its path after this, or an error says why."""
+        if self.frames == 0:
+            self.abort()
+            raise RuntimeError(f"{self.path}: no frames were added")
         _, err = self._proc.communicate()
-        if self._proc.returncode != 0 or self.frames == 0:
+        if self._proc.returncode != 0:
             self._cleanup()
-            why = err.decode(errors="replace").strip() or "no frames"
-            raise RuntimeError(f"{FFMPEG} failed ({self._proc.returncode}) writing {self.path}: {why}")
+            raise RuntimeError(f"{FFMPEG} failed ({self._proc.returncode}) writing {self.path}: {err.decode(errors='replace').strip()}")
         os.replace(self.partial, self.path)
         return self.path
 

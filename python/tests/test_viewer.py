@@ -366,6 +366,28 @@ def test_movie_is_an_orbit_mp4_and_the_camera_comes_back(viewer, tmp_path):
     assert len(list((tmp_path / "captures").glob("*.png"))) == 1
 
 
+def test_a_movie_pads_odd_sizes_and_leaves_no_file_when_it_fails(tmp_path):
+    from lab import ffprobe_frames
+
+    capture = viewer_module.capture
+    movie = capture.Movie(tmp_path / "odd.mp4", fps=10)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        movie.add(rng.random((11, 15, 3), dtype=np.float32))
+    # yuv420p takes even sizes only: one black column and row are added.
+    assert ffprobe_frames(movie.finish()) == (3, 16, 12)
+    # A frame of another size, and a movie of no frames, are errors that leave nothing.
+    bad = capture.Movie(tmp_path / "bad.mp4")
+    bad.add(np.zeros((8, 8, 3), np.float32))
+    with pytest.raises(ValueError, match="a frame is 4x4"):
+        bad.add(np.zeros((4, 4, 3), np.float32))
+    with pytest.raises(RuntimeError, match="no frames"):
+        capture.Movie(tmp_path / "empty.mp4").finish()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["odd.mp4"]
+    with pytest.raises(ValueError, match="fps"):
+        capture.Movie(tmp_path / "x.mp4", fps=0)
+
+
 def test_cuts_from_the_page_clip_and_crop(viewer):
     v, sent = viewer
     plane = {"point": [0.0, 0.0, 0.1], "normal": [0.0, 0.0, 1.0], "enabled": True}
