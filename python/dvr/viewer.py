@@ -130,9 +130,14 @@ class Viewer(anywidget.AnyWidget):
             names = _run_names(denoisers[0], split or "") + [d for d in denoisers[1:] if d != NOISY]
             renderer, self._owns = Renderer(source, size=size, denoisers=list(dict.fromkeys(names)) or ["none"], **kwargs), True
             shown = denoisers
-        counts = renderer.histogram().astype(np.float64)
-        info = panel.volume_info(renderer)
-        limit = panel.spp_limit(renderer)
+        try:
+            counts = renderer.histogram().astype(np.float64)
+            info = panel.volume_info(renderer)
+            limit = panel.spp_limit(renderer)
+        except BaseException:
+            if self._owns:
+                renderer.close()  # made here: its device memory goes now, not at GC
+            raise
         super().__init__(
             denoiser=shown[0],
             split=split or "",

@@ -123,7 +123,7 @@ def spp_limit(renderer):
         return limit
     try:
         renderer.settings.spp = limit
-    except ValueError as e:
+    except (ValueError, RuntimeError) as e:
         m = re.search(r"1 to (\d+) samples", str(e))
         return int(m.group(1)) if m else None
     renderer.settings.spp = current

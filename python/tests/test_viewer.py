@@ -326,6 +326,21 @@ def test_frames_carry_the_orientation_and_a_scale_bar_in_mm(viewer):
     assert {o["left"], o["right"]} in ({"R", "L"}, {"A", "P"}, {"S", "I"})
 
 
+def test_a_volumes_window_and_physical_size_reach_the_panel(monkeypatch):
+    monkeypatch.setattr(dvr.Viewer, "send", lambda self, content, buffers=None: None)
+    # [z, y, x] with spacing in that order: extents z 20 mm, y 20 mm, x 15 mm.
+    data = (np.arange(10 * 20 * 30).reshape(10, 20, 30) % 1000).astype(np.int16)
+    volume = dvr.Volume(data, spacing=(2.0, 1.0, 0.5))
+    v = dvr.Viewer(volume, size=(8, 8), denoisers=["none"])
+    try:
+        assert v.volume["shape"] == [30, 20, 10] and v.volume["spacing"] == [0.5, 1.0, 2.0]
+        assert v.volume["physical"] == pytest.approx(20.0)
+        # The TF axis is labelled in the data's values: the window the engine chose.
+        assert v.volume["window"] == pytest.approx(list(volume.window)) and volume.window[1] > 1
+    finally:
+        v.close()
+
+
 def test_screenshot_is_a_lossless_png_at_render_size(viewer, tmp_path):
     from lab import decode_png
 
