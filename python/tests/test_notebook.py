@@ -63,6 +63,7 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
             "print('tf', json.dumps([dict(p) for p in v.renderer.tf.points]))",
             "v.renderer.tf = 'phantom-vessels'",
             "print('clip', json.dumps(v.renderer.clip.to_list()))",
+            "print('spp', v.renderer.spp)",
         ],
     )
     page = browser.new_page(viewport={"width": 1400, "height": 1200})
@@ -74,11 +75,18 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
     counter = int(page.locator(".dvr-frame-counter").inner_text())
     assert counter >= later[0] > first[0]
     # The spp box shows the device's limit and holds only what the renderer takes.
-    assert page.locator(".dvr-spp").get_attribute("max") == page.locator(".dvr-spp-range").inner_text().strip("()").split("–")[1]
+    limit = page.locator(".dvr-spp").get_attribute("max")
+    assert limit == page.locator(".dvr-spp-range").inner_text().strip("()").split("–")[1]
+    page.fill(".dvr-spp", "99")
+    page.locator(".dvr-spp").blur()  # the box's change event: its value committed
+    wait_for("the box clamped to the limit", lambda: page.locator(".dvr-spp").input_value() == limit)
+    assert "99" in page.locator(".dvr-status").inner_text()
+    wait_for("the limit's spp in the kernel", lambda: nb.run(7).strip() == f"spp {limit}")
 
     # A left drag orbits the camera (the kernel's camera moves), and the page says how
     # many frames the drag took to show.
     before = nb.run(1)
+    page.locator(".dvr-stage").scroll_into_view_if_needed()  # running a cell scrolls
     box = page.locator(".dvr-stage").bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
     page.mouse.move(x, y)
