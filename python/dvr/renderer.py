@@ -222,11 +222,50 @@ class Renderer:
         """Flies to fit the volume, keeping the viewing direction."""
         self._r.fit()
 
-    def view_from(self, side):
-        """Looks at the volume from one side of the patient: ``"anterior"``,
-        ``"posterior"``, ``"left"``, ``"right"``, ``"superior"`` or ``"inferior"``
-        (world space is patient RAS), keeping the target and the distance."""
-        self._r.view_from(str(side))
+    # Where each named side's camera sits (a unit vector from the target) and its up
+    # vector, in world space = patient RAS (+x Right, +y Anterior, +z Superior). The
+    # up vectors follow the radiological convention, the patient's right on the
+    # screen's left, wherever that is a free choice: the anterior view (facing the
+    # patient) and the inferior view (from the feet, anterior up, as axial slices are
+    # read) give it by themselves; the superior view looks down with anterior at the
+    # bottom so the right stays on the left. The posterior, left and right views have
+    # +z up, so the patient's right is necessarily on the screen's right from behind.
+    VIEWS = {
+        "anterior": ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
+        "posterior": ((0.0, -1.0, 0.0), (0.0, 0.0, 1.0)),
+        "left": ((-1.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
+        "right": ((1.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
+        "superior": ((0.0, 0.0, 1.0), (0.0, -1.0, 0.0)),
+        "inferior": ((0.0, 0.0, -1.0), (0.0, 1.0, 0.0)),
+    }
+
+    def view_from(self, side, elevation=0.0, azimuth=0.0):
+        """Moves the camera to look at its target from ``side`` (``"anterior"``,
+        ``"posterior"``, ``"left"``, ``"right"``, ``"superior"`` or ``"inferior"``: the
+        patient's side, world space being RAS), keeping the target and the distance;
+        then turns it ``azimuth`` degrees about the view's up vector and ``elevation``
+        degrees toward it. One edit: temporal denoisers reproject across it."""
+        if side not in self.VIEWS:
+            raise ValueError(f"view_from: side={side!r}, expected one of {', '.join(self.VIEWS)}")
+        for name, v in (("elevation", elevation), ("azimuth", azimuth)):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
+                raise ValueError(f"view_from: {name}={v!r} must be a finite number of degrees")
+        if abs(elevation) >= 90:
+            # At ±90° the view direction is the up vector: no camera basis.
+            raise ValueError(f"view_from: elevation={elevation!r} must be within (-90, 90) degrees")
+        direction, up = (np.array(v) for v in self.VIEWS[side])
+        with self._edit:
+            view = self._r.view()
+            cam = view["camera"]
+            target = np.asarray(cam["target"], dtype=np.float64)
+            distance = float(np.linalg.norm(np.asarray(cam["position"], dtype=np.float64) - target))
+            a, e = np.radians(float(azimuth)), np.radians(float(elevation))
+            side_axis = np.cross(up, direction)
+            d = np.cos(e) * (np.cos(a) * direction + np.sin(a) * side_axis) + np.sin(e) * up
+            new_up = up if e == 0 else np.cross(np.cross(d, up), d)
+            cam["position"] = (target + distance * d).tolist()
+            cam["up"] = (new_up / np.linalg.norm(new_up)).tolist()
+            self._r.set_view(view)
 
     # The rest.
 

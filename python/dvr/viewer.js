@@ -27,50 +27,99 @@ function select(options, value, onchange, extra = []) {
   return s;
 }
 
-// The TF editor: the opacity curve of the control points over the density histogram.
-// Drag a point, double-click to add one, shift-click a point to remove it.
-function tfEditor(model) {
-  const W = 240, H = 110;
-  const svg = document.createElementNS(SVG, "svg");
-  svg.setAttribute("class", "dvr-tf");
-  svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+function svgEl(tag, attrs = {}, text = null) {
+  const e = document.createElementNS(SVG, tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  if (text !== null) e.textContent = text;
+  return e;
+}
+
+const clamp01 = (v) => Math.min(1, Math.max(0, v));
+const rgb = (c) => `rgb(${(c || [1, 1, 1]).map((v) => Math.round(255 * clamp01(v))).join(",")})`;
+
+// A tick label: `v` with as many decimals as its range needs.
+function tickLabel(v, span) {
+  const digits = span >= 100 ? 0 : span >= 10 ? 1 : 2;
+  return v.toFixed(digits);
+}
+
+// The TF editor: the opacity curve of the control points over the density histogram,
+// with axes (density 0..1, or the volume's data values where its window maps other
+// values to 0..1) and a colour bar (the TF's colour, and that colour at its opacity
+// over a checkerboard). Drag a point, double-click to add one, shift-click a point to
+// remove it. It always shows the kernel's `tf_points` (the renderer's TF, whoever set
+// it); every field of a point (specular, emissive, roughness too) is kept in edits.
+function tfEditor(model, uid) {
+  const W = 210, H = 100, L = 30, T = 6, BAR = 8;
+  const VW = L + W + 6, VH = T + H + 4 + 2 * BAR + 26;
+  const svg = svgEl("svg", { class: "dvr-tf", viewBox: `0 0 ${VW} ${VH}` });
   let points = [];
-  let dragging = -1;
-  const toX = (d) => d * W, toY = (o) => H - o * H;
+  let dragging = -1, stale = false;
+  const toX = (d) => L + d * W, toY = (o) => T + H - o * H;
   const fromEvent = (ev) => {
-    const r = svg.getBoundingClientRect();
-    const x = Math.min(1, Math.max(0, (ev.clientX - r.left) / r.width));
-    const y = Math.min(1, Math.max(0, 1 - (ev.clientY - r.top) / r.height));
-    return [x, y];
+    const p = svg.createSVGPoint();
+    p.x = ev.clientX;
+    p.y = ev.clientY;
+    const q = p.matrixTransform(svg.getScreenCTM().inverse());
+    return [clamp01((q.x - L) / W), clamp01((T + H - q.y) / H)];
   };
-  const colour = (p) => {
-    const c = p.diffuse || [1, 1, 1];
-    return `rgb(${c.map((v) => Math.round(255 * Math.min(1, Math.max(0, v)))).join(",")})`;
-  };
+  function axes() {
+    const vol = model.get("volume") || {};
+    const win = vol.window;
+    // Data units only where they differ from density: a [0, 1] window is density.
+    const data = win && !(win[0] === 0 && win[1] === 1);
+    const g = svgEl("g", { class: "dvr-axes" });
+    g.append(svgEl("line", { x1: L, y1: T + H, x2: L + W, y2: T + H }));
+    g.append(svgEl("line", { x1: L, y1: T, x2: L, y2: T + H }));
+    for (const d of [0, 0.25, 0.5, 0.75, 1]) {
+      const v = data ? win[0] + d * (win[1] - win[0]) : d;
+      g.append(svgEl("line", { x1: toX(d), y1: T + H, x2: toX(d), y2: T + H + 3 }));
+      const anchor = d === 0 ? "start" : d === 1 ? "end" : "middle";
+      g.append(svgEl("text", { x: toX(d), y: VH - 13, "text-anchor": anchor, class: "dvr-tick" }, tickLabel(v, data ? Math.abs(win[1] - win[0]) : 1)));
+    }
+    for (const o of [0, 0.5, 1]) {
+      g.append(svgEl("line", { x1: L - 3, y1: toY(o), x2: L, y2: toY(o) }));
+      g.append(svgEl("text", { x: L - 5, y: toY(o) + 3, "text-anchor": "end", class: "dvr-tick" }, o.toFixed(1)));
+    }
+    const title = data ? `data value (window ${tickLabel(win[0], win[1] - win[0])} – ${tickLabel(win[1], win[1] - win[0])} → density 0–1)` : "density";
+    g.append(svgEl("text", { x: L + W / 2, y: VH - 2, "text-anchor": "middle", class: "dvr-axis-title" }, title));
+    g.append(svgEl("text", { x: 8, y: T + H / 2, "text-anchor": "middle", class: "dvr-axis-title", transform: `rotate(-90 8 ${T + H / 2})` }, "opacity"));
+    return g;
+  }
+  function colourBar() {
+    // Gradients between the points as the engine interpolates them (linearly in
+    // density); before the first and after the last point the end values hold.
+    const defs = svgEl("defs");
+    const colour = svgEl("linearGradient", { id: `${uid}-c`, x1: 0, x2: 1, y1: 0, y2: 0 });
+    const alpha = svgEl("linearGradient", { id: `${uid}-a`, x1: 0, x2: 1, y1: 0, y2: 0 });
+    for (const p of points) {
+      colour.append(svgEl("stop", { offset: p.density, "stop-color": rgb(p.diffuse) }));
+      alpha.append(svgEl("stop", { offset: p.density, "stop-color": rgb(p.diffuse), "stop-opacity": clamp01(p.opacity) }));
+    }
+    const check = svgEl("pattern", { id: `${uid}-k`, width: 8, height: 8, patternUnits: "userSpaceOnUse" });
+    check.append(svgEl("rect", { width: 8, height: 8, fill: "#999" }));
+    check.append(svgEl("rect", { width: 4, height: 4, fill: "#555" }));
+    check.append(svgEl("rect", { x: 4, y: 4, width: 4, height: 4, fill: "#555" }));
+    defs.append(colour, alpha, check);
+    const y = T + H + 4;
+    const g = svgEl("g", { class: "dvr-colour-bar" });
+    g.append(defs);
+    g.append(svgEl("rect", { x: L, y, width: W, height: BAR, fill: `url(#${uid}-c)` }));
+    g.append(svgEl("rect", { x: L, y: y + BAR, width: W, height: BAR, fill: `url(#${uid}-k)` }));
+    g.append(svgEl("rect", { x: L, y: y + BAR, width: W, height: BAR, fill: `url(#${uid}-a)`, class: "dvr-opacity-bar" }));
+    return g;
+  }
   function draw() {
     svg.replaceChildren();
     const hist = model.get("histogram") || [];
     const bw = W / Math.max(1, hist.length);
-    hist.forEach((h, i) => {
-      const r = document.createElementNS(SVG, "rect");
-      r.setAttribute("x", i * bw);
-      r.setAttribute("y", H - h * H);
-      r.setAttribute("width", bw + 0.2);
-      r.setAttribute("height", h * H);
-      r.setAttribute("class", "dvr-hist");
-      svg.append(r);
-    });
-    const line = document.createElementNS(SVG, "polyline");
-    line.setAttribute("points", points.map((p) => `${toX(p.density)},${toY(p.opacity)}`).join(" "));
-    line.setAttribute("class", "dvr-curve");
-    svg.append(line);
+    svg.append(svgEl("rect", { x: L, y: T, width: W, height: H, class: "dvr-plot" }));
+    hist.forEach((h, i) => svg.append(svgEl("rect", { x: L + i * bw, y: T + H - h * H, width: bw + 0.2, height: h * H, class: "dvr-hist" })));
+    svg.append(axes());
+    if (points.length) svg.append(colourBar());
+    svg.append(svgEl("polyline", { points: points.map((p) => `${toX(p.density)},${toY(p.opacity)}`).join(" "), class: "dvr-curve" }));
     points.forEach((p, i) => {
-      const c = document.createElementNS(SVG, "circle");
-      c.setAttribute("cx", toX(p.density));
-      c.setAttribute("cy", toY(p.opacity));
-      c.setAttribute("r", 4.5);
-      c.setAttribute("fill", colour(p));
-      c.setAttribute("class", "dvr-point");
+      const c = svgEl("circle", { cx: toX(p.density), cy: toY(p.opacity), r: 4.5, fill: rgb(p.diffuse), class: "dvr-point" });
       c.addEventListener("pointerdown", (ev) => {
         ev.stopPropagation();
         if (ev.shiftKey && points.length > 1) {
@@ -103,36 +152,156 @@ function tfEditor(model) {
     if (dragging >= 0) {
       dragging = -1;
       commit();
+      if (stale) load();
     }
   });
   svg.addEventListener("dblclick", (ev) => {
     const [x, y] = fromEvent(ev);
-    // The new point takes the colour of its nearest neighbour.
+    // The new point takes every other field (colours, specular, emission, roughness)
+    // of its nearest neighbour.
     let near = points[0];
     for (const p of points) if (Math.abs(p.density - x) < Math.abs(near.density - x)) near = p;
-    points.push({ density: x, opacity: y, diffuse: [...(near ? near.diffuse || [1, 1, 1] : [1, 1, 1])] });
+    points.push({ ...structuredClone(near || { diffuse: [1, 1, 1] }), density: x, opacity: y });
     commit();
   });
-  const load = () => {
-    points = (model.get("tf_points") || []).map((p) => ({ ...p }));
+  // The kernel's TF replaces the shown one, except under a drag (then right after it).
+  function load() {
+    if (dragging >= 0) {
+      stale = true;
+      return;
+    }
+    stale = false;
+    points = (model.get("tf_points") || []).map((p) => structuredClone(p));
     draw();
-  };
+  }
   model.on("change:tf_points", load);
   model.on("change:histogram", draw);
+  model.on("change:volume", draw);
   load();
   return svg;
 }
 
+function button(label, cls, onclick) {
+  return el("button", { class: `dvr-button ${cls}`, type: "button", onclick }, label);
+}
+
+function slider(min, max, step, value, oninput, cls = "") {
+  const s = el("input", { type: "range", min, max, step, class: cls });
+  s.value = value;
+  s.addEventListener("input", () => oninput(parseFloat(s.value)));
+  return s;
+}
+
+// The cuts panel: clip planes (an axis-aligned plane added at the centre, its offset
+// dragged along its normal, flipped, switched off, removed) and the crop box (a min and
+// max slider per axis, in the box's units: -0.5 to 0.5). It shows the kernel's
+// `clip_planes` and `crop_box`, whoever set them.
+function cutsPanel(model) {
+  const AXES = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] };
+  const planesEl = el("div", { class: "dvr-clips" });
+  const axis = select(Object.keys(AXES), "z", () => {});
+  axis.classList.add("dvr-clip-axis");
+  const save = (planes) => {
+    model.set("clip_planes", planes);
+    model.save_changes();
+  };
+  const norm = (n) => Math.hypot(...n) || 1;
+  const offsetOf = (p) => p.point.reduce((s, v, i) => s + v * p.normal[i], 0) / norm(p.normal);
+  const add = button("add clip plane", "dvr-add-clip", () => {
+    const planes = structuredClone(model.get("clip_planes") || []);
+    if (planes.length >= 6) return;
+    planes.push({ point: [0, 0, 0], normal: AXES[axis.value], enabled: true });
+    save(planes);
+  });
+  function drawPlanes() {
+    const planes = model.get("clip_planes") || [];
+    add.disabled = planes.length >= 6;
+    planesEl.replaceChildren(...planes.map((p, i) => {
+      const edit = (f) => {
+        const all = structuredClone(model.get("clip_planes") || []);
+        f(all[i]);
+        save(all);
+      };
+      const n = p.normal.map((v) => v / norm(p.normal));
+      const on = el("input", { type: "checkbox", title: "enabled" });
+      on.checked = p.enabled !== false;
+      on.addEventListener("change", () => edit((q) => (q.enabled = on.checked)));
+      return el("div", { class: "dvr-clip" },
+        on,
+        el("span", { class: "dvr-clip-normal" }, `n=(${n.map((v) => v.toFixed(2)).join(",")})`),
+        slider("-0.87", "0.87", "0.01", offsetOf(p), (v) => edit((q) => (q.point = n.map((c) => c * v))), "dvr-clip-offset"),
+        button("flip", "dvr-clip-flip", () => edit((q) => (q.normal = q.normal.map((c) => -c)))),
+        button("×", "dvr-clip-remove", () => save((model.get("clip_planes") || []).filter((_, j) => j !== i))));
+    }));
+  }
+  const crop = el("input", { type: "checkbox", class: "dvr-crop-on" });
+  const cropSliders = {};
+  const cropRows = ["x", "y", "z"].map((a, i) => {
+    cropSliders[a] = [
+      slider("-0.5", "0.5", "0.01", -0.5, () => sendCrop(), `dvr-crop-${a}-min`),
+      slider("-0.5", "0.5", "0.01", 0.5, () => sendCrop(), `dvr-crop-${a}-max`),
+    ];
+    return el("div", { class: "dvr-crop-row" }, `${a} `, ...cropSliders[a]);
+  });
+  function sendCrop() {
+    if (!crop.checked) crop.checked = true;
+    const lo = [], hi = [];
+    for (const a of ["x", "y", "z"]) {
+      let [a0, a1] = cropSliders[a].map((s) => parseFloat(s.value));
+      if (a0 > a1 - 0.01) a0 = a1 - 0.01; // the engine takes min < max only
+      lo.push(Math.max(-0.5, a0));
+      hi.push(Math.max(-0.49, a1));
+    }
+    model.set("crop_box", { min: lo, max: hi, enabled: true });
+    model.save_changes();
+  }
+  crop.addEventListener("change", () => {
+    if (crop.checked) sendCrop();
+    else {
+      model.set("crop_box", {});
+      model.save_changes();
+    }
+  });
+  function drawCrop() {
+    const box = model.get("crop_box") || {};
+    crop.checked = !!box.min && box.enabled !== false;
+    ["x", "y", "z"].forEach((a, i) => {
+      cropSliders[a][0].value = box.min ? box.min[i] : -0.5;
+      cropSliders[a][1].value = box.max ? box.max[i] : 0.5;
+    });
+  }
+  model.on("change:clip_planes", drawPlanes);
+  model.on("change:crop_box", drawCrop);
+  drawPlanes();
+  drawCrop();
+  return el("details", { class: "dvr-cuts" },
+    el("summary", {}, "cuts"),
+    el("div", { class: "dvr-row" }, axis, add),
+    planesEl,
+    el("label", {}, crop, "crop box"),
+    ...cropRows);
+}
+
 function render({ model, el: root }) {
   root.classList.add("dvr-viewer");
+  const uid = `dvr${Math.random().toString(36).slice(2, 10)}`;
   const img = el("img", { class: "dvr-frame", alt: "dvr frame", draggable: "false" });
   const labels = el("div", { class: "dvr-labels" });
-  const stage = el("div", { class: "dvr-stage" }, img, labels);
+  // The patient's side each edge of the view faces, and a scale bar (in mm at the
+  // target's depth; absent where the volume's physical size is unknown).
+  const orient = Object.fromEntries(["left", "right", "top", "bottom"].map((k) => [k, el("span", { class: `dvr-orient dvr-orient-${k}` })]));
+  const triad = svgEl("svg", { class: "dvr-triad", viewBox: "-22 -22 44 44" });
+  const scaleBar = el("div", { class: "dvr-scale-bar" });
+  const scaleLabel = el("span", { class: "dvr-scale-label" });
+  const scale = el("div", { class: "dvr-scale", hidden: "" }, scaleBar, scaleLabel);
+  const stage = el("div", { class: "dvr-stage" }, img, labels, ...Object.values(orient), triad, scale);
   const counter = el("span", { class: "dvr-frame-counter" }, "0");
   const fps = el("span", { class: "dvr-fps" }, "–");
   const latency = el("span", { class: "dvr-latency" }, "–");
   const timings = el("table", { class: "dvr-timings" });
   const status = el("div", { class: "dvr-status" });
+  const captures = el("ul", { class: "dvr-captures" });
+  const downloads = new Map(); // path -> blob URL of its bytes
 
   const denoiser = () =>
     select(model.get("methods"), model.get("denoiser"), (v) => {
@@ -156,20 +325,43 @@ function render({ model, el: root }) {
     model.set("split_position", parseFloat(splitPos.value));
     model.save_changes();
   });
-  const spp = el("input", { type: "number", min: "1", class: "dvr-spp" });
-  spp.max = model.get("max_spp");
+  // spp: the box holds only what the renderer takes (1 to the engine's limit on this
+  // device, from the kernel); a number past it is clamped there, and says so.
+  const spp = el("input", { type: "number", min: "1", step: "1", class: "dvr-spp" });
+  const sppRange = el("span", { class: "dvr-spp-range" });
+  const showLimit = () => {
+    spp.max = model.get("max_spp");
+    sppRange.textContent = `(1–${model.get("max_spp")})`;
+  };
+  showLimit();
   spp.value = model.get("spp");
   spp.addEventListener("change", () => {
+    const max = model.get("max_spp");
     const n = parseInt(spp.value, 10);
-    if (n >= 1 && n <= model.get("max_spp")) {
-      model.set("spp", n);
-      model.save_changes();
-    }
+    const ok = Math.min(max, Math.max(1, Number.isFinite(n) ? n : model.get("spp")));
+    if (ok !== n) status.textContent = `spp ${spp.value} is outside 1–${max} (this device's limit): set to ${ok}`;
+    spp.value = ok;
+    model.set("spp", ok);
+    model.save_changes();
   });
   let denoiserSel = denoiser(), splitSel = split(), presetSel = preset();
   denoiserSel.classList.add("dvr-denoiser");
   splitSel.classList.add("dvr-split");
   presetSel.classList.add("dvr-preset");
+  const send = (msg) => {
+    seq += 1;
+    sentAt.set(seq, performance.now());
+    model.send({ ...msg, seq });
+  };
+  const cameraRow = el("div", { class: "dvr-row dvr-camera-buttons" },
+    button("reset", "dvr-reset", () => send({ type: "reset" })),
+    button("fit", "dvr-fit", () => send({ type: "fit" })));
+  const sidesRow = el("div", { class: "dvr-row dvr-sides" },
+    ...(model.get("sides") || []).map((s) => button(s.slice(0, 3), `dvr-view-${s}`, () => send({ type: "view", side: s }))));
+  sidesRow.querySelectorAll("button").forEach((b, i) => (b.title = `view from the ${model.get("sides")[i]} side`));
+  const captureRow = el("div", { class: "dvr-row" },
+    button("screenshot", "dvr-screenshot", () => model.send({ type: "screenshot" })),
+    button("movie", "dvr-movie", () => model.send({ type: "movie" })));
   const panel = el(
     "div",
     { class: "dvr-panel" },
@@ -177,10 +369,15 @@ function render({ model, el: root }) {
     el("div", { class: "dvr-row" }, "drag latency ", latency),
     el("label", {}, "denoiser ", denoiserSel),
     el("label", {}, "split ", splitSel, splitPos),
-    el("label", {}, "spp ", spp),
+    el("label", {}, "spp ", spp, sppRange),
+    cameraRow,
+    sidesRow,
     el("label", {}, "TF preset ", presetSel),
-    tfEditor(model),
+    tfEditor(model, uid),
     el("div", { class: "dvr-hint" }, "drag a point · double-click adds · shift-click removes"),
+    cutsPanel(model),
+    captureRow,
+    captures,
     timings,
     status,
   );
@@ -189,17 +386,21 @@ function render({ model, el: root }) {
   model.on("change:split", () => (splitSel.value = model.get("split")));
   model.on("change:preset", () => (presetSel.value = model.get("preset")));
   model.on("change:spp", () => (spp.value = model.get("spp")));
+  model.on("change:max_spp", showLimit);
   model.on("change:status", () => (status.textContent = model.get("status")));
+  const drawCaptures = () =>
+    captures.replaceChildren(...(model.get("captures") || []).map((c) => {
+      const url = downloads.get(c.path);
+      const name = c.path.split("/").pop();
+      return el("li", { class: `dvr-capture dvr-capture-${c.kind}`, "data-path": c.path },
+        `${c.kind}: ${c.path} `, url ? el("a", { href: url, download: name }, "download") : "");
+    }));
+  model.on("change:captures", drawCaptures);
 
   // Mouse: left drag orbits, right (or middle) drag pans, the wheel zooms. Movements
   // are summed and sent at most once per animation frame.
   let seq = 0, drag = null, sum = [0, 0], scheduled = false;
   const sentAt = new Map(); // seq -> time sent
-  const send = (msg) => {
-    seq += 1;
-    sentAt.set(seq, performance.now());
-    model.send({ ...msg, seq });
-  };
   const flush = () => {
     scheduled = false;
     if (!drag || (sum[0] === 0 && sum[1] === 0)) return;
@@ -236,9 +437,26 @@ function render({ model, el: root }) {
     { passive: false },
   );
 
+  function drawOrientation(o) {
+    for (const k of Object.keys(orient)) orient[k].textContent = o[k];
+    // The triad: world x, y, z on the screen, labelled at their + ends (R, A, S).
+    triad.replaceChildren();
+    ["R", "A", "S"].forEach((name, i) => {
+      const [x, y] = o.axes[i];
+      triad.append(svgEl("line", { x1: 0, y1: 0, x2: 14 * x, y2: -14 * y, class: `dvr-triad-${name}` }));
+      triad.append(svgEl("text", { x: 19 * x, y: -19 * y + 3, "text-anchor": "middle", class: `dvr-triad-${name}` }, name));
+    });
+  }
+
   // Frames from the kernel: show, then acknowledge (the kernel sends the next then).
+  // Captures: their bytes, for a download link.
   let url = null;
   const onMessage = (msg, buffers) => {
+    if (msg && msg.type === "capture" && buffers && buffers.length) {
+      downloads.set(msg.path, URL.createObjectURL(new Blob([buffers[0]], { type: msg.mime })));
+      drawCaptures();
+      return;
+    }
     if (!msg || msg.type !== "frame" || !buffers || !buffers.length) return;
     const blob = new Blob([buffers[0]], { type: msg.mime });
     const next = URL.createObjectURL(blob);
@@ -267,6 +485,13 @@ function render({ model, el: root }) {
     }
     labels.replaceChildren(...msg.names.map((n) => el("span", {}, n)));
     labels.classList.toggle("dvr-split-labels", msg.names.length > 1);
+    if (msg.orientation) drawOrientation(msg.orientation);
+    if (msg.scale) {
+      scale.hidden = false;
+      scaleBar.style.width = `${(100 * msg.scale.fraction).toFixed(2)}%`;
+      scaleLabel.textContent = `${msg.scale.mm} mm`;
+      scale.dataset.mm = msg.scale.mm;
+    } else scale.hidden = true;
     timings.replaceChildren(
       el("tr", {}, el("th", {}, "pass"), el("th", {}, "GPU ms")),
       ...Object.entries(msg.timings).map(([k, v]) => el("tr", {}, el("td", {}, k), el("td", {}, v.toFixed(2)))),
@@ -276,6 +501,7 @@ function render({ model, el: root }) {
   return () => {
     model.off("msg:custom", onMessage);
     if (url) URL.revokeObjectURL(url);
+    for (const u of downloads.values()) URL.revokeObjectURL(u);
   };
 }
 

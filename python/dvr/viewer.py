@@ -10,10 +10,16 @@ of them before its next frame (drags are summed, never queued), as edits of the 
 :class:`dvr.Renderer`, which the temporal denoisers reproject. The same renderer can be
 edited from other cells (``v.renderer.lights[0].intensity = 30``) while the viewer runs.
 
+The panel always shows the renderer's current state: the render thread compares the
+renderer's TF, clip planes, crop box and spp with what the panel shows after each frame
+and sends any change, whichever road it came by (the page, another cell, a preset).
+
 The render thread stops when the viewer is closed (:meth:`Viewer.close`, or the
-frontend closing its comm) or the kernel is interrupted while idle.
+frontend closing its comm) or the kernel is interrupted while idle. A closed viewer
+leaves its last frame in the cell's output as a PNG, so a saved notebook shows it.
 """
 
+import base64
 import math
 import pathlib
 import signal
@@ -32,6 +38,8 @@ except ImportError as e:  # pragma: no cover - the notebook extra is missing
     ) from e
 
 from . import _native
+from . import viewer_capture as capture
+from . import viewer_panel as panel
 from .renderer import Renderer
 from .scene import Scene, TransferFunction
 
@@ -42,8 +50,6 @@ _HERE = pathlib.Path(__file__).parent
 # million pixels is no drag); edits arrive as messages anyone on the page can send.
 _MAX_DRAG = 10_000.0
 _MAX_ZOOM = 100.0
-# At most this many control points in a TF edited in the browser.
-_MAX_TF_POINTS = 256
 # A frame not acknowledged for this long is taken as lost (the view was closed or
 # reloaded), so the next one may go.
 _ACK_TIMEOUT_S = 2.0
@@ -53,18 +59,31 @@ _interrupt_lock = threading.Lock()
 _interrupt_installed = False
 
 
+# What the page's "view" buttons may ask for (dvr.Renderer.view_from's sides).
+_SIDES = tuple(Renderer.VIEWS)
+# The raw path-traced input, offered beside the denoisers: the renderer always returns
+# it (as "noisy"); a renderer asked for the engine's pass-through, "none", runs no
+# denoiser at all (its `denoisers` is then empty).
+NOISY = "noisy"
+
+
 class Viewer(anywidget.AnyWidget):
     """A live view of ``source`` in the cell: a :class:`dvr.Renderer` (edited live by
     the viewer and by the caller), or anything :class:`dvr.Renderer` takes (a
     :class:`dvr.Scene`, a built-in scene name, a :class:`dvr.Volume`), rendered at
     ``size`` with ``denoisers`` (the first is shown; ``split`` names one to show on
-    the right). ``format`` is ``"jpeg"`` (with ``quality``) or ``"png"``.
+    the right; ``"noisy"`` is the path tracer's raw input). ``format`` is ``"jpeg"``
+    (with ``quality``) or ``"png"``. Captures from the page's buttons go to
+    ``captures`` (a folder, made when first needed).
 
     Left drag orbits, right drag pans, the wheel zooms (the explorer's mouse). The
-    panel edits the TF (the opacity curve over the density histogram: drag a point,
-    double-click to add one, shift-click to remove one; colour presets), picks the shown
-    denoiser and a split view, sets spp, and shows the frame counter, frames per
-    second, the latency of the last drag, and the GPU ms per pass.
+    panel edits the TF (the opacity curve over the density histogram, with a colour
+    bar: drag a point, double-click to add one, shift-click to remove one; colour
+    presets), picks the shown denoiser and a split view, sets spp (within the device's
+    limit), resets, fits, and views from a patient side; adds clip planes and a crop
+    box; takes a screenshot or an orbit movie; and shows the frame counter, frames per
+    second, the latency of the last drag, the GPU ms per pass, the patient's sides at
+    the view's edges and a scale bar in mm.
     """
 
     _esm = (_HERE / "viewer.js").read_text(encoding="utf-8")
@@ -75,18 +94,24 @@ class Viewer(anywidget.AnyWidget):
     split = traitlets.Unicode("").tag(sync=True)
     split_position = traitlets.Float(0.5).tag(sync=True)
     spp = traitlets.Int(1).tag(sync=True)
-    max_spp = traitlets.Int(4).tag(sync=True)
+    max_spp = traitlets.Int(1).tag(sync=True)
     preset = traitlets.Unicode("").tag(sync=True)
     tf_points = traitlets.List().tag(sync=True)
+    clip_planes = traitlets.List().tag(sync=True)
+    crop_box = traitlets.Dict().tag(sync=True)
     status = traitlets.Unicode("").tag(sync=True)
+    captures = traitlets.List().tag(sync=True)
     # Fixed for the viewer's life.
     methods = traitlets.List().tag(sync=True)
     presets = traitlets.List().tag(sync=True)
+    sides = traitlets.List().tag(sync=True)
     histogram = traitlets.List().tag(sync=True)
+    volume = traitlets.Dict().tag(sync=True)
     width = traitlets.Int(256).tag(sync=True)
     height = traitlets.Int(256).tag(sync=True)
 
-    def __init__(self, source, size=(256, 256), denoisers=("ours",), split=None, format="jpeg", quality=85, **kwargs):
+    def __init__(self, source, size=(256, 256), denoisers=("ours",), split=None, format="jpeg", quality=85,
+                 captures="dvr-captures", **kwargs):
         if format not in ("jpeg", "png"):
             raise ValueError(f'format={format!r}: must be "jpeg" or "png"')
         if not isinstance(quality, int) or not 1 <= quality <= 100:
@@ -98,41 +123,60 @@ class Viewer(anywidget.AnyWidget):
             raise ValueError("denoisers: name at least one (the shown one)")
         if isinstance(source, Renderer):
             renderer, self._owns = source, False
-            shown = [d for d in renderer.denoisers] or ["none"]
+            shown = [NOISY if d == "none" else d for d in renderer.denoisers] or [NOISY]
         else:
             if not isinstance(source, (Scene, str)):
                 source = Scene(source)
-            names = denoisers + ([split] if split and split not in denoisers else [])
-            renderer, self._owns = Renderer(source, size=size, denoisers=names, **kwargs), True
+            names = _run_names(denoisers[0], split or "") + [d for d in denoisers[1:] if d != NOISY]
+            renderer, self._owns = Renderer(source, size=size, denoisers=list(dict.fromkeys(names)) or ["none"], **kwargs), True
             shown = denoisers
-        counts = renderer.histogram().astype(np.float64)
-        tf = renderer.tf
+        try:
+            counts = renderer.histogram().astype(np.float64)
+            info = panel.volume_info(renderer)
+            limit = panel.spp_limit(renderer)
+        except BaseException:
+            if self._owns:
+                renderer.close()  # made here: its device memory goes now, not at GC
+            raise
         super().__init__(
             denoiser=shown[0],
             split=split or "",
             spp=renderer.spp,
-            max_spp=max(4, renderer.spp),
-            tf_points=[dict(p) for p in tf.points],
-            preset=tf.name if tf.name in TransferFunction.presets() else "",
-            methods=sorted(n for n in _native_names() if n != "none"),
+            max_spp=limit or renderer.spp,
+            methods=[NOISY] + sorted(n for n in _native_names() if n != "none"),
             presets=TransferFunction.presets(),
+            sides=list(_SIDES),
             histogram=[round(float(math.log1p(c) / math.log1p(counts.max())), 4) if counts.max() > 0 else 0.0 for c in counts],
+            volume=info or {},
             width=renderer.size[0],
             height=renderer.size[1],
         )
         self.renderer = renderer
         self._format, self._quality = format, quality
+        self._capture_dir = pathlib.Path(captures)
         self._pending = _Pending()
         # The split's method may not run yet on a renderer handed in.
         self._pending.set("denoisers", (self.denoiser, self.split))
+        # Trait changes made by the kernel to show the renderer's state are not edits
+        # to send back (a thread-local flag: the page's changes come on another thread).
+        self._local = threading.local()
+        self._shown = {}  # what the panel shows of the renderer's state, as last synced
+        self._sync(renderer._r.view(), renderer._r.tf())
+        if limit is None:
+            self.status = "the engine did not say its spp limit: the box keeps the renderer's spp"
         self._stop = threading.Event()
         self._acked = threading.Event()
         self._acked.set()
         self._sent_at = 0.0
+        # Held by the render thread for each frame and by a movie for all of its frames,
+        # so a movie's frames are the only ones rendered while it runs.
+        self._render_lock = threading.Lock()
+        self._last = None  # (frame number, composed image) of the newest frame
+        self._display_id = None
         self.on_msg(self._on_message)
         if self.comm is not None:
             self.comm.on_close(lambda _msg: self.close())
-        self.observe(self._on_state, names=["denoiser", "split", "spp", "preset", "tf_points"])
+        self.observe(self._on_state, names=["denoiser", "split", "spp", "preset", "tf_points", "clip_planes", "crop_box"])
         self._thread = threading.Thread(
             target=_render_loop, args=(weakref.ref(self), renderer, self._pending, self._stop, self._acked),
             name="dvr-viewer", daemon=True,
@@ -148,46 +192,171 @@ class Viewer(anywidget.AnyWidget):
 
     def close(self):
         """Stops the render thread, frees a renderer the viewer made, and closes the
-        widget. Safe on a viewer whose construction failed part way (the widget's
-        finaliser calls it)."""
+        widget; the cell's output keeps the last frame as a PNG. Safe on a viewer whose
+        construction failed part way (the widget's finaliser calls it)."""
         stop, thread = getattr(self, "_stop", None), getattr(self, "_thread", None)
         if stop is not None:
             stop.set()
         if thread is not None and thread.is_alive() and threading.current_thread() is not thread:
             thread.join(timeout=60)
+        self._leave_last_frame()
         if getattr(self, "_owns", False) and getattr(self, "renderer", None) is not None:
             self.renderer.close()
             self.renderer = None
         _live.discard(self)
         super().close()
 
+    # Captures.
+
+    def screenshot(self, path=None):
+        """Writes the frame the viewer shows (split view and all) as a lossless PNG at
+        the render size, tone-mapped as the eval's PNGs; returns its path (default: a
+        new file in the captures folder)."""
+        frame, image = self._frame()
+        path = pathlib.Path(path) if path is not None else self._capture_dir / f"dvr-frame-{frame:06d}.png"
+        capture.write_png(image, path)
+        self._captured("screenshot", path)
+        return path
+
+    def movie(self, path=None, frames=60, degrees=360.0, fps=30):
+        """Renders an orbit of ``degrees`` about the camera's up axis in ``frames``
+        frames (the shown denoiser, split view and all) and writes it as an MP4 at
+        ``fps``; returns its path. The live view pauses meanwhile, and the camera comes
+        back to where it was."""
+        if isinstance(frames, bool) or not isinstance(frames, int) or not 2 <= frames <= 10_000:
+            raise ValueError(f"frames={frames!r}: must be a whole number from 2 to 10000")
+        degrees = panel.number(degrees, 36_000)
+        if degrees is None:
+            raise ValueError("degrees: must be a finite number (at most 100 turns)")
+        r = self._renderer()
+        path = pathlib.Path(path) if path is not None else self._capture_dir / f"dvr-orbit-{r.frames_rendered:06d}.mp4"
+        with self._render_lock:
+            start = r.camera.to_dict()
+            movie = capture.Movie(path, fps)
+            try:
+                for i, cam in enumerate(capture.orbit_cameras(start, frames, degrees)):
+                    r.camera = cam
+                    image, _ = _compose(r.render(), self.denoiser, self.split, self.split_position)
+                    movie.add(image)
+                    if i % 10 == 0:
+                        self.status = f"movie: frame {i + 1} of {frames}"
+                movie.finish()
+            except BaseException:
+                movie.abort()
+                raise
+            finally:
+                r.camera = start
+        self.status = ""
+        self._captured("movie", path)
+        return path
+
+    def _renderer(self):
+        if self.renderer is None or self.renderer.closed:
+            raise RuntimeError("this viewer is closed")
+        return self.renderer
+
+    def _frame(self):
+        """The newest shown frame (rendering one when none has been yet)."""
+        if self._last is None:
+            r = self._renderer()
+            with self._render_lock:
+                image, _ = _compose(r.render(), self.denoiser, self.split, self.split_position)
+            return r.frames_rendered, image
+        return self._last
+
+    def _captured(self, kind, path):
+        """Lists a capture in the panel and sends its bytes for the page's download
+        link (a movie only when small enough for one message)."""
+        path = pathlib.Path(path).resolve()
+        # The bytes first: the page lists the capture with its link in one go.
+        if path.stat().st_size <= 32 << 20:
+            mime = "image/png" if kind == "screenshot" else "video/mp4"
+            self.send({"type": "capture", "kind": kind, "path": str(path), "name": path.name, "mime": mime},
+                      buffers=[path.read_bytes()])
+        self.captures = self.captures + [{"kind": kind, "path": str(path)}]
+
+    # The cell's output: the widget, and its last frame once closed.
+
+    def _ipython_display_(self):
+        from IPython.display import display
+
+        if self._display_id is None:
+            self._display_id = f"dvr-viewer-{id(self):x}-{time.monotonic_ns():x}"
+        bundle = self._repr_mimebundle_()
+        # ipywidgets hands back (data, metadata); older versions the data alone.
+        data, metadata = bundle if isinstance(bundle, tuple) else (bundle, {})
+        display(data, metadata=metadata, raw=True, display_id=self._display_id)
+
+    def _leave_last_frame(self):
+        """Replaces the widget in the cell's output with its last frame as a PNG (the
+        widget's view goes with its model), so the notebook keeps what was seen."""
+        last, display_id = getattr(self, "_last", None), getattr(self, "_display_id", None)
+        if last is None or display_id is None:
+            return
+        self._display_id = None  # once: a second close (the finaliser's) leaves it be
+        try:
+            from IPython.display import update_display
+
+            png = _native.encode_image(last[1], "png")
+            h, w = last[1].shape[:2]
+            update_display(
+                {"image/png": base64.b64encode(png).decode("ascii"),
+                 "text/plain": f"dvr.Viewer (closed): frame {last[0]}, {w}x{h}"},
+                raw=True, display_id=display_id,
+            )
+        except Exception as e:  # noqa: BLE001 - closing must not fail for the picture
+            self.status = f"could not leave the last frame: {e}"
+
     # Browser to kernel.
 
     def _on_message(self, _widget, msg, _buffers):
         if not isinstance(msg, dict):
+            self.status = "refused a message from the page (not an object)"
             return
         kind = msg.get("type")
         if kind == "ack":
             self._acked.set()
-            return
-        if kind in ("orbit", "pan"):
-            dx, dy = _number(msg.get("dx"), _MAX_DRAG), _number(msg.get("dy"), _MAX_DRAG)
+        elif kind in ("orbit", "pan"):
+            dx, dy = panel.number(msg.get("dx"), _MAX_DRAG), panel.number(msg.get("dy"), _MAX_DRAG)
             if dx is None or dy is None:
+                self.status = f"refused a {kind} from the page (dx, dy: numbers within ±{_MAX_DRAG:g})"
                 return
             self._pending.drag(kind, dx, dy, _seq(msg))
         elif kind == "zoom":
-            steps = _number(msg.get("steps"), _MAX_ZOOM)
-            if steps is not None:
-                self._pending.drag("zoom", steps, 0.0, _seq(msg))
+            steps = panel.number(msg.get("steps"), _MAX_ZOOM)
+            if steps is None:
+                self.status = f"refused a zoom from the page (steps: a number within ±{_MAX_ZOOM:g})"
+                return
+            self._pending.drag("zoom", steps, 0.0, _seq(msg))
         elif kind in ("reset", "fit"):
             self._pending.set(kind, True, _seq(msg))
+        elif kind == "view":
+            if msg.get("side") not in _SIDES:
+                self.status = f"refused a view from the page: side {msg.get('side')!r} is not one of {', '.join(_SIDES)}"
+                return
+            self._pending.set("view", msg["side"], _seq(msg))
+        elif kind in ("screenshot", "movie"):
+            # Off the kernel's message thread: a movie takes seconds to minutes.
+            threading.Thread(target=self._capture_from_page, args=(kind,), name=f"dvr-{kind}", daemon=True).start()
+        else:
+            self.status = f"refused a message from the page: unknown type {kind!r}"
+
+    def _capture_from_page(self, kind):
+        try:
+            path = self.screenshot() if kind == "screenshot" else self.movie()
+            self.status = f"{kind} saved: {path}"
+        except Exception as e:  # noqa: BLE001 - shown in the panel
+            self.status = f"{kind} failed: {e}"
 
     def _on_state(self, change):
+        if getattr(self._local, "syncing", False):
+            return
         name, value = change["name"], change["new"]
         if name == "tf_points":
-            points = _tf_points(value)
+            points = panel.tf_points(value)
             if points is None:
                 self.status = "refused a transfer function from the page (not a list of control points)"
+                self._shown.pop("tf", None)  # the panel shows the renderer's again
                 return
             self._pending.set("tf", points)
         elif name == "preset":
@@ -201,6 +370,62 @@ class Viewer(anywidget.AnyWidget):
         elif name == "spp":
             if isinstance(value, int) and 1 <= value <= self.max_spp:
                 self._pending.set("spp", value)
+            else:
+                self.status = f"spp {value!r} refused: this renderer takes 1 to {self.max_spp} samples per pixel per frame"
+                self._shown.pop("spp", None)
+        elif name == "clip_planes":
+            planes = panel.clip_planes(value)
+            if planes is None:
+                self.status = f"refused clip planes from the page (at most {panel.MAX_CLIP_PLANES}, each a point and a non-zero normal)"
+                self._shown.pop("clip", None)
+                return
+            self._pending.set("clip", planes)
+        elif name == "crop_box":
+            box = panel.crop_box(value)
+            if box is None:
+                self.status = "refused a crop box from the page (min < max per axis, within -0.5 to 0.5)"
+                self._shown.pop("crop", None)
+                return
+            self._pending.set("crop", box)
+
+    # Kernel to browser.
+
+    def _sync(self, view, tf):
+        """Shows the renderer's TF, clip planes, crop box and spp in the panel where
+        they differ from what it shows (whoever changed them)."""
+        a = tf["a"]
+        state = {
+            "tf": (a["point"], a.get("name", "")),
+            "clip": [{"point": c["point"], "normal": c["normal"], "enabled": c.get("enabled", True)} for c in view.get("clip", [])],
+            "crop": view.get("crop") or {},
+            "spp": view.get("render", {}).get("spp", self.spp),
+        }
+        changed = {k: v for k, v in state.items() if self._shown.get(k) != v}
+        if not changed:
+            return
+        # (No hold_sync here: its flag is the widget's, shared with the kernel's thread
+        # applying the page's changes; each trait goes in a message of its own.)
+        self._local.syncing = True
+        try:
+            if "tf" in changed:
+                points, name = changed["tf"]
+                self.tf_points = [dict(p) for p in points]
+                self.preset = name if name in self.presets else ""
+            if "clip" in changed:
+                self.clip_planes = changed["clip"]
+            if "crop" in changed:
+                crop = changed["crop"]
+                if crop.get("units", "box") == "box":
+                    self.crop_box = {k: crop[k] for k in ("min", "max", "enabled") if k in crop}
+                else:
+                    # The sliders are in the box's units; a crop in voxels stays Python's.
+                    self.crop_box = {}
+                    self.status = "the crop box is in voxels: the sliders show none (edit it from Python, or move one to replace it)"
+            if "spp" in changed:
+                self.spp = changed["spp"]
+        finally:
+            self._local.syncing = False
+        self._shown.update(changed)
 
 
 class _Pending:
@@ -232,50 +457,76 @@ class _Pending:
 
 
 def _render_loop(viewer_ref, renderer, pending, stop, acked):
-    """The render thread: apply the newest edits, render, send the frame when the
-    browser has shown the last one. Holds the viewer only weakly."""
+    """The render thread: apply the newest edits, render, show the renderer's state in
+    the panel, send the frame when the browser has shown the last one. Holds the viewer
+    only weakly."""
     frames, started = 0, time.perf_counter()
     shown_at = []
     while not stop.is_set():
-        edits, seq = pending.take()
-        status = _apply(renderer, edits)
         viewer = viewer_ref()
         if viewer is None:
             return
-        try:
-            out = renderer.render()
-        except Exception as e:  # noqa: BLE001 - shown in the panel, then the loop ends
-            viewer.status = f"render failed: {e}"
-            return
+        with viewer._render_lock:
+            if stop.is_set():
+                return
+            edits, seq = pending.take()
+            status = _apply(renderer, edits)
+            try:
+                out = renderer.render()
+                view, tf = renderer._r.view(), renderer._r.tf()
+            except Exception as e:  # noqa: BLE001 - shown in the panel, then the loop ends
+                viewer.status = f"render failed: {e}"
+                return
         frames += 1
         now = time.perf_counter()
         shown_at.append(now)
         shown_at = shown_at[-30:]
         if status:
             viewer.status = status
-        if acked.is_set() or now - viewer._sent_at > _ACK_TIMEOUT_S:
+            # A refused edit leaves the panel showing it: show the renderer's again.
+            viewer._shown.clear()
+        try:
+            viewer._sync(view, tf)
             image, names = _compose(out, viewer.denoiser, viewer.split, viewer.split_position)
-            data = _native.encode_image(image, viewer._format, viewer._quality)
-            fps = (len(shown_at) - 1) / (shown_at[-1] - shown_at[0]) if len(shown_at) > 1 else 0.0
-            acked.clear()
-            viewer._sent_at = now
-            viewer.send(
-                {
-                    "type": "frame",
-                    "mime": "image/jpeg" if viewer._format == "jpeg" else "image/png",
-                    "frame": renderer.frames_rendered,
-                    "seq": seq,
-                    "names": names,
-                    "spp": renderer.spp,
-                    "fps": round(fps, 2),
-                    "seconds": round(now - started, 2),
-                    "timings": {k: round(v, 3) for k, v in renderer.timings().items()},
-                    "width": image.shape[1],
-                    "height": image.shape[0],
-                },
-                buffers=[data],
-            )
+            viewer._last = (renderer.frames_rendered, image)
+            if acked.is_set() or now - viewer._sent_at > _ACK_TIMEOUT_S:
+                _send_frame(viewer, renderer, image, names, view["camera"], seq, shown_at, now - started)
+                acked.clear()
+                viewer._sent_at = now
+        except Exception as e:  # noqa: BLE001 - a frame lost is said, the loop goes on
+            viewer.status = f"frame not sent: {e}"
         del viewer
+
+
+def _send_frame(viewer, renderer, image, names, camera, seq, shown_at, seconds):
+    data = _native.encode_image(image, viewer._format, viewer._quality)
+    fps = (len(shown_at) - 1) / (shown_at[-1] - shown_at[0]) if len(shown_at) > 1 else 0.0
+    physical = viewer.volume.get("physical")
+    viewer.send(
+        {
+            "type": "frame",
+            "mime": "image/jpeg" if viewer._format == "jpeg" else "image/png",
+            "frame": renderer.frames_rendered,
+            "seq": seq,
+            "names": names,
+            "spp": renderer.spp,
+            "fps": round(fps, 2),
+            "seconds": round(seconds, 2),
+            "timings": {k: round(v, 3) for k, v in renderer.timings().items()},
+            "width": image.shape[1],
+            "height": image.shape[0],
+            "orientation": panel.orientation(camera),
+            # No bar where the volume's physical size is unknown (never a wrong one).
+            "scale": panel.scale_bar(camera, image.shape[0], image.shape[1], physical) if physical else None,
+        },
+        buffers=[data],
+    )
+
+
+def _run_names(left, right):
+    """The denoisers a renderer runs to show `left` and `right`: "noisy" needs none (the
+    renderer always returns its input)."""
+    return [n for n in dict.fromkeys((left, right)) if n and n != NOISY]
 
 
 def _apply(renderer, edits):
@@ -283,29 +534,45 @@ def _apply(renderer, edits):
     panel when one is refused."""
     try:
         if "denoisers" in edits:
-            left, right = edits["denoisers"]
-            names = [left] + ([right] if right and right != left else [])
+            names = _run_names(*edits["denoisers"])
             if tuple(names) != renderer.denoisers:
-                renderer.denoisers = names
+                renderer.denoisers = names or ["none"]
         if "spp" in edits and edits["spp"] != renderer.spp:
             renderer.settings.spp = edits["spp"]
         if "preset" in edits:
             renderer.tf = edits["preset"]
         if "tf" in edits:
             renderer.tf = TransferFunction(edits["tf"], "edited")
+        if "clip" in edits:
+            renderer.clip = edits["clip"]
+        if "crop" in edits:
+            renderer.crop = edits["crop"] or None
         if edits.get("reset"):
-            renderer.reset_camera()
+            _reset_camera(renderer)
         if edits.get("fit"):
             renderer.fit()
+        if "view" in edits:
+            renderer.view_from(edits["view"])
         if "orbit" in edits:
-            renderer.orbit(*edits["orbit"])
+            renderer.orbit_pixels(*edits["orbit"])
         if "pan" in edits:
             renderer.pan(*edits["pan"])
         if "zoom" in edits:
             renderer.zoom(edits["zoom"][0])
-    except (ValueError, TypeError) as e:
+    except (ValueError, TypeError, RuntimeError) as e:
         return str(e)
     return ""
+
+
+def _reset_camera(renderer):
+    """The engine's reset (its orbit camera's home: target, distance, yaw, pitch, field
+    of view), then the scene's up vector where the view had another: the engine keeps
+    the current up through a reset, so after a superior or inferior view its reset
+    alone would not be the starting view."""
+    renderer.reset_camera()
+    home = renderer.scene.data.get("camera") if hasattr(renderer.scene, "data") else None
+    if home and "up" in home and not np.allclose(renderer.camera.up, home["up"]):
+        renderer.camera = dict(renderer.camera.to_dict(), **home)
 
 
 def _compose(out, left, right, position):
@@ -325,42 +592,9 @@ def _native_names():
     return [n for n, _ in _native.denoiser_names()]
 
 
-def _number(value, limit):
-    """A finite number within ±limit from a message, else None (refused)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    value = float(value)
-    if not math.isfinite(value) or abs(value) > limit:
-        return None
-    return value
-
-
 def _seq(msg):
     seq = msg.get("seq", 0)
     return seq if isinstance(seq, int) and not isinstance(seq, bool) and seq >= 0 else 0
-
-
-def _tf_points(value):
-    """Control points from the page, as the engine checks them (it names any bad
-    value); None when the shape is wrong."""
-    if not isinstance(value, list) or not 1 <= len(value) <= _MAX_TF_POINTS:
-        return None
-    points = []
-    for p in value:
-        if not isinstance(p, dict):
-            return None
-        point = {}
-        for key in ("density", "opacity"):
-            x = _number(p.get(key), 1e6)
-            if x is None:
-                return None
-            point[key] = x
-        diffuse = p.get("diffuse", [1.0, 1.0, 1.0])
-        if not isinstance(diffuse, list) or len(diffuse) != 3 or any(_number(c, 1e6) is None for c in diffuse):
-            return None
-        point["diffuse"] = [float(c) for c in diffuse]
-        points.append(point)
-    return points
 
 
 def _interrupt(signum, frame, previous):

@@ -15,7 +15,7 @@ use dvr_engine::passes::aux_features::{ALBEDO, NORMAL};
 use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup, DEFAULT_VOLUME_SIZE};
 use dvr_engine::renderer::{FrameRequest, FrameResult, FEATURE_IMAGES};
 use dvr_engine::scene::{parse_memory_size, TfState, ViewSections};
-use dvr_engine::session::{Anatomical, Edit, Session, SessionError};
+use dvr_engine::session::{Edit, Session, SessionError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, PoisonError};
@@ -367,19 +367,6 @@ impl Renderer {
     /// Flies to fit the volume, keeping the viewing direction.
     fn fit(&self, py: Python<'_>) -> PyResult<()> {
         self.edit(py, Edit::FitCamera)
-    }
-
-    /// Looks from one side of the patient (`anterior`, `posterior`, `left`, `right`,
-    /// `superior`, `inferior`), keeping the target and distance.
-    fn view_from(&self, py: Python<'_>, side: &str) -> PyResult<()> {
-        let side = Anatomical::from_name(side).ok_or_else(|| {
-            let names: Vec<&str> = Anatomical::ALL.iter().map(|a| a.name()).collect();
-            value_error(format!(
-                "unknown side {side:?}; the sides are {}",
-                names.join(", ")
-            ))
-        })?;
-        self.edit(py, Edit::ViewFrom(side))
     }
 
     /// Renders at (width, height) from the next render on (histories restart).

@@ -1,16 +1,23 @@
 """dvr.Viewer in a real JupyterLab, driven by headless Chromium: frames stream into the
-cell, a drag moves the camera, a TF preset and a split view show, an interrupted kernel
-stops the render loop, and a closed viewer leaves no thread and no renderer. The example
-notebooks run through nbclient."""
+cell, a drag moves the camera and reset brings it back, the TF editor follows a TF set
+from another cell and a preset picked in the page, a point added to a preset reaches the
+kernel with the preset's points intact, the raw input shows in the split view, a clip
+plane is added from the cuts panel, a screenshot and a movie are written, an interrupted
+kernel stops the render loop, and a closed viewer leaves no thread and no renderer and
+its last frame in the saved notebook. The example notebooks run through nbclient."""
 
+import base64
+import json
 import pathlib
 import re
 import time
 
 import nbformat
+import numpy as np
+import pytest
 from nbclient import NotebookClient
 
-from lab import Notebook, image_stats, write_notebook
+from lab import Notebook, decode_png, ffprobe_frames, image_stats, write_notebook
 
 EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
 
@@ -33,6 +40,10 @@ def shown_after(page, frame):
     )
 
 
+def numbers(text):
+    return [float(x) for x in re.findall(r"-?\d+\.\d*(?:e-?\d+)?", text)]
+
+
 def difference(a, b):
     return sum(abs(x - y) for x, y in zip(a[4], b[4])) / len(a[4])
 
@@ -41,7 +52,7 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
     write_notebook(
         lab.root / "viewer.ipynb",
         [
-            "import dvr, gc, threading, weakref\n"
+            "import dvr, gc, json, threading, weakref\n"
             "v = dvr.Viewer('phantom/orbit', size=(48, 48), denoisers=['ours'])\n"
             "renderer = weakref.ref(v.renderer)\n"
             "v",
@@ -49,9 +60,13 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
             "print('state', v.renderer.tf.name, v.renderer.denoisers, v.running)",
             "v.close()\ngc.collect()\n"
             "print('threads', [t.name for t in threading.enumerate() if t.name == 'dvr-viewer'], 'renderer', renderer())",
+            "print('tf', json.dumps([dict(p) for p in v.renderer.tf.points]))",
+            "v.renderer.tf = 'phantom-vessels'",
+            "print('clip', json.dumps(v.renderer.clip.to_list()))",
+            "print('spp', v.renderer.spp)",
         ],
     )
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    page = browser.new_page(viewport={"width": 1400, "height": 1200})
     nb = Notebook(page, lab, "viewer.ipynb")
     nb.run(0)
     # The image appears and the frame counter grows.
@@ -59,10 +74,19 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
     later = shown_after(page, first[0] + 2)
     counter = int(page.locator(".dvr-frame-counter").inner_text())
     assert counter >= later[0] > first[0]
+    # The spp box shows the device's limit and holds only what the renderer takes.
+    limit = page.locator(".dvr-spp").get_attribute("max")
+    assert limit == page.locator(".dvr-spp-range").inner_text().strip("()").split("–")[1]
+    page.fill(".dvr-spp", "99")
+    page.locator(".dvr-spp").blur()  # the box's change event: its value committed
+    wait_for("the box clamped to the limit", lambda: page.locator(".dvr-spp").input_value() == limit)
+    assert "99" in page.locator(".dvr-status").inner_text()
+    wait_for("the limit's spp in the kernel", lambda: nb.run(7).strip() == f"spp {limit}")
 
     # A left drag orbits the camera (the kernel's camera moves), and the page says how
     # many frames the drag took to show.
     before = nb.run(1)
+    page.locator(".dvr-stage").scroll_into_view_if_needed()  # running a cell scrolls
     box = page.locator(".dvr-stage").bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
     page.mouse.move(x, y)
@@ -74,6 +98,15 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
     after = nb.run(1)
     assert before != after and after.startswith("camera"), (before, after)
     assert float(latency.get_attribute("data-ms")) > 0, latency.inner_text()
+    # Reset puts the camera back where it started.
+    page.click(".dvr-reset")
+    wait_for("the camera reset", lambda: numbers(nb.run(1)) == pytest.approx(numbers(before), abs=1e-9))
+
+    # A TF set from another cell shows in the editor and the dropdown.
+    nb.run(5)
+    vessels = dvr_tf("phantom-vessels")
+    wait_for("the other cell's TF in the editor", lambda: page.locator(".dvr-tf .dvr-point").count() == len(vessels))
+    assert page.locator(".dvr-preset").input_value() == "phantom-vessels"
 
     # A TF preset shows in the next frames.
     still = shown_after(page, int(page.locator(".dvr-frame-counter").inner_text()))
@@ -81,12 +114,54 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
     wait_for("the preset in the kernel", lambda: "phantom-opaque" in nb.run(2))
     changed = shown_after(page, int(page.locator(".dvr-frame-counter").inner_text()) + 1)
     assert difference(still, changed) > 5.0, difference(still, changed)
+    # The editor shows the preset; a double-click adds a point to it: the kernel's TF
+    # is the preset (every field of every point) plus that point.
+    opaque = dvr_tf("phantom-opaque")
+    wait_for("the preset in the editor", lambda: page.locator(".dvr-tf .dvr-point").count() == len(opaque))
+    # (Running cells scrolls the notebook: the editor is brought into view first.)
+    page.locator(".dvr-tf").scroll_into_view_if_needed()
+    plot = page.locator(".dvr-tf .dvr-plot").bounding_box()
+    page.mouse.dblclick(plot["x"] + 0.78 * plot["width"], plot["y"] + 0.4 * plot["height"])
+    wait_for("the edited TF in the kernel", lambda: "edited" in nb.run(2))
+    points = json.loads(nb.run(4).split("tf ", 1)[1])
+    added = [p for p in points if p not in opaque]
+    assert len(points) == len(opaque) + 1 and len(added) == 1, points
+    assert abs(added[0]["density"] - 0.78) < 0.02 and abs(added[0]["opacity"] - 0.6) < 0.03, added
+    # It took the colour, specular and roughness of its nearest neighbour (0.86).
+    near = next(p for p in opaque if p["density"] == 0.86)
+    assert {k: v for k, v in added[0].items() if k not in ("density", "opacity")} == {k: v for k, v in near.items() if k not in ("density", "opacity")}
+    wait_for("the dropdown saying edited", lambda: page.locator(".dvr-preset").input_value() == "")
 
-    # The split view shows two methods, labelled.
-    page.select_option(".dvr-split", "svgf")
+    # The split view shows the denoiser beside the raw path-traced input, labelled.
+    page.select_option(".dvr-split", "noisy")
     wait_for("two labels", lambda: page.locator(".dvr-labels span").count() == 2)
-    assert page.locator(".dvr-labels span").all_inner_texts() == ["ours", "svgf"]
-    assert "('ours', 'svgf')" in nb.run(2)
+    assert page.locator(".dvr-labels span").all_inner_texts() == ["ours", "noisy"]
+    assert "('ours',)" in nb.run(2)
+    # The orientation letters and the scale bar are drawn.
+    assert sorted(page.locator(".dvr-orient").all_inner_texts()) != ["", "", "", ""]
+    assert float(page.locator(".dvr-scale").get_attribute("data-mm")) > 0
+
+    # The cuts panel adds a clip plane in the kernel.
+    page.click(".dvr-cuts summary")
+    page.click(".dvr-add-clip")
+    wait_for("the clip plane in the kernel", lambda: json.loads(nb.run(6).split("clip ", 1)[1]))
+
+    # Screenshot: a PNG of the shown frame at the render size; movie: an MP4 of an orbit.
+    page.click(".dvr-screenshot")
+    shot = page.locator(".dvr-capture-screenshot")
+    shot.wait_for(timeout=60_000)
+    png = pathlib.Path(shot.get_attribute("data-path"))
+    assert decode_png(png.read_bytes())[:2] == (48, 48)
+    # The download link holds the file's bytes.
+    href = shot.locator("a[download]").get_attribute("href", timeout=30_000)
+    assert page.evaluate("async (u) => (await (await fetch(u)).arrayBuffer()).byteLength", href) == png.stat().st_size
+    page.click(".dvr-movie")
+    movie = page.locator(".dvr-capture-movie")
+    movie.wait_for(timeout=300_000)
+    mp4 = pathlib.Path(movie.get_attribute("data-path"))
+    assert mp4.stat().st_size > 0
+    frames, w, h = ffprobe_frames(mp4)
+    assert frames > 1 and (w, h) == (48, 48), (frames, w, h)
 
     # An interrupted kernel stops the render loop.
     page.locator(".jp-Notebook").click()
@@ -95,15 +170,55 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
     page.keyboard.press("i")
     wait_for("the loop to stop", lambda: nb.run(2).strip().endswith("False"))
 
-    # Closed: no render thread, the renderer freed.
+    # Closed: no render thread, the renderer freed; the cell keeps the last frame as an
+    # image, in the page and in the saved notebook.
     out = nb.run(3)
     assert re.search(r"threads \[\] renderer None", out), out
+    nb.cell(0).locator(".jp-OutputArea img").wait_for(timeout=30_000)
+    page.keyboard.press("Control+s")
+
+    def saved_image():
+        cell = json.loads((lab.root / "viewer.ipynb").read_text())["cells"][0]
+        return next((o["data"]["image/png"] for o in cell["outputs"] if "image/png" in o.get("data", {})), None)
+
+    image = wait_for("the last frame in the saved notebook", saved_image)
+    assert decode_png(base64.b64decode(image))[:2] == (48, 48)
     page.close()
 
 
+def dvr_tf(name):
+    """A preset's points as the kernel prints them (plain dicts)."""
+    import dvr
+
+    return [dict(p) for p in dvr.TransferFunction.preset(name).points]
+
+
 def test_the_example_notebooks_run():
+    """Every example notebook runs from top to bottom: each code cell executed in order,
+    none with an error, each that prints printing; and live.ipynb's results are what it
+    says they are (scores in dB, the renderer moved, the viewer rendered frames while it
+    was open, and its cell kept the last frame once it was closed)."""
     notebooks = sorted(EXAMPLES.glob("*.ipynb"))
-    assert notebooks, f"no notebooks in {EXAMPLES}"
+    assert [p.name for p in notebooks] == ["live.ipynb"], f"examples changed: {notebooks}; check each here"
     for path in notebooks:
         nb = nbformat.read(path, as_version=4)
         NotebookClient(nb, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(EXAMPLES)}}).execute()
+        code = [c for c in nb.cells if c.cell_type == "code"]
+        assert [c.execution_count for c in code] == list(range(1, len(code) + 1)), path.name
+        for c in code:
+            assert not [o for o in c.outputs if o.output_type == "error"], (path.name, c.source)
+            if "print(" in c.source:
+                assert any(o.output_type == "stream" and o.text.strip() for o in c.outputs), (path.name, c.source)
+        text = ["".join(o.text for o in c.outputs if o.output_type == "stream") for c in code]
+        scores = re.fullmatch(r"ours (\d+\.\d) dB, svgf (\d+\.\d) dB after 8 frames\s*", text[0])
+        assert scores and all(10 < float(x) < 80 for x in scores.groups()), text[0]
+        # The 40-pixel orbit moved the camera from the scene's, at the same distance.
+        import dvr
+
+        start = np.array(dvr.Scene.builtin("phantom/orbit").camera.position)
+        moved = np.array(numbers(text[1].split("position=", 1)[1])[:3])
+        assert np.linalg.norm(moved - start) > 0.1 and np.linalg.norm(moved) == pytest.approx(np.linalg.norm(start)), text[1]
+        frames = re.search(r"(\d+) frames rendered", text[3])
+        assert frames and int(frames.group(1)) > 9, text[3]  # 9: the cells before the viewer's
+        # The viewer's cell: the widget, replaced by its last frame when it closed.
+        assert any("image/png" in o.get("data", {}) for o in code[2].outputs), code[2].outputs

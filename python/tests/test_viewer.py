@@ -150,6 +150,300 @@ def test_bad_viewer_arguments_are_errors():
         dvr.Viewer("cloud/orbit", quality=0)
     with pytest.raises(ValueError, match="denoisers"):
         dvr.Viewer("cloud/orbit", denoisers=[])
-    assert viewer_module._tf_points("no") is None
+    assert viewer_module.panel.tf_points("no") is None
     # The half-made widgets' finalisers (close) run without an error of their own.
     gc.collect()
+
+
+# The panel shows the renderer's state, whoever changes it, and keeps every field.
+
+
+def frames_after(sent, v, n):
+    """Acknowledges frames until one more than `n` were sent; returns the newest."""
+    def newer():
+        v._on_message(v, {"type": "ack"}, [])
+        return len(sent.frames) > n
+    wait_for(f"frame {n + 1}", newer)
+    return sent.frames[-1]
+
+
+def test_the_tf_editor_follows_the_renderers_tf_by_any_road_and_keeps_every_field(viewer):
+    v, sent = viewer
+    # Another cell assigns a preset: the panel's curve and dropdown follow.
+    v.renderer.tf = "phantom-opaque"
+    preset = dvr.TransferFunction.preset("phantom-opaque").points
+    wait_for("the preset in the panel", lambda: v.tf_points == preset and v.preset == "phantom-opaque")
+    # A point with specular, emission and roughness, edited in the page (its opacity):
+    # the renderer's TF keeps every field of every point.
+    points = [dict(p) for p in v.tf_points]
+    points[-1] = dict(points[-1], specular=[0.5, 0.4, 0.3], emissive=[0.2, 0.0, 0.1], roughness=0.25)
+    points[-1]["opacity"] = 0.5
+    v.tf_points = points
+    wait_for("the page's edit in the renderer", lambda: v.renderer.tf.name == "edited")
+    got = [dict(p) for p in v.renderer.tf.points]
+    assert got[-1]["specular"] == pytest.approx([0.5, 0.4, 0.3]) and got[-1]["emissive"] == pytest.approx([0.2, 0.0, 0.1])
+    assert got[-1]["roughness"] == pytest.approx(0.25) and got[-1]["opacity"] == pytest.approx(0.5)
+    assert [p["density"] for p in got] == pytest.approx([p["density"] for p in preset])
+    # The dropdown no longer names the preset; the panel shows the renderer's TF.
+    wait_for("the edited TF in the panel", lambda: v.preset == "" and v.tf_points == got)
+    # A preset picked in the page, then an assignment from Python: each shows.
+    v.preset = "phantom-vessels"
+    wait_for("the page's preset applied", lambda: v.renderer.tf.name == "phantom-vessels")
+    v.renderer.tf = dvr.TransferFunction.from_array([[0.0, 1, 1, 1, 0.0], [1.0, 1, 1, 1, 0.3]], "mine")
+    wait_for("Python's TF in the panel", lambda: len(v.tf_points) == 2 and v.preset == "")
+    # A TF the engine refuses leaves the panel showing the renderer's, not the refused.
+    v.tf_points = [{"density": 0.0, "opacity": 7.0}, {"density": 1.0, "opacity": 0.0}]
+    wait_for("the refusal", lambda: "opacity" in v.status)
+    wait_for("the renderer's TF back in the panel", lambda: v.tf_points[0]["opacity"] == 0.0 and v.tf_points[1]["opacity"] == 0.3)
+    # Unknown fields are refused, not passed on or dropped.
+    assert viewer_module.panel.tf_points([{"density": 0, "opacity": 0, "glow": 1}]) is None
+
+
+def test_noisy_is_offered_as_a_denoiser_and_in_the_split(viewer, monkeypatch):
+    v, sent = viewer
+    # Every change of the renderer's denoisers, counted (each restarts the histories).
+    changes = []
+    prop = dvr.Renderer.denoisers
+    monkeypatch.setattr(dvr.Renderer, "denoisers", property(prop.fget, lambda r, names: (changes.append(list(names)), prop.fset(r, names))))
+    assert v.methods[0] == "noisy" and "ours" in v.methods and "none" not in v.methods
+    v.denoiser, v.split = "noisy", "ours"
+    wait_for("the split of noisy and ours", lambda: frames_after(sent, v, len(sent.frames))[0]["names"] == ["noisy", "ours"])
+    assert v.renderer.denoisers == ("ours",), "noisy needs no denoiser run"
+    v.split = ""
+    wait_for("noisy alone: no denoiser runs", lambda: v.renderer.denoisers == ())
+    # Asked once, not again each frame (that would restart the histories each frame).
+    n = v.renderer.frames_rendered
+    wait_for("frames", lambda: v.renderer.frames_rendered > n + 3)
+    assert changes == [["none"]], changes
+    content, _ = frames_after(sent, v, len(sent.frames))
+    assert content["names"] == ["noisy"]
+    # Shown alone, the frame is the renderer's raw input.
+    out = v.renderer.render()
+    image, names = viewer_module._compose(out, "noisy", "", 0.5)
+    assert names == ["noisy"] and image is out["noisy"]
+
+
+def test_the_spp_box_takes_the_engines_limit(viewer):
+    v, sent = viewer
+    limit = v.max_spp
+    # The limit is the engine's: it takes `limit` and refuses one more.
+    r = v.renderer
+    assert 1 <= limit <= 64
+    if "llvmpipe" in r.device:
+        assert limit == 4, "lavapipe takes 4 samples per pixel per frame"
+    v.spp = limit
+    wait_for("spp at the limit", lambda: r.spp == limit)
+    with pytest.raises(ValueError, match="samples per pixel"):
+        r.settings.spp = limit + 1
+    # 99 in the box is refused with the limit named, and the box shows the renderer's.
+    v.spp = 99
+    assert f"1 to {limit}" in v.status
+    wait_for("the box back at the renderer's spp", lambda: v.spp == limit)
+    # From Python the panel follows too.
+    r.settings.spp = 1
+    wait_for("Python's spp in the box", lambda: v.spp == 1)
+
+
+@pytest.mark.parametrize(
+    "side, direction, up, edges",
+    [
+        ("anterior", (0, 1, 0), (0, 0, 1), ("R", "L", "S", "I")),
+        ("posterior", (0, -1, 0), (0, 0, 1), ("L", "R", "S", "I")),
+        ("left", (-1, 0, 0), (0, 0, 1), ("A", "P", "S", "I")),
+        ("right", (1, 0, 0), (0, 0, 1), ("P", "A", "S", "I")),
+        ("superior", (0, 0, 1), (0, -1, 0), ("R", "L", "P", "A")),
+        ("inferior", (0, 0, -1), (0, 1, 0), ("R", "L", "A", "P")),
+    ],
+)
+def test_view_from_a_patient_side_keeps_target_and_distance(side, direction, up, edges):
+    with dvr.Renderer("phantom/orbit", size=(8, 8), denoisers=["none"]) as r:
+        r.camera.target = (0.1, -0.05, 0.02)
+        cam = r.camera.to_dict()
+        distance = np.linalg.norm(np.subtract(cam["position"], cam["target"]))
+        r.view_from(side)
+        now = r.camera.to_dict()
+        assert now["target"] == pytest.approx(cam["target"])
+        offset = np.subtract(now["position"], now["target"])
+        assert np.linalg.norm(offset) == pytest.approx(distance)
+        assert offset / distance == pytest.approx(direction, abs=1e-9)
+        assert now["up"] == pytest.approx(up)
+        # The letters at the view's left, right, top and bottom edges.
+        o = viewer_module.panel.orientation(now)
+        assert (o["left"], o["right"], o["top"], o["bottom"]) == edges
+        # Azimuth and elevation in degrees: 90° of azimuth from anterior is the left
+        # or right side; elevation 30° lifts the camera by sin(30°).
+        r.view_from(side, elevation=30)
+        lifted = np.subtract(r.camera.position, r.camera.target) / distance
+        assert np.dot(lifted, up) == pytest.approx(0.5)
+        with pytest.raises(ValueError, match="side"):
+            r.view_from("north")
+        with pytest.raises(ValueError, match="elevation"):
+            r.view_from(side, elevation=90)
+        # Azimuth turns about the view's up: 90° from the front is the patient's left.
+        if side == "anterior":
+            r.view_from("anterior", azimuth=90)
+            assert np.subtract(r.camera.position, r.camera.target) / distance == pytest.approx((-1, 0, 0), abs=1e-9)
+
+
+def test_reset_fit_and_side_buttons_move_the_camera(viewer):
+    v, sent = viewer
+    wait_for("a first frame", lambda: sent.frames)
+    start = v.renderer.camera.to_dict()
+    v._on_message(v, {"type": "view", "side": "superior", "seq": 3}, [])
+    wait_for("the superior view", lambda: v.renderer.camera.up == pytest.approx((0, -1, 0)))
+    content, _ = frames_after(sent, v, len(sent.frames))
+    assert content["orientation"]["top"] == "P" and content["orientation"]["left"] == "R"
+    v._on_message(v, {"type": "reset"}, [])
+    # Back to the start, up vector and all (the engine's own reset keeps the current up).
+    wait_for("the camera reset", lambda: v.renderer.camera.position == pytest.approx(start["position"]) and v.renderer.camera.up == pytest.approx(start["up"]))
+    v._on_message(v, {"type": "zoom", "steps": 5}, [])
+    wait_for("zoomed", lambda: v.renderer.camera.position != start["position"])
+    zoomed = v.renderer.camera.to_dict()
+    v._on_message(v, {"type": "fit"}, [])
+    wait_for("fitted", lambda: v.renderer.camera.position != zoomed["position"])
+    # Fit keeps the viewing direction.
+    unit = lambda c: np.subtract(c["position"], c["target"]) / np.linalg.norm(np.subtract(c["position"], c["target"]))  # noqa: E731
+    assert unit(v.renderer.camera.to_dict()) == pytest.approx(unit(zoomed), abs=1e-6)
+    v._on_message(v, {"type": "view", "side": "<script>"}, [])
+    assert "side" in v.status and v.running
+
+
+def test_frames_carry_the_orientation_and_a_scale_bar_in_mm(viewer):
+    v, sent = viewer
+    content, _ = frames_after(sent, v, 0)
+    # The volume's physical size, read from the engine's Volume (the builtin cloud).
+    vol = dvr.Volume.builtin("cloud")
+    extent = max(n * s for n, s in zip(vol.shape, vol.spacing))
+    assert v.volume["physical"] == pytest.approx(extent) and v.volume["window"] == list(vol.window)
+    cam = v.renderer.camera.to_dict()
+    visible_mm = 2 * np.linalg.norm(np.subtract(cam["position"], cam["target"])) * np.tan(np.radians(cam["fov_y_degrees"]) / 2) * extent
+    scale = content["scale"]
+    # The bar's length in mm over the view's width in mm (square pixels) is its share.
+    # (The view is square: its width in mm is its height's.)
+    assert scale["fraction"] == pytest.approx(scale["mm"] / visible_mm, rel=1e-3)
+    assert 0.1 < scale["fraction"] <= 0.25 and str(scale["mm"])[0] in "125"
+    o = content["orientation"]
+    assert {o["left"], o["right"]} in ({"R", "L"}, {"A", "P"}, {"S", "I"})
+
+
+def test_a_volumes_window_and_physical_size_reach_the_panel(monkeypatch):
+    monkeypatch.setattr(dvr.Viewer, "send", lambda self, content, buffers=None: None)
+    # [z, y, x] with spacing in that order: extents z 20 mm, y 20 mm, x 15 mm.
+    data = (np.arange(10 * 20 * 30).reshape(10, 20, 30) % 1000).astype(np.int16)
+    volume = dvr.Volume(data, spacing=(2.0, 1.0, 0.5))
+    v = dvr.Viewer(volume, size=(8, 8), denoisers=["none"])
+    try:
+        assert v.volume["shape"] == [30, 20, 10] and v.volume["spacing"] == [0.5, 1.0, 2.0]
+        assert v.volume["physical"] == pytest.approx(20.0)
+        # The TF axis is labelled in the data's values: the window the engine chose.
+        assert v.volume["window"] == pytest.approx(list(volume.window)) and volume.window[1] > 1
+    finally:
+        v.close()
+
+
+def test_screenshot_is_a_lossless_png_at_render_size(viewer, tmp_path):
+    from lab import decode_png
+
+    v, sent = viewer
+    frames_after(sent, v, 0)
+    # The render thread stopped, so the shown frame stays the one compared with.
+    v._stop.set()
+    v._thread.join()
+    path = v.screenshot(tmp_path / "shot.png")
+    w, h, rows = decode_png(path.read_bytes())
+    assert (w, h) == (16, 16) and len(rows) == 16
+    # Exactly the shown frame, tone-mapped as the eval's PNGs (the last frame composed).
+    assert path.read_bytes() == dvr._native.encode_image(v._last[1], "png")
+    assert v.captures[-1] == {"kind": "screenshot", "path": str(path.resolve())}
+    content, buffers = next((c, b) for c, b in reversed(sent.frames) if c["type"] == "capture")
+    assert content["mime"] == "image/png" and bytes(buffers[0]) == path.read_bytes()
+    # A second screenshot without a path goes to the captures folder.
+    v._capture_dir = tmp_path / "captures"
+    default = v.screenshot()
+    assert default.parent == tmp_path / "captures" and default.read_bytes() == path.read_bytes()
+
+
+def test_movie_is_an_orbit_mp4_and_the_camera_comes_back(viewer, tmp_path):
+    from lab import ffprobe_frames
+
+    v, sent = viewer
+    start = v.renderer.camera.to_dict()
+    path = v.movie(tmp_path / "orbit.mp4", frames=6, degrees=90, fps=12)
+    assert ffprobe_frames(path) == (6, 16, 16)
+    assert v.renderer.camera.position == pytest.approx(start["position"])
+    assert not list(tmp_path.glob("*.partial*")) and v.captures[-1]["kind"] == "movie"
+    with pytest.raises(ValueError, match="frames"):
+        v.movie(tmp_path / "x.mp4", frames=1)
+    # From the page's button: a file in the captures folder, said in the status line.
+    v._capture_dir = tmp_path / "captures"
+    v._on_message(v, {"type": "screenshot"}, [])
+    wait_for("the page's screenshot", lambda: "screenshot saved" in v.status)
+    assert len(list((tmp_path / "captures").glob("*.png"))) == 1
+
+
+def test_a_movie_pads_odd_sizes_and_leaves_no_file_when_it_fails(tmp_path):
+    from lab import ffprobe_frames
+
+    capture = viewer_module.capture
+    movie = capture.Movie(tmp_path / "odd.mp4", fps=10)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        movie.add(rng.random((11, 15, 3), dtype=np.float32))
+    # yuv420p takes even sizes only: one black column and row are added.
+    assert ffprobe_frames(movie.finish()) == (3, 16, 12)
+    # A frame of another size, and a movie of no frames, are errors that leave nothing.
+    bad = capture.Movie(tmp_path / "bad.mp4")
+    bad.add(np.zeros((8, 8, 3), np.float32))
+    with pytest.raises(ValueError, match="a frame is 4x4"):
+        bad.add(np.zeros((4, 4, 3), np.float32))
+    with pytest.raises(RuntimeError, match="no frames"):
+        capture.Movie(tmp_path / "empty.mp4").finish()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["odd.mp4"]
+    with pytest.raises(ValueError, match="fps"):
+        capture.Movie(tmp_path / "x.mp4", fps=0)
+
+
+def test_cuts_from_the_page_clip_and_crop(viewer):
+    v, sent = viewer
+    plane = {"point": [0.0, 0.0, 0.1], "normal": [0.0, 0.0, 1.0], "enabled": True}
+    v.clip_planes = [plane]
+    wait_for("the clip plane", lambda: len(v.renderer.clip) == 1)
+    assert v.renderer.clip[0].point == pytest.approx((0, 0, 0.1))
+    # Dragged (its offset) from the page.
+    v.clip_planes = [dict(plane, point=[0.0, 0.0, -0.2])]
+    wait_for("the plane moved", lambda: v.renderer.clip[0].point == pytest.approx((0, 0, -0.2)))
+    v.crop_box = {"min": [-0.3, -0.5, -0.5], "max": [0.3, 0.5, 0.5], "enabled": True}
+    wait_for("the crop box", lambda: v.renderer.crop is not None and v.renderer.crop.min == pytest.approx((-0.3, -0.5, -0.5)))
+    # Refused with a reason: a zero normal, seven planes, min past max.
+    v.clip_planes = [dict(plane, normal=[0, 0, 0])]
+    assert "refused clip planes" in v.status
+    v.clip_planes = [plane] * 7
+    assert "refused clip planes" in v.status
+    v.crop_box = {"min": [0.3, 0, 0], "max": [0.1, 0.5, 0.5]}
+    assert "refused a crop box" in v.status
+    # The panel goes back to the renderer's planes, and follows Python's edits.
+    wait_for("the renderer's plane in the panel", lambda: len(v.clip_planes) == 1)
+    v.renderer.clip = []
+    v.renderer.crop = None
+    wait_for("Python's edits in the panel", lambda: v.clip_planes == [] and v.crop_box == {})
+
+
+def test_a_closed_viewer_leaves_its_last_frame_in_the_output(monkeypatch):
+    from lab import decode_png
+    import base64
+    import IPython.display
+
+    shown, updated = [], []
+    monkeypatch.setattr(dvr.Viewer, "send", lambda self, content, buffers=None: None)
+    monkeypatch.setattr(IPython.display, "display", lambda *a, **k: shown.append((a, k)))
+    monkeypatch.setattr(IPython.display, "update_display", lambda *a, **k: updated.append((a, k)))
+    v = dvr.Viewer("cloud/orbit", size=(12, 10), denoisers=["ours"])
+    v._ipython_display_()
+    (bundle,), kw = shown[-1]
+    assert "application/vnd.jupyter.widget-view+json" in bundle and kw["display_id"]
+    wait_for("a frame", lambda: v._last is not None)
+    v.close()
+    (out,), kw2 = updated[0]
+    assert kw2["display_id"] == kw["display_id"] and kw2["raw"]
+    assert decode_png(base64.b64decode(out["image/png"]))[:2] == (12, 10)
+    assert "closed" in out["text/plain"]
