@@ -144,6 +144,7 @@ fn a_volume_past_the_device_limits_is_paged_and_a_mis_sized_one_refused_before_a
         blocks: None,
         world_size: [1.0; 3],
         window: [0.0, 1.0],
+        mm_per_unit: 1.0,
         bricks: BrickRanges {
             brick: 8,
             grid: [1, 1, 1],

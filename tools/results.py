@@ -23,166 +23,32 @@ either generated from a run's files or not there.
 import argparse
 import csv
 import json
-import math
 import os
-import re
 import sys
 
-ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-RESULTS = os.path.join(ROOT, "assets", "results")
-PAGES = ["README.md"] + sorted(
-    os.path.join("docs", "src", f)
-    for f in os.listdir(os.path.join(ROOT, "docs", "src"))
-    if f.endswith(".md")
+from results_io import (
+    ROOT,
+    PAGES,
+    BLOCK,
+    COMPARED,
+    Missing,
+    path,
+    read_csv,
+    read_json,
+    num,
+    fmt,
+    mean,
+    method_order,
+    scenes_of,
+    means,
+    best,
+    table,
+    bold_if,
+    source,
+    means_table,
+    per_scene_table,
+    present,
 )
-BLOCK = re.compile(
-    r"(<!-- results:(?P<name>[a-z0-9-]+) -->\n)(?P<body>.*?)(<!-- /results:(?P=name) -->)",
-    re.S,
-)
-
-# The methods compared (the others are ablations of ours or of the paper's family).
-COMPARED = ["none", "taa", "svgf", "wrls-paper", "rls-paper", "wrls", "rls", "wrls-nf",
-            "rls-nf", "rae", "rae-phantom", "rae-mri", "rae-fp16", "oidn", "oidn-aux", "ours"]
-ORDER = ["none", "accum", "taa", "svgf", "ours", "ours-no-gradient", "ours-no-lag",
-         "ours-no-prior", "ours-no-atrous", "wrls-paper", "rls-paper", "wrls", "rls",
-         "wrls-nf", "rls-nf", "rae", "rae-phantom", "rae-mri", "rae-fp16", "oidn", "oidn-aux"]
-# metric: (column title, digits, higher is better)
-METRICS = {
-    "psnr": ("PSNR dB", 2, True),
-    "ssim": ("SSIM", 3, True),
-    "flip": ("FLIP", 4, False),
-    "temporal_error": ("temporal error", 5, False),
-    "gpu_ms": ("GPU ms", 1, None),
-}
-
-
-class Missing(Exception):
-    pass
-
-
-def path(*parts):
-    return os.path.join(RESULTS, *parts)
-
-
-def read_csv(*parts):
-    p = path(*parts)
-    if not os.path.exists(p):
-        raise Missing(os.path.relpath(p, ROOT))
-    with open(p, newline="") as f:
-        return list(csv.DictReader(f))
-
-
-def read_json(*parts):
-    p = path(*parts)
-    if not os.path.exists(p):
-        raise Missing(os.path.relpath(p, ROOT))
-    with open(p) as f:
-        return json.load(f)
-
-
-def num(s):
-    try:
-        v = float(s)
-    except (TypeError, ValueError):
-        return None
-    return v if math.isfinite(v) else None
-
-
-def fmt(v, digits):
-    return "" if v is None else f"{v:.{digits}f}"
-
-
-def mean(xs):
-    xs = [x for x in xs if x is not None]
-    return sum(xs) / len(xs) if xs else None
-
-
-def method_order(methods):
-    return sorted(methods, key=lambda m: (ORDER.index(m) if m in ORDER else len(ORDER), m))
-
-
-def scenes_of(rows):
-    seen = []
-    for r in rows:
-        if r["scene"] not in seen:
-            seen.append(r["scene"])
-    return seen
-
-
-def means(rows, methods=None):
-    """Per method, the mean over scenes of each metric in a summary.csv."""
-    out = {}
-    for m in methods or method_order({r["method"] for r in rows}):
-        sel = [r for r in rows if r["method"] == m]
-        if sel:
-            out[m] = {k: mean(num(r[k]) for r in sel) for k in METRICS}
-    return out
-
-
-def best(values, higher):
-    vals = [v for v in values.values() if v is not None]
-    if not vals:
-        return None
-    return max(vals) if higher else min(vals)
-
-
-def table(header, rows):
-    lines = ["| " + " | ".join(header) + " |", "|" + " --- |" * len(header)]
-    lines += ["| " + " | ".join(r) + " |" for r in rows]
-    return "\n".join(lines)
-
-
-def bold_if(text, cond):
-    return f"**{text}**" if cond and text else text
-
-
-def source(set_, files):
-    meta = read_json(set_, "meta.json")
-    names = ", ".join(f"`assets/results/{set_}/{f}`" for f in files)
-    load = meta.get("load_average_at_end")
-    busy = (f" Load average (1, 5, 15 min) as the run ended: "
-            f"{', '.join(f'{x:.1f}' for x in load)}." if load else "")
-    return (f"Source: {names}, made by `{meta['command']}` at commit {meta['commit']} "
-            f"({meta['date']}) on {meta['machine']}.{busy}")
-
-
-def means_table(set_, rows, methods, metrics=("psnr", "ssim", "flip", "temporal_error", "gpu_ms")):
-    m = means(rows, methods)
-    bests = {}
-    for k in metrics:
-        hib = METRICS[k][2]
-        if hib is not None:
-            bests[k] = best({x: v[k] for x, v in m.items() if x in COMPARED}, hib)
-    header = ["method"] + [METRICS[k][0] for k in metrics]
-    body = []
-    for x, v in m.items():
-        cells = [f"`{x}`"]
-        for k in metrics:
-            t = fmt(v[k], METRICS[k][1])
-            b = x in COMPARED and k in bests and v[k] is not None and \
-                fmt(v[k], METRICS[k][1]) == fmt(bests[k], METRICS[k][1])
-            cells.append(bold_if(t, b))
-        body.append(cells)
-    return table(header, body)
-
-
-def per_scene_table(rows, methods, metric="psnr", label="scene"):
-    digits = METRICS[metric][1]
-    hib = METRICS[metric][2]
-    body = []
-    for s in scenes_of(rows):
-        vals = {r["method"]: num(r[metric]) for r in rows if r["scene"] == s}
-        b = best({x: vals.get(x) for x in methods if x in COMPARED}, hib)
-        body.append([s] + [bold_if(fmt(vals.get(x), digits),
-                                   x in COMPARED and vals.get(x) is not None and
-                                   fmt(vals.get(x), digits) == fmt(b, digits))
-                           for x in methods])
-    return table([label] + [f"`{x}`" for x in methods], body)
-
-
-def present(rows, methods):
-    have = {r["method"] for r in rows}
-    return [m for m in methods if m in have]
 
 
 # ---------------------------------------------------------------------------- blocks
@@ -647,10 +513,12 @@ def b_viewer():
     parts = ", ".join(f"`{g['pass']}` {num(g['mean_ms']):.3f}" for g in at)
     lines += [
         "",
-        f"On a GPU the device is no longer what limits the view: {meta['machine']} renders "
-        f"a 256×256 frame of `ours` in {total:.2f} ms ({parts}; {meta['command']}, "
-        f"{meta['date']}), so frames reach the page as fast as they are encoded and the "
-        "page shows them. Source: `assets/results/gpu/h200-profile.csv`.",
+        f"On a GPU the device is no longer what limits the view: {meta['machine']} rendered "
+        f"a 256×256 frame of the `ours` of {meta['commit']} in {total:.2f} ms ({parts}; "
+        f"{meta['command']}, {meta['date']}): an older `ours` than today's, whose passes "
+        "have changed since, and no GPU figure of today's code exists. Frames of that "
+        "speed reach the page as fast as they are encoded. Source: "
+        "`assets/results/gpu/h200-profile.csv`.",
     ]
     return "\n".join(lines)
 
@@ -712,7 +580,23 @@ def b_cuts():
         table(header, body),
         "",
         source("cuts", ["summary.csv", "metrics.csv"]),
+        "",
+        newer_runs_note(scenes_of(rows)),
     ])
+
+
+def newer_runs_note(scenes):
+    """Where a scene of the cuts run is also in the validation set's run, which is newer:
+    says so, naming both commits, so two figures for one scene read as two runs."""
+    cuts = read_json("cuts", "meta.json")
+    val = read_json("validation", "meta.json")
+    shared = [sc for sc in scenes if sc.startswith("val/")]
+    if not shared or val["commit"] == cuts["commit"]:
+        return ""
+    names = ", ".join(f"`{sc}`" for sc in shared)
+    return (f"{names} is also in the validation set, whose table above is a later run "
+            f"(commit {val['commit']}) of a later `ours`; the figures here are the cuts run's "
+            f"(commit {cuts['commit']}).")
 
 
 def b_cuts_line():
@@ -729,7 +613,8 @@ def b_cuts_line():
     return (
         f"Mean PSNR (dB) of `ours` / `oidn-aux` on the cut scenes, 128×128, 48 frames, 256-spp "
         f"references: {pairs}. After frame 4, `ours` is above the better of `svgf` and `taa` on "
-        f"every frame (closest {closest[0]:+.2f} dB). Commit {meta['commit']}; source: "
+        f"every frame (closest {closest[0]:+.2f} dB). Commit {meta['commit']} (the validation "
+        "scene's later run is in the results' validation table); source: "
         "`assets/results/cuts/`."
     )
 
@@ -843,7 +728,7 @@ BLOCKS = {
     "viewer": (b_viewer, ["viewer/viewer.csv", "gpu/h200-profile.csv"]),
     "viewer-line": (b_viewer_line, ["viewer/viewer.csv"]),
     "soak": (b_soak, ["soak/soak.csv"]),
-    "cuts": (b_cuts, ["cuts/summary.csv", "cuts/metrics.csv"]),
+    "cuts": (b_cuts, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json", "validation/meta.json"]),
     "cuts-line": (b_cuts_line, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json"]),
     "cut-cost": (b_cut_cost, ["cut-cost/profile.csv"]),
     "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv",

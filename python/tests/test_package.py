@@ -5,6 +5,8 @@ includes."""
 import importlib.metadata
 import re
 
+import pytest
+
 
 def test_metadata_has_the_summary_and_the_readme(root):
     meta = importlib.metadata.metadata("dvr")
@@ -20,12 +22,22 @@ def test_metadata_has_the_summary_and_the_readme(root):
 def test_the_book_includes_the_package_readme(root):
     page = (root / "docs/src/python.md").read_text()
     assert "{{#include ../../python/README.md}}" in page
+    # The built book (tools/test.sh builds it before these tests) shows every section
+    # of the guide on its Python page.
+    built = root / "docs/book/python.html"
+    if not built.is_file():
+        pytest.skip("the book is not built (mdbook build docs)")
+    html = built.read_text()
+    headings = re.findall(r"^## (.+)$", (root / "python/README.md").read_text(), re.M)
+    assert len(headings) >= 5
+    for h in headings:
+        assert h.replace("&", "&amp;") in html, f"the book's Python page lacks the section {h!r}"
 
 
 def _copy_docs(root, dest):
     import shutil
 
-    for rel in ("tools/results.py", "README.md"):
+    for rel in ("tools/results.py", "tools/results_io.py", "README.md"):
         (dest / rel).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy(root / rel, dest / rel)
     for rel in ("docs/src", "assets/results", "assets/rae"):

@@ -157,13 +157,16 @@ def images(draw):
 @FAST
 @given(images(), images())
 def test_any_image_pair_scores_or_is_a_named_refusal(a, b):
-    for f in (dvr.metrics.psnr, dvr.metrics.ssim, dvr.metrics.flip):
+    # Each score is finite and in its metric's range: PSNR is capped for identical
+    # images (as the eval caps it), SSIM lies in [-1, 1] and FLIP in [0, 1].
+    ranges = {dvr.metrics.psnr: (0.0, 100.0), dvr.metrics.ssim: (-1.0, 1.0), dvr.metrics.flip: (0.0, 1.0)}
+    for f, (lo, hi) in ranges.items():
         try:
             score = f(a, b)
         except (ValueError, TypeError) as e:
             refused(e, "reference", "test", "image", "dtype", "shape", "size")
             continue
-        assert math.isfinite(score) or score == math.inf
+        assert math.isfinite(score) and lo <= score <= hi, (f.__name__, score)
 
 
 @pytest.fixture(scope="module")

@@ -18,6 +18,12 @@ pub struct ViewGeometry {
     pub half: DVec3,
     /// The shown view's rectangle, in points.
     pub rect: egui::Rect,
+    /// The camera's target and unit right vector, world space (the scale bar's depth
+    /// and direction).
+    pub target: DVec3,
+    pub right: DVec3,
+    /// The volume's millimetres per world unit.
+    pub mm_per_unit: f64,
 }
 
 /// Where a plane is along its normal from the volume's centre, in world units.

@@ -169,17 +169,24 @@ impl Explorer {
         Ok(())
     }
 
-    /// The camera and rectangle of the view shown this frame, for the cut's outline.
+    /// The camera and rectangle of the view shown this frame, for the cut's outline and
+    /// the orientation cue.
     fn view_geometry(&self) -> Option<cut_panel::ViewGeometry> {
         let session = self.gfx.as_ref()?.session.as_ref()?;
         let (vw, vh) = self.view_size();
         let ppp = self.egui_ctx.pixels_per_point();
-        let camera = session.view().camera.camera();
-        let half = glam::Vec3::from(session.setup().volume.world_size).as_dvec3() * 0.5;
+        let spec = &session.view().camera;
+        let camera = spec.camera();
+        let volume = &session.setup().volume;
+        let half = glam::Vec3::from(volume.world_size).as_dvec3() * 0.5;
+        let forward = camera.forward().as_dvec3();
         Some(cut_panel::ViewGeometry {
             view_proj: camera.view_proj(vw as f32 / vh as f32),
-            forward: camera.forward().as_dvec3(),
+            forward,
             half,
+            target: spec.target,
+            right: forward.cross(spec.up).normalize_or(glam::DVec3::X),
+            mm_per_unit: f64::from(volume.mm_per_unit),
             rect: egui::Rect::from_min_size(
                 egui::Pos2::ZERO,
                 egui::vec2(vw as f32 / ppp, vh as f32 / ppp),

@@ -28,6 +28,7 @@ mod frame;
 mod input;
 mod model;
 mod moving;
+mod orientation;
 mod overlay;
 mod record;
 mod tf_editor;
@@ -244,7 +245,7 @@ impl Explorer {
             right: names.get(1).cloned(),
             split: 0.5,
         };
-        let mut ui = UiState::new(histogram);
+        let mut ui = UiState::new(histogram, setup.volume.window);
         let recorder = match &args.record {
             Some(dir) => {
                 ui.recording = true;

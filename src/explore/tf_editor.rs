@@ -103,6 +103,19 @@ pub fn remove_point(tf: &mut TransferFunction, i: usize) -> bool {
     true
 }
 
+/// The data value at normalised density `d` through `window`, as the axis shows it.
+pub fn axis_label(window: [f32; 2], d: f32) -> String {
+    let v = window[0] + d * (window[1] - window[0]);
+    let span = (window[1] - window[0]).abs();
+    if span >= 100.0 {
+        format!("{v:.0}")
+    } else if span >= 1.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.3}")
+    }
+}
+
 fn colour32(c: [f32; 3], alpha: f32) -> Color32 {
     let u = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
     Color32::from_rgba_unmultiplied(u(c[0]), u(c[1]), u(c[2]), u(alpha))
@@ -116,7 +129,15 @@ fn rgb_edit(ui: &mut egui::Ui, label: &str, c: &mut [f32; 3]) {
 }
 
 /// The editor widget.
-pub fn show(ui: &mut egui::Ui, ed: &mut TfEditor, tf: &mut TransferFunction, histogram: &[f32]) {
+/// The editor over the histogram; `window` (the data values at density 0 and 1) labels
+/// its axis in the volume's data units (Hounsfield for a CT).
+pub fn show(
+    ui: &mut egui::Ui,
+    ed: &mut TfEditor,
+    tf: &mut TransferFunction,
+    histogram: &[f32],
+    window: [f32; 2],
+) {
     let width = ui.available_width();
     let (rect, response) =
         ui.allocate_exact_size(egui::vec2(width, 130.0), Sense::click_and_drag());
@@ -211,6 +232,21 @@ pub fn show(ui: &mut egui::Ui, ed: &mut TfEditor, tf: &mut TransferFunction, his
             colour32(s.diffuse.map(|c| c * s.opacity.sqrt()), 1.0),
         );
     }
+    // The axis, in data units.
+    let (axis, _) = ui.allocate_exact_size(egui::vec2(width, 14.0), Sense::hover());
+    for (k, align) in [
+        (0.0, egui::Align2::LEFT_TOP),
+        (0.5, egui::Align2::CENTER_TOP),
+        (1.0, egui::Align2::RIGHT_TOP),
+    ] {
+        ui.painter().text(
+            egui::pos2(axis.left() + axis.width() * k, axis.top()),
+            align,
+            axis_label(window, k),
+            egui::FontId::proportional(11.0),
+            Color32::from_gray(170),
+        );
+    }
     // The selected point's properties.
     if let Some(i) = ed.selected.filter(|&i| i < tf.points.len()) {
         let p = &mut tf.points[i];
@@ -285,6 +321,15 @@ mod tests {
 
     fn rect() -> Rect {
         Rect::from_min_size(egui::pos2(10.0, 20.0), egui::vec2(200.0, 100.0))
+    }
+
+    #[test]
+    fn the_axis_is_labelled_in_data_units() {
+        assert_eq!(axis_label([-1024.0, 3071.0], 0.0), "-1024");
+        assert_eq!(axis_label([-1024.0, 3071.0], 1.0), "3071");
+        assert_eq!(axis_label([0.0, 1.0], 0.5), "0.5");
+        assert_eq!(axis_label([0.0, 0.5], 0.5), "0.250");
+        assert_eq!(axis_label([0.0, 10.0], 0.25), "2.5");
     }
 
     #[test]

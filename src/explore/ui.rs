@@ -6,6 +6,7 @@
 
 use super::cut_panel;
 use super::input::SHORTCUTS;
+use super::orientation;
 use super::tf_editor::{self, TfEditor};
 use dvr_engine::denoise::DENOISERS;
 use dvr_engine::gpu::timestamps::PassTiming;
@@ -95,6 +96,8 @@ pub struct UiState {
     pub tf_editor: TfEditor,
     /// Histogram of the volume, log-scaled to [0, 1].
     pub histogram: Vec<f32>,
+    /// The volume's data values at density 0 and 1 (the TF editor's axis).
+    pub window: [f32; 2],
     pub stats: Stats,
     /// A short message (saved files, errors) and when it was set.
     pub status: Option<(String, std::time::Instant)>,
@@ -113,12 +116,13 @@ pub struct UiRequests {
 }
 
 impl UiState {
-    pub fn new(histogram: &[u32]) -> Self {
+    pub fn new(histogram: &[u32], window: [f32; 2]) -> Self {
         Self {
             show_panel: true,
             show_help: false,
             tf_editor: TfEditor::new(),
             histogram: log_histogram(histogram),
+            window,
             stats: Stats::default(),
             status: None,
             recording: false,
@@ -168,6 +172,7 @@ pub fn draw(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model) -> UiRequ
     }
     if let Some(view) = &state.view {
         cut_panel::draw_outline(ui.ctx(), &model.cut, view);
+        orientation::draw(ui.ctx(), view);
     }
     if state.show_help {
         help(ui.ctx(), &mut state.show_help);
@@ -220,7 +225,13 @@ fn panel(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model, requests: &m
     egui::CollapsingHeader::new("Transfer function")
         .default_open(true)
         .show(ui, |ui| {
-            tf_editor::show(ui, &mut state.tf_editor, &mut model.tf, &state.histogram);
+            tf_editor::show(
+                ui,
+                &mut state.tf_editor,
+                &mut model.tf,
+                &state.histogram,
+                state.window,
+            );
         });
     egui::CollapsingHeader::new("Denoiser")
         .default_open(true)

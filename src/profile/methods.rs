@@ -2,9 +2,20 @@
 //! may need too (the surface features, the guide images), and the frame it would make
 //! alone, with its dispatches and the bytes it moves per pixel.
 
-use crate::eval::run::method_gpu_ms;
 use crate::profile::Profile;
 use dvr_engine::gpu::timestamps::{gb_per_s, PassOwner, PassTiming};
+
+/// GPU time of `method` in one frame: the passes every method shares (path trace,
+/// motion) plus those it needs (the surface features and guide images, when it reads
+/// them, however many other methods read them too) and its own; uploads and readbacks
+/// are no method's cost. The graph records whom each pass works for.
+pub fn method_gpu_ms(timings: &[PassTiming], method: &str) -> f64 {
+    timings
+        .iter()
+        .filter(|t| t.owner.counts_for(method))
+        .map(|t| t.ms)
+        .sum()
+}
 
 /// One denoiser at one size (per-frame means after the warm-up).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]

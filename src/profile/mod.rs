@@ -12,6 +12,7 @@ pub mod stats;
 
 use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::passes::bandwidth::PeakBandwidth;
+pub use methods::method_gpu_ms;
 use serde::Serialize;
 pub use stats::{aggregate, PassStats, Stats, WARMUP_FRAMES};
 use std::collections::VecDeque;

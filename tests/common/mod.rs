@@ -48,6 +48,7 @@ pub fn constant_volume(n: u32, d: f32) -> VolumeUpload {
         blocks: None,
         world_size: [1.0, 1.0, 1.0],
         window: [0.0, 1.0],
+        mm_per_unit: 1.0,
         bricks: BrickRanges {
             brick: n,
             grid: [1, 1, 1],

@@ -461,6 +461,7 @@ mod tests {
             blocks: None,
             world_size: [1.0; 3],
             window: [0.0, 1.0],
+            mm_per_unit: 1.0,
             bricks: BrickRanges {
                 brick: 8,
                 grid: [5, 1, 1],

@@ -58,6 +58,8 @@ pub struct VolumeUpload {
     pub world_size: [f32; 3],
     /// The physical values at density 0 and 1: what a data-unit TF is mapped through.
     pub window: [f32; 2],
+    /// Millimetres per world unit: the volume's longest physical side (the scale bar).
+    pub mm_per_unit: f32,
     pub bricks: BrickRanges,
 }
 
@@ -85,6 +87,7 @@ impl VolumeUpload {
             blocks: None,
             world_size: extent.map(|e| e / longest),
             window: v.window,
+            mm_per_unit: longest,
             bricks: BrickRanges {
                 brick: grid.brick,
                 grid: grid.dims,
@@ -109,6 +112,8 @@ impl VolumeUpload {
             bytes: Vec::new(),
             world_size: dims.map(|d| d as f32 / longest),
             window: [0.0, 1.0],
+            // Made on demand at 1 mm voxels.
+            mm_per_unit: longest,
             bricks: BrickRanges {
                 brick: Self::BRICK,
                 grid: dims.map(|d| d.div_ceil(Self::BRICK)),

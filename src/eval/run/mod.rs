@@ -17,6 +17,7 @@ use super::plan::{Plan, PlannedScene};
 use super::references::fill::FillReport;
 use super::references::{frame_name, ReferenceCache};
 use super::results::{MetricRow, SceneResult};
+use crate::profile::method_gpu_ms;
 use crate::progress::Progress;
 use crate::setup::Setup;
 use crate::shard::{FolderReport, RunReport};
@@ -53,18 +54,6 @@ pub fn total_units(plan: &Plan, take: impl Fn(usize) -> bool) -> f64 {
                 + f64::from(s.frames) * (f64::from(s.spp) + plan.methods as f64)
                 + baseline::units(s.frames, plan.ref_spp)
         })
-        .sum()
-}
-
-/// GPU time of `method` in one frame: the passes every method shares (path trace,
-/// motion) plus those it needs (the surface features and guide images, when it reads
-/// them, however many other methods read them too) and its own; uploads and readbacks
-/// are no method's cost. The graph records whom each pass works for.
-pub fn method_gpu_ms(timings: &[PassTiming], method: &str) -> f64 {
-    timings
-        .iter()
-        .filter(|t| t.owner.counts_for(method))
-        .map(|t| t.ms)
         .sum()
 }
 
