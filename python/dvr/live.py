@@ -131,6 +131,7 @@ class SettingsView(_Section):
         self.update(**{key: value})
 
     def keys(self):
+        """The section's field names (as a dict's ``keys()``)."""
         return self._get().keys()
 
 
@@ -145,6 +146,8 @@ class LightView(_Section):
         return LIGHT_FIELDS.get(self._get().get("kind"), ())
 
     def update(self, **fields):
+        """Sets several of the light's fields in one edit (``color`` is read as
+        ``colour``)."""
         if "color" in fields:
             fields["colour"] = fields.pop("color")
         d = dict(self._get())

@@ -287,6 +287,7 @@ class Renderer:
 
     @property
     def closed(self) -> bool:
+        """Whether :meth:`close` has run (a closed renderer renders nothing more)."""
         return self._r.closed
 
     def __enter__(self):
@@ -302,10 +303,12 @@ class Renderer:
 
     @property
     def frames_rendered(self) -> int:
+        """Frames rendered so far (what the temporal denoisers have seen)."""
         return self._r.frames_rendered
 
     @property
     def device(self) -> str:
+        """The Vulkan device it renders on (e.g. ``"llvmpipe (LLVM 15.0.6, 256 bits)"``)."""
         return self._r.device
 
     @property
@@ -317,6 +320,7 @@ class Renderer:
 
     @property
     def spp(self) -> int:
+        """Samples per pixel per frame."""
         return self._r.spp
 
     def _put(self, section, value):

@@ -145,6 +145,7 @@ class TransferFunction:
         return list(_native.tf_preset_names())
 
     def to_dict(self) -> dict:
+        """The TF as a TF file holds it: its name, units and control points."""
         d = {"name": self.name, "point": [dict(p) for p in self.points]}
         if self.units == "data":
             # Densities in the volume's data units (Hounsfield for CT): the engine maps
@@ -169,6 +170,7 @@ class Camera:
         self.fov_y_degrees = float(fov_y_degrees)
 
     def to_dict(self) -> dict:
+        """The scene file's section this stands for, as a plain dict."""
         return {"position": self.position, "target": self.target, "up": self.up, "fov_y_degrees": self.fov_y_degrees}
 
     @classmethod
@@ -188,6 +190,7 @@ class PointLight:
         self.intensity = float(intensity)
 
     def to_dict(self):
+        """The scene file's section this stands for, as a plain dict."""
         return {"kind": "point", "position": self.position, "colour": self.colour, "intensity": self.intensity}
 
 
@@ -202,6 +205,7 @@ class AreaLight:
         self.intensity = float(intensity)
 
     def to_dict(self):
+        """The scene file's section this stands for, as a plain dict."""
         return {
             "kind": "area",
             "position": self.position,
@@ -223,6 +227,7 @@ class EnvironmentLight:
         self.intensity = float(intensity)
 
     def to_dict(self):
+        """The scene file's section this stands for, as a plain dict."""
         if self.top is not None and self.bottom is not None:
             return {"kind": "environment", "mode": "gradient", "top": self.top, "bottom": self.bottom, "intensity": self.intensity}
         return {"kind": "environment", "mode": "constant", "colour": self.colour, "intensity": self.intensity}
@@ -238,6 +243,7 @@ class ClipPlane:
         self.enabled = bool(enabled)
 
     def to_dict(self):
+        """The scene file's section this stands for, as a plain dict."""
         return {"point": self.point, "normal": self.normal, "enabled": self.enabled}
 
     def __repr__(self):
@@ -256,6 +262,7 @@ class CropBox:
         self.enabled = bool(enabled)
 
     def to_dict(self):
+        """The scene file's section this stands for, as a plain dict."""
         return {"min": self.min, "max": self.max, "units": self.units, "enabled": self.enabled}
 
     def __repr__(self):
@@ -332,10 +339,12 @@ class Scene:
 
     @property
     def name(self) -> str:
+        """The scene's name (reports and file names use it)."""
         return self.data.get("name", "python")
 
     @property
     def frames(self) -> int:
+        """Frames in the scene's animation (settable)."""
         return int(self.data.get("animation", {}).get("frames", 1))
 
     @frames.setter

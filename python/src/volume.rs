@@ -27,6 +27,8 @@ const FIELDS: &[&str] = &[
     "data",
 ];
 
+/// A density volume in the engine's form: from a numpy array, a file or a built-in
+/// dataset, held in RAS order (see `to_patient`) with its data window and stored type.
 #[pyclass(module = "dvr._native", frozen)]
 pub struct Volume {
     pub inner: EngineVolume,

@@ -1,6 +1,6 @@
 //! One level of the à-trous filter over estimates that carry their variance
 //! (shaders/glsl/variance_atrous.comp), shared by ours' spatial filter and the paper's
-//! p = [1] models: the push block, the pipeline and how a level is added.
+//! p = \[1\] models: the push block, the pipeline and how a level is added.
 
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline, SpecValue};

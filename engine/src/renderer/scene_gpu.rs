@@ -293,7 +293,7 @@ pub fn majorants(bricks: &BrickRanges, opacity: &[f32], density_scale: f32) -> V
 }
 
 /// Zeroes the majorant of every brick that one cut removes whole (see
-/// [`Cut::removes`]), for a volume of `dims` voxels spanning `world` units: the majorant
+/// [`Cut::removes`](crate::scene::Cut::removes)), for a volume of `dims` voxels spanning `world` units: the majorant
 /// grid then skips it, and the brick pool does not make it resident.
 pub fn mask_cut(
     majorants: &mut [f32],

@@ -1,15 +1,15 @@
 //! The paper's weighted-RLS family (TVCG §5–6): `wrls-paper` (its exact formulation) and
 //! `rls-paper` (the same without weights), the family's base `wrls` (the feature from the
 //! reprojected history, residual weights, restarts) and its Fig. 8 ablations `rls` (no
-//! weighting), `wrls-nf` (no temporal feature, p = [1]) and `rls-nf` (neither), from the
+//! weighting), `wrls-nf` (no temporal feature, p = \[1\]) and `rls-nf` (neither), from the
 //! same passes through specialisation constants.
 //!
 //! Passes of a frame, in order (each in its own file here):
 //! - `<name>.update` ([`update`]): the per-pixel models reprojected and updated by
 //!   weighted RLS: `wrls_update.comp` for the paper's p = [1, z] (nine state images),
-//!   `wrls_constant.comp` for p = [1] (two);
+//!   `wrls_constant.comp` for p = \[1\] (two);
 //! - `<name>.spatial` (`wrls_spatial.comp`): the paper's 5×5 model blending, or for p =
-//!   [1] `<name>.atrous0` (`variance_atrous.comp`): one 5×5 level over the predictions
+//!   \[1\] `<name>.atrous0` (`variance_atrous.comp`): one 5×5 level over the predictions
 //!   ([`spatial`]).
 
 mod spatial;
@@ -29,7 +29,7 @@ use update::{WrlsConstantPush, WrlsUpdatePush};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WrlsParams {
     pub lambda: f32,
-    /// Forgetting factor of a pixel whose surface moved on screen (p = [1] models).
+    /// Forgetting factor of a pixel whose surface moved on screen (p = \[1\] models).
     pub lambda_moving: f32,
     pub alpha: f32,
     /// Bandwidth of the paper's relative-distance weights (`wrls-paper` only).
@@ -45,7 +45,7 @@ pub struct WrlsParams {
     pub kappa: f32,
     /// Squared a-priori residual over its running noise level that counts as a change.
     pub change_ratio: f32,
-    /// Residual weights of the p = [1] models: a sample's weight falls off with its
+    /// Residual weights of the p = \[1\] models: a sample's weight falls off with its
     /// a-priori residual in units of the model's running noise level, exp(−r²/(k²·noise));
     /// this is k. Only samples many standard deviations out (spikes) lose weight.
     pub outlier_sigmas: f32,

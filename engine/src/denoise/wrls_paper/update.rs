@@ -1,5 +1,5 @@
 //! `<name>.update`: the per-pixel models reprojected from last frame and updated by
-//! weighted RLS with this frame's noisy colour: the constant model p = [1]
+//! weighted RLS with this frame's noisy colour: the constant model p = \[1\]
 //! (`wrls_constant.comp`, two state images) or the paper's p = [1, z] (`wrls_update.comp`,
 //! nine: the feature, β per channel, the shared P, and the constant model and both
 //! models' errors that the shaders' model selection would use).
