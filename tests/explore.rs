@@ -437,3 +437,58 @@ fn without_a_display_it_says_how_to_get_one() {
         "{err}"
     );
 }
+
+/// Pixels of the orientation cue's colour (a light blue, far from the volume's and the
+/// background's greys) in a rectangle of a shot.
+fn cue_pixels(s: &Shot, x0: u32, y0: u32, x1: u32, y1: u32) -> usize {
+    let mut n = 0;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let [r, g, b] = s.px(x, y);
+            if b > 200 && i32::from(b) - i32::from(r) > 80 && g > 150 {
+                n += 1;
+            }
+        }
+    }
+    n
+}
+
+#[test]
+fn the_view_shows_orientation_letters_and_a_scale_bar_that_follow_the_camera() {
+    let Some(x) = xvfb() else { return };
+    let dir = tempfile::tempdir().expect("temp dir");
+    // Key 1: the anterior view (R on the left edge); key 3: from the left (A there).
+    let front = explore_shot(&x, dir.path(), "front.png", &["--script", "key:1@0"]);
+    let side = explore_shot(&x, dir.path(), "side.png", &["--script", "key:3@0"]);
+    let mid = SIZE / 2;
+    for (name, s) in [("front", &front), ("side", &side)] {
+        let left = cue_pixels(s, 0, mid - 14, 24, mid + 14);
+        let right = cue_pixels(s, SIZE - 24, mid - 14, SIZE, mid + 14);
+        let top = cue_pixels(s, mid - 14, 0, mid + 14, 30);
+        let bar = cue_pixels(s, 0, SIZE - 50, 140, SIZE);
+        eprintln!("{name}: cue pixels left {left}, right {right}, top {top}, scale bar {bar}");
+        assert!(
+            left > 5 && right > 5 && top > 5,
+            "{name}: no letters at the edges"
+        );
+        assert!(bar > 40, "{name}: no scale bar");
+    }
+    // The left edge's letter changes with the view (R from the front, A from the left).
+    let mut differ = 0;
+    for y in mid - 14..mid + 14 {
+        for px in 0..24 {
+            differ += usize::from(front.px(px, y) != side.px(px, y));
+        }
+    }
+    let letters_differ = (0..24)
+        .flat_map(|px| (mid - 14..mid + 14).map(move |y| (px, y)))
+        .filter(|&(px, y)| {
+            let cue = |s: &Shot| cue_pixels(s, px, y, px + 1, y + 1) == 1;
+            cue(&front) != cue(&side)
+        })
+        .count();
+    assert!(
+        differ > 0 && letters_differ > 5,
+        "the left edge's letter is the same from the front and the side"
+    );
+}
