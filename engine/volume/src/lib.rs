@@ -68,6 +68,7 @@ mod phantom;
 mod procedural;
 mod raw;
 mod samples;
+mod series;
 pub mod sparse;
 #[cfg(test)]
 mod write;
@@ -81,6 +82,7 @@ pub use majorant::MajorantGrid;
 pub use orientation::PatientTransform;
 pub use raw::{RawFormat, RawParams};
 pub use samples::SampleKind;
+pub use series::{expand_glob, ChannelInfo, Series, SeriesInfo, MAX_CHANNELS};
 
 use samples::{Samples, Stored};
 
@@ -365,9 +367,22 @@ impl Volume {
         spacing: [f32; 3],
         stored: Stored,
     ) -> Result<Volume, VolumeError> {
+        Self::from_stored_in(path, name, dims, spacing, stored, None).map(|(v, _)| v)
+    }
+
+    /// [`Volume::from_stored`] through the window `fixed` where given (a series' later
+    /// time points), else its own; returns the window used, unrounded.
+    pub(crate) fn from_stored_in(
+        path: &Path,
+        name: String,
+        dims: [u32; 3],
+        spacing: [f32; 3],
+        stored: Stored,
+        fixed: Option<(f64, f64)>,
+    ) -> Result<(Volume, (f64, f64)), VolumeError> {
         let orientation = stored.orientation;
         let sample_kind = stored.samples.kind();
-        let n = normalise::normalise(path, dims, stored)?;
+        let n = normalise::normalise(path, dims, stored, fixed)?;
         let v = Volume {
             name,
             dims,
@@ -377,10 +392,11 @@ impl Volume {
             sample_kind,
             data: n.data,
         };
-        match orientation {
-            Some(t) => orientation::to_ras(path, v, t),
-            None => Ok(v),
-        }
+        let v = match orientation {
+            Some(t) => orientation::to_ras(path, v, t)?,
+            None => v,
+        };
+        Ok((v, n.exact_window))
     }
 }
 
