@@ -17,7 +17,7 @@ use std::path::Path;
 
 use super::error::VolumeError;
 use super::samples::{Affine, Rescale, SampleKind, Samples, Stored};
-use super::series::{Source, SourceChannel, SourceInfo};
+use super::series::{channel_list, Source, SourceInfo};
 use super::{io, name_of, validate_dims, validate_spacing, PatientTransform, Volume};
 
 /// Size of a NIfTI-1 header.
@@ -79,7 +79,7 @@ pub(crate) fn open_series(path: &Path) -> Result<Box<dyn Source>, VolumeError> {
         name: name_of(path),
         dims: header.dims,
         orientation: header.orientation,
-        channels: vec![SourceChannel::default(); header.channels as usize],
+        channels: channel_list(path, u64::from(header.channels), Vec::new())?,
         times: header.times as usize,
     };
     Ok(Box::new(NiftiSeries { info, header }))

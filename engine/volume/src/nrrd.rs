@@ -15,8 +15,9 @@ use std::path::{Path, PathBuf};
 
 use super::error::VolumeError;
 use super::samples::{SampleKind, Samples, Stored};
-use super::series::{Source, SourceChannel, SourceInfo};
+use super::series::{channel_list, Source, SourceInfo};
 use super::{io, name_of, validate_dims, validate_spacing, PatientTransform, Volume};
+use axes::{classify_axes, gather, Axes};
 
 const SUPPORTED_TYPES: &str = "uint8, uint16, int16, float";
 
@@ -70,7 +71,7 @@ pub(crate) fn open_series(path: &Path) -> Result<Box<dyn Source>, VolumeError> {
         name: name_of(path),
         dims: nrrd.dims,
         orientation: nrrd.orientation,
-        channels: vec![SourceChannel::default(); nrrd.channels],
+        channels: channel_list(path, nrrd.channels as u64, Vec::new())?,
         times: nrrd.times,
     };
     Ok(Box::new(NrrdSeries { info, nrrd }))
@@ -164,6 +165,12 @@ fn open(path: &Path) -> Result<Nrrd, VolumeError> {
             ))
         }
     };
+    // Every byte offset below is within this product; a header whose sizes overflow it
+    // describes more data than any file holds.
+    sizes
+        .iter()
+        .try_fold(kind.bytes() as u64, |a, &n| a.checked_mul(n as u64))
+        .ok_or_else(|| malformed("sizes", format!("{sizes:?}: more data than a file holds")))?;
 
     let big_endian = match header.fields.get("endian").map(|s| s.trim()) {
         Some("little") => false,
@@ -430,26 +437,6 @@ impl Nrrd {
     }
 }
 
-/// The voxels of a span read at element strides `sp` (x, y, z), packed x fastest.
-fn gather(span: Vec<u8>, b: usize, dims: [u32; 3], sp: [u64; 3]) -> Vec<u8> {
-    let contiguous = sp[0] == 1
-        && sp[1] == u64::from(dims[0])
-        && sp[2] == u64::from(dims[0]) * u64::from(dims[1]);
-    if contiguous {
-        return span;
-    }
-    let mut out = Vec::with_capacity(crate::voxel_count(dims) as usize * b);
-    for z in 0..u64::from(dims[2]) {
-        for y in 0..u64::from(dims[1]) {
-            for x in 0..u64::from(dims[0]) {
-                let at = ((x * sp[0] + y * sp[1] + z * sp[2]) as usize) * b;
-                out.extend_from_slice(&span[at..at + b]);
-            }
-        }
-    }
-    out
-}
-
 /// `Truncated` or `SizeMismatch` when `found` bytes are not the `expected` of every
 /// channel and time point.
 fn check_total(
@@ -579,133 +566,6 @@ fn parse_type(path: &Path, t: &str) -> Result<SampleKind, VolumeError> {
             supported: SUPPORTED_TYPES,
         }),
     }
-}
-
-/// What each axis of the data is.
-#[derive(Clone, Debug, PartialEq)]
-struct Axes {
-    /// The axes that become x, y, z, in order.
-    spatial: Vec<usize>,
-    channel: Option<usize>,
-    time: Option<usize>,
-}
-
-/// `kinds` that hold the components of a value at one place: channels.
-const CHANNEL_KINDS: &[&str] = &[
-    "list",
-    "point",
-    "vector",
-    "covariant-vector",
-    "normal",
-    "stub",
-    "scalar",
-    "complex",
-    "2-vector",
-    "3-color",
-    "rgb-color",
-    "hsv-color",
-    "xyz-color",
-    "4-color",
-    "rgba-color",
-    "3-vector",
-    "3-gradient",
-    "3-normal",
-    "4-vector",
-    "quaternion",
-];
-
-/// Which axes are space, channels and time. By `kinds` where given (`domain`/`space`
-/// are space, `time` is time, [`CHANNEL_KINDS`] are channels; `???`/`none` decide
-/// nothing); otherwise for 4D data a size-1 axis is dropped, else the non-spatial axis
-/// is the one whose `space directions` entry is `none` (else the last): channels when it
-/// has at most 4 entries, time when more. 5D data needs `kinds`.
-fn classify_axes(
-    path: &Path,
-    fields: &HashMap<String, String>,
-    sizes: &[i64],
-) -> Result<Axes, VolumeError> {
-    let n = sizes.len();
-    let unsupported = |reason: String| VolumeError::Unsupported {
-        path: path.to_path_buf(),
-        reason,
-    };
-    if !(2..=5).contains(&n) {
-        return Err(unsupported(format!(
-            "NRRD dimension {n}: a volume needs 2 (one slice) or 3 spatial axes, with at most \
-             a channel and a time axis"
-        )));
-    }
-    let mut channel = None;
-    let mut time = None;
-    let mut spatial = Vec::new();
-    let kinds: Option<Vec<String>> = fields
-        .get("kinds")
-        .map(|k| {
-            k.split_whitespace()
-                .map(|s| s.to_ascii_lowercase())
-                .collect()
-        })
-        .filter(|k: &Vec<String>| k.len() == n);
-    let decided = kinds
-        .as_ref()
-        .is_some_and(|k| k.iter().all(|k| k != "???" && k != "none"));
-    if let (Some(k), true) = (&kinds, decided) {
-        for (a, kind) in k.iter().enumerate() {
-            let slot = if kind == "time" {
-                &mut time
-            } else if CHANNEL_KINDS.contains(&kind.as_str()) {
-                &mut channel
-            } else {
-                spatial.push(a);
-                continue;
-            };
-            if slot.replace(a).is_some() {
-                return Err(VolumeError::MalformedHeader {
-                    path: path.to_path_buf(),
-                    field: "kinds".into(),
-                    problem: format!("{k:?}: more than one {kind} axis"),
-                });
-            }
-        }
-    } else if n <= 3 {
-        spatial = (0..n).collect();
-    } else if n == 4 {
-        let none_dir = fields
-            .get("space directions")
-            .and_then(|d| parse_directions(d))
-            .and_then(|d| d.iter().position(Option::is_none));
-        let extra = match sizes.iter().position(|&s| s == 1) {
-            Some(one) => one,
-            None => none_dir.unwrap_or(3),
-        };
-        if sizes[extra] <= 4 {
-            channel = Some(extra);
-        } else {
-            time = Some(extra);
-        }
-        spatial = (0..4).filter(|&a| a != extra).collect();
-    } else {
-        return Err(unsupported(format!(
-            "5D NRRD with sizes {sizes:?} and no `kinds`: say which axis is time and which \
-             channels (e.g. `kinds: vector domain domain domain time`)"
-        )));
-    }
-    if !(2..=3).contains(&spatial.len()) || (spatial.len() == 2 && n > 2) {
-        return Err(VolumeError::MalformedHeader {
-            path: path.to_path_buf(),
-            field: "kinds".into(),
-            problem: format!(
-                "{} spatial axes in sizes {sizes:?}: a volume has 3 (at most one channel and \
-                 one time axis beside them)",
-                spatial.len()
-            ),
-        });
-    }
-    Ok(Axes {
-        spatial,
-        channel,
-        time,
-    })
 }
 
 /// Spacing of the spatial axes from `space directions` or `spacings` (1 mm when
@@ -916,5 +776,6 @@ fn resolve(header: &Path, name: &str) -> PathBuf {
     }
 }
 
+mod axes;
 #[cfg(test)]
 mod tests;

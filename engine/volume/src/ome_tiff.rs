@@ -15,7 +15,7 @@
 
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
-use super::series::{Source, SourceChannel, SourceInfo};
+use super::series::{channel_list, Source, SourceChannel, SourceInfo};
 use super::{io, name_of, validate_dims, validate_spacing, Volume, MAX_DIM};
 use std::path::Path;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
@@ -238,15 +238,7 @@ pub(crate) fn open_series(path: &Path) -> Result<Box<dyn Source>, VolumeError> {
     let (dims, channels, times) = match &pixels {
         Some(p) => {
             let dims = validate_dims(path, p.size.map(|n| i64::try_from(n).unwrap_or(i64::MAX)))?;
-            let c = usize::try_from(p.channels).unwrap_or(usize::MAX);
-            let mut meta = p.channel_meta.clone();
-            if c > 4096 {
-                return Err(VolumeError::TooManyChannels {
-                    path: path.to_path_buf(),
-                    count: c,
-                });
-            }
-            meta.resize(c, SourceChannel::default());
+            let meta = channel_list(path, p.channels, p.channel_meta.clone())?;
             (dims, meta, usize::try_from(p.times).unwrap_or(usize::MAX))
         }
         // A plain stack: its page count is known only once read.

@@ -108,6 +108,27 @@ pub(crate) struct SourceChannel {
     pub display_window: Option<[f64; 2]>,
 }
 
+/// Most channels a file may state: far more than any image has, and a bound on what a
+/// header's channel count makes us allocate before its data is read.
+pub(crate) const MAX_SOURCE_CHANNELS: u64 = 1 << 16;
+
+/// `n` channels with `meta` for the first ones (and none for the rest), refused past
+/// [`MAX_SOURCE_CHANNELS`].
+pub(crate) fn channel_list(
+    path: &Path,
+    n: u64,
+    mut meta: Vec<SourceChannel>,
+) -> Result<Vec<SourceChannel>, VolumeError> {
+    if n > MAX_SOURCE_CHANNELS {
+        return Err(VolumeError::TooManyChannels {
+            path: path.to_path_buf(),
+            count: usize::try_from(n).unwrap_or(usize::MAX),
+        });
+    }
+    meta.resize(n as usize, SourceChannel::default());
+    Ok(meta)
+}
+
 /// A file's series layout, from its header alone.
 #[derive(Clone, Debug)]
 pub(crate) struct SourceInfo {
