@@ -19,8 +19,9 @@
 //! | NRRD | `.nrrd` (attached) and `.nhdr` (detached); raw/gzip; uint8/uint16/int16/float | `nrrd.rs` |
 //! | NIfTI-1 | `.nii`, `.nii.gz`; uint8/int16/uint16/float32; `scl_slope/inter` | `nifti.rs` |
 //! | DICOM | a folder of slices (uncompressed little endian, 8/16 bit) | `dicom.rs` |
-//! | OME-TIFF | `.ome.tif(f)` z-stacks (channel 0, time 0; spacing from the OME-XML), plain `.tif` page stacks; uint8/uint16/int16/float32 | `ome_tiff.rs` |
+//! | OME-TIFF | `.ome.tif(f)` z-stacks (channel 0, time 0 here, all of them as a series; spacing from the OME-XML), plain `.tif` page stacks; uint8/uint16/int16/float32 | `ome_tiff.rs` |
 //! | OME-Zarr | an image group (0.4 on Zarr v2, 0.5 on Zarr v3; the finest level that fits) or one level's array; uint8/uint16/int16/float32; blosc, gzip, zstd | `zarr.rs` |
+//! | a series | up to 4 channels on one grid at T time points, read one time point at a time ([`Series`]): NIfTI `dim[4]`/`dim[5]`, NRRD `kinds`, OME-Zarr `c`/`t` axes and `omero`, OME-TIFF `SizeC`/`SizeT`, lists and globs of files | `series.rs` |
 //! | built-in | `phantom` (CT-like head, thin vessels), `cloud` (homogeneous), `mri` (MNI152) | `builtin.rs` |
 //!
 //! Loaders keep the file's index order (no reorientation to RAS/LPS): the renderer

@@ -333,7 +333,7 @@ impl Nrrd {
                 path: data_path.clone(),
                 source,
             })?;
-        let mut data: Box<dyn BufRead> = Box::new(file);
+        let mut data = file;
         let mut skipped_lines: u64 = 0;
         for _ in 0..line_skip {
             let mut line = Vec::new();
@@ -374,7 +374,15 @@ impl Nrrd {
                 }
                 // Check the size before reading, so wrong dims on a huge file fail fast.
                 check_total(data_path, dims, kind, expected, region_len - skip)?;
-                io::read_bounded(data_path, data, skip + base * b, span * b, &skip_past_end)?
+                // The length is checked: seek to the span rather than read up to it, so
+                // a late time point costs no more than the first.
+                let at = self.data_start + skipped_lines + skip + base * b;
+                data.seek(SeekFrom::Start(at))
+                    .map_err(|source| VolumeError::Io {
+                        path: data_path.clone(),
+                        source,
+                    })?;
+                io::read_bounded(data_path, data, 0, span * b, &skip_past_end)?
             }
             "gzip" | "gz" => {
                 if byte_skip < 0 {

@@ -577,3 +577,77 @@ fn bad_selections_times_and_channel_counts_are_errors_naming_the_file() {
     let e = Series::open(&p, None).unwrap_err().to_string();
     assert!(e.contains("short.nii") && e.contains("truncated"), "{e}");
 }
+
+#[test]
+fn a_dicom_series_is_one_channel_at_one_time_point_with_its_orientation() {
+    let dir = tempfile::tempdir().unwrap();
+    for z in 0..3 {
+        let s = write::DicomSlice {
+            rows: 3,
+            cols: 4,
+            pixels16: Some((0..12).map(|i| i * 40 + z as i16).collect()),
+            pixels8: None,
+            signed: true,
+            bits_stored: 12,
+            position: Some([-10.0, -20.0, 5.0 + 2.5 * z as f64]),
+            orientation: Some([1.0, 0.0, 0.0, 0.0, 1.0, 0.0]),
+            instance: Some(z as i64 + 1),
+            pixel_spacing: [0.7, 0.6],
+            thickness: Some(3.0),
+            rescale: (1.0, -1024.0),
+            series: "1.2.3.4".into(),
+            explicit: true,
+        };
+        write::dicom(&dir.path().join(format!("{z}.dcm")), &s);
+    }
+    let want = Volume::load(dir.path(), None).unwrap();
+    let s = Series::open(dir.path(), None).unwrap();
+    assert_eq!((s.info().channels.len(), s.info().times), (1, 1));
+    assert_eq!(s.read(0).unwrap(), vec![want]);
+}
+
+#[test]
+fn lists_of_channel_files_must_agree_on_time_points_and_hold_one_channel_each() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.nii");
+    let b = dir.path().join("b.nii");
+    let two = dir.path().join("two.nii");
+    write::nifti(&a, [2, 2, 2], [1.0; 3], &NiftiData::U8(block(0)), None);
+    let data: Vec<u8> = (0..2).flat_map(block).collect();
+    write::nifti_series(
+        &b,
+        [2, 2, 2],
+        [2, 1],
+        [1.0; 3],
+        &NiftiData::U8(data.clone()),
+        None,
+        None,
+    );
+    write::nifti_series(
+        &two,
+        [2, 2, 2],
+        [1, 2],
+        [1.0; 3],
+        &NiftiData::U8(data),
+        None,
+        None,
+    );
+    let e = Series::open_channels(&[a.clone(), b.clone()], None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("a.nii") && e.contains("b.nii") && e.contains("2 time points"),
+        "{e}"
+    );
+    let e = Series::open_channels(&[a.clone(), two], None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("two.nii") && e.contains("holds 2"), "{e}");
+    // An explicit list of time points; a 2-time-point file in it is refused.
+    let c = dir.path().join("c.nii");
+    write::nifti(&c, [2, 2, 2], [1.0; 3], &NiftiData::U8(block(7)), None);
+    let s = Series::open_times(&[a.clone(), c.clone()], None).unwrap();
+    assert_eq!(u8s(&s.read(1).unwrap()[0]), block(7));
+    let e = Series::open_times(&[a, b], None).unwrap_err().to_string();
+    assert!(e.contains("b.nii") && e.contains("2 time points"), "{e}");
+}
