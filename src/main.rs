@@ -3,7 +3,7 @@
 //! interactive window), capture (offscreen sequences),
 //! reference (high-sample references), eval (denoisers against references: metrics,
 //! plots, HTML), profile (per-pass GPU timing), bench (the one-call GPU benchmark), scenes
-//! (the built-in scenes).
+//! (the built-in scenes), info (what a volume file holds: grid, channels, time points).
 
 mod args;
 mod bench;
@@ -12,6 +12,7 @@ mod demo;
 mod eval;
 mod explore;
 mod font;
+mod info;
 mod logger;
 mod output;
 mod profile;
@@ -102,6 +103,9 @@ enum Command {
     /// 1920x1080 and runs the eval suite at 256x256 against 1024-spp references; writes
     /// one small folder of CSV, JSON and plots (`tools/gpu-bench.sh` wraps it).
     Bench(bench::BenchArgs),
+    /// What a volume file (or a list of files) holds: its grid, spacing, orientation
+    /// (to_patient), channels (name, colour, window) and time points.
+    Info(info::InfoArgs),
     /// List the built-in scenes, or print one as a TOML scene file.
     Scenes {
         /// Print this scene as TOML (a starting point for your own).
@@ -184,6 +188,7 @@ fn run(cli: Cli) -> Result<()> {
             trace,
         } => capture::profile(&scene, &denoiser, json.as_deref(), trace.as_deref()),
         Command::Bench(args) => bench::run(&args),
+        Command::Info(args) => info::run(&args),
         Command::Scenes { dump } => setup::list_scenes(dump.as_deref()),
     }
 }

@@ -740,3 +740,58 @@ fn a_reference_folder_is_never_shared_by_runs_with_other_settings() {
     }
     assert!(frames_and_key(&twins.join("reference")) == frames_and_key(&alone4.join("reference")));
 }
+
+/// A NIfTI-1 file of `t` time points of `c` channels of 2×2×2 uint8 voxels (voxel i of
+/// volume v holds 30 i + v), no orientation.
+fn nifti_4d(path: &Path, t: i16, c: i16) {
+    let mut h = vec![0u8; 352];
+    let put = |h: &mut Vec<u8>, at: usize, b: &[u8]| h[at..at + b.len()].copy_from_slice(b);
+    put(&mut h, 0, &348i32.to_le_bytes());
+    for (i, d) in [5i16, 2, 2, 2, t, c, 1, 1].iter().enumerate() {
+        put(&mut h, 40 + 2 * i, &d.to_le_bytes());
+    }
+    put(&mut h, 70, &2i16.to_le_bytes());
+    put(&mut h, 72, &8i16.to_le_bytes());
+    for i in 0..8 {
+        put(&mut h, 76 + 4 * i, &1f32.to_le_bytes());
+    }
+    put(&mut h, 108, &352f32.to_le_bytes());
+    h[123] = 2;
+    put(&mut h, 344, b"n+1\0");
+    for v in 0..(t * c) as u8 {
+        h.extend((0..8u8).map(|i| 30 * i + v));
+    }
+    std::fs::write(path, h).expect("write nifti");
+}
+
+#[test]
+fn info_prints_a_series_channels_and_time_points() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let file = dir.path().join("fmri.nii");
+    nifti_4d(&file, 3, 2);
+    let path = file.to_str().expect("utf-8 path");
+    let out = dvr(&["info", path, "--json"]);
+    assert_ok(&out);
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(info["dims"], serde_json::json!([2, 2, 2]));
+    assert_eq!(info["times"], 3);
+    assert_eq!(info["channels"].as_array().map(Vec::len), Some(2));
+    assert_eq!(
+        info["to_patient"][3],
+        serde_json::json!([0.0, 0.0, 0.0, 1.0])
+    );
+    // A selection, in its order; the text form names the channels.
+    let out = dvr(&["info", path, "--channels", "1"]);
+    assert_ok(&out);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("time points 3") && text.contains("channel 1"),
+        "{text}"
+    );
+    let out = dvr(&["info", path, "--channels", "0,5"]);
+    assert_error(&out, &["fmri.nii", "channel 5 is out of range"]);
+    let many = dir.path().join("many.nii");
+    nifti_4d(&many, 1, 5);
+    let out = dvr(&["info", many.to_str().expect("utf-8 path")]);
+    assert_error(&out, &["many.nii", "5 channels", "channels = [0, 2]"]);
+}

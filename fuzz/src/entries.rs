@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use dvr_engine::scene::Scene;
 use dvr_engine::transfer::TransferFunction;
 use dvr_engine::volume::{
-    RawFormat, RawParams, Volume, VolumeError, MAX_ANISOTROPY, MAX_DIM, MAX_SPACING_MM, MAX_VOXELS,
-    MIN_SPACING_MM,
+    RawFormat, RawParams, Series, Volume, VolumeError, MAX_ANISOTROPY, MAX_DIM, MAX_SPACING_MM,
+    MAX_VOXELS, MIN_SPACING_MM,
 };
 
 /// A target's entry point: the input, and a folder for the files it writes.
@@ -52,6 +52,13 @@ fn load_file(scratch: &Path, file_name: &str, bytes: &[u8], raw: Option<&RawPara
     let path = dir.join(file_name);
     std::fs::write(&path, bytes).expect("write input");
     let _ = Volume::load(&path, raw);
+    if raw.is_none() {
+        // The same bytes as a series: its header's channels and time points, and its
+        // last time point (the read furthest into the data).
+        if let Ok(series) = Series::open(&path, None) {
+            let _ = series.read(series.info().times - 1);
+        }
+    }
 }
 
 /// `.nii` (or gzipped: the loader looks at the magic bytes, not the name).

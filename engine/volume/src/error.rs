@@ -107,4 +107,55 @@ pub enum VolumeError {
     /// `Volume::builtin` was given a name it does not know.
     #[error("unknown builtin volume `{name}`; valid names: {valid}")]
     UnknownBuiltin { name: String, valid: String },
+
+    /// More channels than one volume texture packs (4), with no selection.
+    #[error(
+        "{}: {count} channels; dvr renders at most 4 at once: pick some by index, e.g. \
+         `channels = [0, 2]` (`--channels 0,2` on the command line)",
+        path.display()
+    )]
+    TooManyChannels { path: PathBuf, count: usize },
+
+    /// A channel selection names a channel that is not there, or one twice.
+    #[error("{}: channel selection {selection:?}: {problem}", path.display())]
+    ChannelSelection {
+        path: PathBuf,
+        selection: Vec<usize>,
+        problem: String,
+    },
+
+    /// A time point past the series' last.
+    #[error("{}: time point {time} is out of range: the series has {times} (0..{times})", path.display())]
+    TimeOutOfRange {
+        path: PathBuf,
+        time: usize,
+        times: usize,
+    },
+
+    /// Two files of one series that must share a grid do not.
+    #[error(
+        "{}: {what} on different grids: {} is {}, {} is {}",
+        path.display(), path.display(), shape, other.display(), other_shape
+    )]
+    GridMismatch {
+        path: PathBuf,
+        what: &'static str,
+        shape: String,
+        other: PathBuf,
+        other_shape: String,
+    },
+
+    /// A channel on another grid than the first file's, with no orientation to place it.
+    #[error(
+        "{}: its grid ({shape}) differs from {}'s ({first_shape}) and it has no affine to \
+         resample by (no sform/qform, space directions or DICOM orientation); give it the \
+         first file's grid, or an orientation",
+        path.display(), first.display()
+    )]
+    NoAffine {
+        path: PathBuf,
+        shape: String,
+        first: PathBuf,
+        first_shape: String,
+    },
 }

@@ -9,6 +9,7 @@
 use std::io::Read;
 use std::path::Path;
 
+use crate::series::{Source, WholeFile};
 use crate::{dicom, nifti, nrrd, ome_tiff, raw, zarr, Volume, VolumeError};
 
 /// What a load asks beyond the path.
@@ -35,6 +36,8 @@ pub(crate) struct Format {
     /// For a format stored as a folder: whether this folder holds one.
     pub folder: Option<fn(&Path) -> bool>,
     pub load: fn(&Path, Request) -> Result<Volume, VolumeError>,
+    /// Opens it as a series of channels and time points (`series.rs`).
+    pub series: fn(&Path) -> Result<Box<dyn Source>, VolumeError>,
 }
 
 /// Every format `Volume::load` reads, in the order it tries them.
@@ -45,6 +48,7 @@ pub(crate) const FORMATS: &[Format] = &[
         magic: &[],
         folder: Some(zarr::is_zarr),
         load: |p, r| zarr::load(p, r.budget),
+        series: zarr::open_series,
     },
     Format {
         name: "DICOM series",
@@ -61,6 +65,8 @@ pub(crate) const FORMATS: &[Format] = &[
                 dicom::load_files(p, vec![p.to_path_buf()])
             }
         },
+        // A DICOM series is one 3D volume with an orientation.
+        series: |p| WholeFile::open(p, load(p, Request::default())?, true),
     },
     Format {
         name: "NRRD",
@@ -71,6 +77,7 @@ pub(crate) const FORMATS: &[Format] = &[
         }],
         folder: None,
         load: |p, _| nrrd::load(p),
+        series: nrrd::open_series,
     },
     Format {
         name: "NIfTI-1",
@@ -87,6 +94,7 @@ pub(crate) const FORMATS: &[Format] = &[
         ],
         folder: None,
         load: |p, _| nifti::load(p),
+        series: nifti::open_series,
     },
     Format {
         name: "OME-TIFF / TIFF stack",
@@ -103,6 +111,7 @@ pub(crate) const FORMATS: &[Format] = &[
         ],
         folder: None,
         load: |p, _| ome_tiff::load(p),
+        series: ome_tiff::open_series,
     },
 ];
 
@@ -180,6 +189,16 @@ pub(crate) fn load(path: &Path, request: Request) -> Result<Volume, VolumeError>
             known_endings()
         ),
     })
+}
+
+/// Opens `path` as a series with the format the table picks; raw data (a sidecar) is
+/// one channel at one time point without an orientation.
+pub(crate) fn open_series(path: &Path) -> Result<Box<dyn Source>, VolumeError> {
+    if let Some(format) = format_of(path) {
+        return (format.series)(path);
+    }
+    // Raw, or the error `load` gives for what it cannot read.
+    WholeFile::open(path, load(path, Request::default())?, false)
 }
 
 /// Every name ending of the table, for messages: ".zarr, .dcm, .nrrd, …".

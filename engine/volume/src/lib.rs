@@ -19,8 +19,9 @@
 //! | NRRD | `.nrrd` (attached) and `.nhdr` (detached); raw/gzip; uint8/uint16/int16/float | `nrrd.rs` |
 //! | NIfTI-1 | `.nii`, `.nii.gz`; uint8/int16/uint16/float32; `scl_slope/inter` | `nifti.rs` |
 //! | DICOM | a folder of slices (uncompressed little endian, 8/16 bit) | `dicom.rs` |
-//! | OME-TIFF | `.ome.tif(f)` z-stacks (channel 0, time 0; spacing from the OME-XML), plain `.tif` page stacks; uint8/uint16/int16/float32 | `ome_tiff.rs` |
+//! | OME-TIFF | `.ome.tif(f)` z-stacks (channel 0, time 0 here, all of them as a series; spacing from the OME-XML), plain `.tif` page stacks; uint8/uint16/int16/float32 | `ome_tiff.rs` |
 //! | OME-Zarr | an image group (0.4 on Zarr v2, 0.5 on Zarr v3; the finest level that fits) or one level's array; uint8/uint16/int16/float32; blosc, gzip, zstd | `zarr.rs` |
+//! | a series | up to 4 channels on one grid at T time points, read one time point at a time ([`Series`]): NIfTI `dim[4]`/`dim[5]`, NRRD `kinds`, OME-Zarr `c`/`t` axes and `omero`, OME-TIFF `SizeC`/`SizeT`, lists and globs of files | `series.rs` |
 //! | built-in | `phantom` (CT-like head, thin vessels), `cloud` (homogeneous), `mri` (MNI152) | `builtin.rs` |
 //!
 //! Loaders keep the file's index order (no reorientation to RAS/LPS): the renderer
@@ -68,6 +69,7 @@ mod phantom;
 mod procedural;
 mod raw;
 mod samples;
+mod series;
 pub mod sparse;
 #[cfg(test)]
 mod write;
@@ -81,6 +83,7 @@ pub use majorant::MajorantGrid;
 pub use orientation::PatientTransform;
 pub use raw::{RawFormat, RawParams};
 pub use samples::SampleKind;
+pub use series::{expand_glob, ChannelInfo, Series, SeriesInfo, MAX_CHANNELS};
 
 use samples::{Samples, Stored};
 
@@ -365,9 +368,22 @@ impl Volume {
         spacing: [f32; 3],
         stored: Stored,
     ) -> Result<Volume, VolumeError> {
+        Self::from_stored_in(path, name, dims, spacing, stored, None).map(|(v, _)| v)
+    }
+
+    /// [`Volume::from_stored`] through the window `fixed` where given (a series' later
+    /// time points), else its own; returns the window used, unrounded.
+    pub(crate) fn from_stored_in(
+        path: &Path,
+        name: String,
+        dims: [u32; 3],
+        spacing: [f32; 3],
+        stored: Stored,
+        fixed: Option<(f64, f64)>,
+    ) -> Result<(Volume, (f64, f64)), VolumeError> {
         let orientation = stored.orientation;
         let sample_kind = stored.samples.kind();
-        let n = normalise::normalise(path, dims, stored)?;
+        let n = normalise::normalise(path, dims, stored, fixed)?;
         let v = Volume {
             name,
             dims,
@@ -377,10 +393,11 @@ impl Volume {
             sample_kind,
             data: n.data,
         };
-        match orientation {
-            Some(t) => orientation::to_ras(path, v, t),
-            None => Ok(v),
-        }
+        let v = match orientation {
+            Some(t) => orientation::to_ras(path, v, t)?,
+            None => v,
+        };
+        Ok((v, n.exact_window))
     }
 }
 

@@ -5,16 +5,19 @@
 //! friends into every build of the engine. Read: single-file NIfTI-1 (`n+1`) in either
 //! byte order, datatypes uint8, int16, uint16, float32 and float64 (held as float32), `pixdim` for spacing (with the
 //! `xyzt_units` spatial unit converted to mm), `scl_slope/scl_inter` applied before
-//! normalisation. 4D files are read only when the extra dimensions have size 1. The
+//! normalisation. `dim[4]` time points and `dim[5]` channels are read as a series
+//! (`series.rs`: one 3D volume at a time, sought in the file); `Volume::load` reads
+//! files of one 3D volume. The
 //! orientation is the sform when `sform_code > 0`, else the qform (quaternion, offsets,
 //! `qfac`) when `qform_code > 0`, else none (NIfTI's "method 1": the index axes are R,
 //! A, S); the volume is put in RAS order by it (`orientation.rs`).
 
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use super::error::VolumeError;
 use super::samples::{Affine, Rescale, SampleKind, Samples, Stored};
+use super::series::{channel_list, Source, SourceInfo};
 use super::{io, name_of, validate_dims, validate_spacing, PatientTransform, Volume};
 
 /// Size of a NIfTI-1 header.
@@ -22,10 +25,14 @@ pub(crate) const HEADER_LEN: usize = 348;
 const SUPPORTED_TYPES: &str = "uint8 (2), int16 (4), uint16 (512), float32 (16), float64 (64)";
 
 /// The header fields the loader uses.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 struct Header {
     big_endian: bool,
     dims: [u32; 3],
+    /// `dim[4]`: time points (1 for a 3D file).
+    times: u32,
+    /// `dim[5]`: channels, e.g. the components of an intent vector (1 for 3D/4D files).
+    channels: u32,
     kind: SampleKind,
     spacing: [f32; 3],
     vox_offset: u64,
@@ -33,23 +40,105 @@ struct Header {
     orientation: Option<PatientTransform>,
 }
 
-/// Loads a `.nii` or `.nii.gz` file. The header is read and checked first; the data
-/// after it is read only up to what the header's dims promise (one byte more, to tell a
-/// too-long file), so a huge or endless file costs no more memory than its volume.
+impl Header {
+    /// The 3D volumes the file holds, time fastest, then channel.
+    fn blocks(&self) -> u64 {
+        u64::from(self.times) * u64::from(self.channels)
+    }
+}
+
+/// Loads a `.nii` or `.nii.gz` file of one 3D volume. The header is read and checked
+/// first; the data after it is read only up to what the header's dims promise (one byte
+/// more, to tell a too-long file), so a huge or endless file costs no more memory than
+/// its volume. Files of several time points or channels are read as a series
+/// ([`crate::Series`]).
 pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
-    let (file, len) = io::open_regular(path)?;
-    let io_err = |source| VolumeError::Io {
+    let header = read_header(path)?;
+    if header.blocks() > 1 {
+        let (ndim, d, n) = if header.channels > 1 {
+            (5, 5, header.channels)
+        } else {
+            (4, 4, header.times)
+        };
+        return Err(VolumeError::Unsupported {
+            path: path.to_path_buf(),
+            reason: format!(
+                "{ndim}D NIfTI with dim[{d}] = {n}; one 3D volume is read here: open it as a \
+                 series of channels and time points (`dvr info`)"
+            ),
+        });
+    }
+    volume(path, &header, 0, None).map(|(v, _)| v)
+}
+
+/// Opens a NIfTI file as a series: `dim[4]` time points of `dim[5]` channels.
+pub(crate) fn open_series(path: &Path) -> Result<Box<dyn Source>, VolumeError> {
+    let header = read_header(path)?;
+    let info = SourceInfo {
         path: path.to_path_buf(),
-        source,
+        name: name_of(path),
+        dims: header.dims,
+        orientation: header.orientation,
+        channels: channel_list(path, u64::from(header.channels), Vec::new())?,
+        times: header.times as usize,
     };
+    Ok(Box::new(NiftiSeries { info, header }))
+}
+
+struct NiftiSeries {
+    info: SourceInfo,
+    header: Header,
+}
+
+impl Source for NiftiSeries {
+    fn info(&self) -> &SourceInfo {
+        &self.info
+    }
+    fn read(
+        &self,
+        channel: usize,
+        time: usize,
+        window: Option<(f64, f64)>,
+    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+        let block = channel as u64 * u64::from(self.header.times) + time as u64;
+        volume(&self.info.path, &self.header, block, window)
+    }
+}
+
+/// The 3D volume `block` (time fastest, then channel), normalised through `window`
+/// where given.
+fn volume(
+    path: &Path,
+    header: &Header,
+    block: u64,
+    window: Option<(f64, f64)>,
+) -> Result<(Volume, (f64, f64)), VolumeError> {
+    let data = read_block(path, header, block)?;
+    let stored = Stored {
+        samples: Samples::decode(header.kind, data, header.big_endian),
+        type_range: header.kind.full_range(),
+        rescale: Rescale::Uniform(header.rescale),
+        orientation: header.orientation,
+    };
+    Volume::from_stored_in(
+        path,
+        name_of(path),
+        header.dims,
+        header.spacing,
+        stored,
+        window,
+    )
+}
+
+/// Opens the file and reads its header (through gzip when the file is gzipped).
+fn read_header(path: &Path) -> Result<Header, VolumeError> {
+    let (file, _) = io::open_regular(path)?;
     let mut reader = BufReader::new(file);
-    let gz = reader
-        .fill_buf()
-        .map_err(io_err)?
-        .starts_with(&[0x1f, 0x8b]);
-    let (header, data) = if gz {
+    let gz = is_gzip(path, &mut reader)?;
+    let mut head = Vec::with_capacity(HEADER_LEN);
+    if gz {
         let mut dec = io::GzMembers::new(reader);
-        let mut head = vec![0u8; HEADER_LEN];
+        head.resize(HEADER_LEN, 0);
         dec.read_exact(&mut head).map_err(|e| match e.kind() {
             std::io::ErrorKind::UnexpectedEof => short_header(path),
             _ => VolumeError::Decompress {
@@ -57,41 +146,126 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
                 source: e,
             },
         })?;
-        let header = parse_header(path, &head)?;
-        let expected = io::expected_bytes(header.dims, header.kind);
-        let skip = header.vox_offset - HEADER_LEN as u64;
-        let past_end = |got: u64| offset_past_end(path, header.vox_offset, HEADER_LEN as u64 + got);
-        let data = io::read_bounded(path, &mut dec, skip, expected, &past_end)?;
-        if data.len() as u64 == expected {
-            io::note_trailing_bytes(path, &dec);
-        }
-        (header, data)
     } else {
-        let mut head = Vec::with_capacity(HEADER_LEN);
         (&mut reader)
             .take(HEADER_LEN as u64)
             .read_to_end(&mut head)
-            .map_err(io_err)?;
-        let header = parse_header(path, &head)?;
+            .map_err(|source| VolumeError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+    }
+    parse_header(path, &head)
+}
+
+fn is_gzip(path: &Path, reader: &mut BufReader<std::fs::File>) -> Result<bool, VolumeError> {
+    Ok(reader
+        .fill_buf()
+        .map_err(|source| VolumeError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?
+        .starts_with(&[0x1f, 0x8b]))
+}
+
+/// The bytes of 3D volume `block`, read within what the header promises: an
+/// uncompressed file's length is checked against all its volumes before any is read
+/// (and the block is seeked to); a gzipped one is decompressed up to the block's end
+/// (one byte more for the last, to tell a too-long file).
+fn read_block(path: &Path, header: &Header, block: u64) -> Result<Vec<u8>, VolumeError> {
+    let (file, len) = io::open_regular(path)?;
+    let mut reader = BufReader::new(file);
+    let gz = is_gzip(path, &mut reader)?;
+    let expected = io::expected_bytes(header.dims, header.kind);
+    let blocks = header.blocks();
+    let last = block + 1 == blocks;
+    let start = header.vox_offset + block * expected;
+    let past_end = |got: u64| {
+        if block == 0 {
+            offset_past_end(path, header.vox_offset, got)
+        } else {
+            VolumeError::Truncated {
+                path: path.to_path_buf(),
+                expected: expected * blocks,
+                found: got.saturating_sub(header.vox_offset),
+            }
+        }
+    };
+    let mut data = if gz {
+        let mut dec = io::GzMembers::new(reader);
+        let data = io::read_bounded(path, &mut dec, start, expected, &past_end)?;
+        if last && data.len() as u64 == expected {
+            io::note_trailing_bytes(path, &dec);
+        }
+        data
+    } else {
         if header.vox_offset >= len {
             return Err(offset_past_end(path, header.vox_offset, len));
         }
         // Check the size before reading, so a wrong header on a huge file fails fast.
-        io::check_len(path, header.dims, header.kind, len - header.vox_offset)?;
-        let expected = io::expected_bytes(header.dims, header.kind);
-        let skip = header.vox_offset - HEADER_LEN as u64;
-        let past_end = |got: u64| offset_past_end(path, header.vox_offset, HEADER_LEN as u64 + got);
-        let data = io::read_bounded(path, reader, skip, expected, &past_end)?;
-        (header, data)
+        check_total(path, header, len - header.vox_offset)?;
+        reader
+            .seek(SeekFrom::Start(start))
+            .map_err(|source| VolumeError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        io::read_bounded(path, reader, 0, expected, &past_end)?
     };
-    io::check_len(path, header.dims, header.kind, data.len() as u64)?;
-    let stored = Stored {
-        samples: Samples::decode(header.kind, data, header.big_endian),
-        type_range: header.kind.full_range(),
-        rescale: Rescale::Uniform(header.rescale),
-        orientation: header.orientation,
-    };
-    Volume::from_stored(path, name_of(path), header.dims, header.spacing, stored)
+    if !last {
+        // The byte past this block is the next block's first.
+        data.truncate(expected as usize);
+    }
+    if blocks == 1 {
+        io::check_len(path, header.dims, header.kind, data.len() as u64)?;
+    } else if (data.len() as u64) < expected {
+        return Err(VolumeError::Truncated {
+            path: path.to_path_buf(),
+            expected: expected * blocks,
+            found: block * expected + data.len() as u64,
+        });
+    } else if data.len() as u64 > expected {
+        return Err(too_long(path, header, block * expected + data.len() as u64));
+    }
+    Ok(data)
+}
+
+/// `Truncated` or `SizeMismatch` when `found` bytes of voxel data are not what all the
+/// file's volumes need.
+fn check_total(path: &Path, header: &Header, found: u64) -> Result<(), VolumeError> {
+    if header.blocks() == 1 {
+        return io::check_len(path, header.dims, header.kind, found);
+    }
+    let total = io::expected_bytes(header.dims, header.kind) * header.blocks();
+    if found < total {
+        Err(VolumeError::Truncated {
+            path: path.to_path_buf(),
+            expected: total,
+            found,
+        })
+    } else if found > total {
+        Err(too_long(path, header, found))
+    } else {
+        Ok(())
+    }
+}
+
+fn too_long(path: &Path, header: &Header, found: u64) -> VolumeError {
+    VolumeError::MalformedHeader {
+        path: path.to_path_buf(),
+        field: "dim".into(),
+        problem: format!(
+            "{} time point(s) × {} channel(s) of {}x{}x{} {} need {} bytes of voxel data, but \
+             the file holds {found}",
+            header.times,
+            header.channels,
+            header.dims[0],
+            header.dims[1],
+            header.dims[2],
+            header.kind.name(),
+            io::expected_bytes(header.dims, header.kind) * header.blocks()
+        ),
+    }
 }
 
 /// `vox_offset` at or past the end of the (decompressed) file of `len` bytes.
@@ -180,17 +354,36 @@ fn parse_header(path: &Path, h: &[u8]) -> Result<Header, VolumeError> {
         ));
     }
     let ndim = ndim as usize;
-    if let Some(extra) = (4..=ndim).find(|&i| dim[i] != 1) {
+    // dim[4] is time, dim[5] the components of a vector (channels); 6 and 7 are not read.
+    if let Some(extra) = (6..=ndim).find(|&i| dim[i] != 1) {
         return Err(VolumeError::Unsupported {
             path: path.to_path_buf(),
             reason: format!(
-                "{ndim}D NIfTI with dim[{extra}] = {}; only one 3D volume is read",
+                "{ndim}D NIfTI with dim[{extra}] = {}; dims 1-3 are space, 4 time and 5 \
+                 channels",
                 dim[extra]
             ),
         });
     }
+    let extra = |i: usize| -> Result<u32, VolumeError> {
+        if i > ndim {
+            return Ok(1);
+        }
+        match u32::try_from(dim[i]) {
+            Ok(n) if n >= 1 => Ok(n),
+            _ => Err(malformed(
+                &format!("dim[{i}]"),
+                format!(
+                    "{} {}: the {} axis is empty",
+                    dim[i],
+                    if i == 4 { "time points" } else { "channels" },
+                    if i == 4 { "time (T)" } else { "channel" }
+                ),
+            )),
+        }
+    };
+    let (times, channels) = (extra(4)?, extra(5)?);
     let dims = validate_dims(path, [1, 2, 3].map(|i| if i <= ndim { dim[i] } else { 1 }))?;
-
     let datatype = f.i16(70);
     let bitpix = f.i16(72);
     let kind = match datatype {
@@ -255,6 +448,8 @@ fn parse_header(path: &Path, h: &[u8]) -> Result<Header, VolumeError> {
     Ok(Header {
         big_endian: big,
         dims,
+        times,
+        channels,
         kind,
         spacing,
         vox_offset: vox_offset as u64,

@@ -33,14 +33,19 @@ use super::VolumeData;
 pub(crate) struct Normalised {
     pub data: VolumeData,
     pub window: [f32; 2],
+    /// The window as computed, before rounding to f32: what a series hands back for its
+    /// later time points, so that they map through exactly the same table.
+    pub exact_window: (f64, f64),
 }
 
 /// Applies the windowing rule of this module to `stored` (x fastest, `dims` already
-/// validated).
+/// validated), or, where `fixed` is given, that window (a series' channel keeps the
+/// window of its first time point, so its time points do not flicker: `series.rs`).
 pub(crate) fn normalise(
     path: &Path,
     dims: [u32; 3],
     stored: Stored,
+    fixed: Option<(f64, f64)>,
 ) -> Result<Normalised, VolumeError> {
     let slice_len = dims[0] as usize * dims[1] as usize;
     let voxels = slice_len * dims[2] as usize;
@@ -57,6 +62,13 @@ pub(crate) fn normalise(
     }
     if let Samples::F32(v) = &stored.samples {
         check_finite(path, dims, v)?;
+    }
+    if let Some(window) = fixed {
+        return Ok(Normalised {
+            data: apply_window(stored, slice_len, window),
+            window: [window.0 as f32, window.1 as f32],
+            exact_window: window,
+        });
     }
     let data_range = physical_range(&stored.samples, slice_len, &stored.rescale);
     let window = match (&stored.type_range, &stored.samples) {
@@ -87,6 +99,7 @@ pub(crate) fn normalise(
     Ok(Normalised {
         data,
         window: [window.0 as f32, window.1 as f32],
+        exact_window: window,
     })
 }
 

@@ -10,12 +10,14 @@
 //! encodings are rejected with a message saying so.
 
 use std::collections::HashMap;
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use super::error::VolumeError;
 use super::samples::{SampleKind, Samples, Stored};
+use super::series::{channel_list, Source, SourceInfo};
 use super::{io, name_of, validate_dims, validate_spacing, PatientTransform, Volume};
+use axes::{classify_axes, gather, Axes};
 
 const SUPPORTED_TYPES: &str = "uint8, uint16, int16, float";
 
@@ -43,8 +45,83 @@ impl Header {
     }
 }
 
-/// Loads a `.nrrd` or `.nhdr` file.
+/// Loads a `.nrrd` or `.nhdr` file of one 3D volume (a series' one channel at its one
+/// time point).
 pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
+    let nrrd = open(path)?;
+    if nrrd.channels * nrrd.times > 1 {
+        return Err(VolumeError::Unsupported {
+            path: path.to_path_buf(),
+            reason: format!(
+                "{}D NRRD with sizes {:?}: one scalar 3D volume is read here: open it as a \
+                 series of channels and time points (`dvr info`)",
+                nrrd.sizes.len(),
+                nrrd.sizes
+            ),
+        });
+    }
+    nrrd.volume(0, 0, None).map(|(v, _)| v)
+}
+
+/// Opens a NRRD file as a series (see `series.rs` for which axes are channels and time).
+pub(crate) fn open_series(path: &Path) -> Result<Box<dyn Source>, VolumeError> {
+    let nrrd = open(path)?;
+    let info = SourceInfo {
+        path: path.to_path_buf(),
+        name: name_of(path),
+        dims: nrrd.dims,
+        orientation: nrrd.orientation,
+        channels: channel_list(path, nrrd.channels as u64, Vec::new())?,
+        times: nrrd.times,
+    };
+    Ok(Box::new(NrrdSeries { info, nrrd }))
+}
+
+struct NrrdSeries {
+    info: SourceInfo,
+    nrrd: Nrrd,
+}
+
+impl Source for NrrdSeries {
+    fn info(&self) -> &SourceInfo {
+        &self.info
+    }
+    fn read(
+        &self,
+        channel: usize,
+        time: usize,
+        window: Option<(f64, f64)>,
+    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+        self.nrrd.volume(channel, time, window)
+    }
+}
+
+/// A checked header: where the data is and how its axes run. Nothing of the data is
+/// read until [`Nrrd::volume`].
+struct Nrrd {
+    path: PathBuf,
+    data_path: PathBuf,
+    /// Byte offset of the data (after the header of an attached file).
+    data_start: u64,
+    /// Bytes from `data_start` to the end of the data file.
+    data_len: u64,
+    line_skip: usize,
+    byte_skip: i64,
+    encoding: String,
+    kind: SampleKind,
+    big_endian: bool,
+    sizes: Vec<i64>,
+    /// The axes that are x, y, z, then the channel and time axes, if any.
+    axes: Axes,
+    dims: [u32; 3],
+    spacing: [f32; 3],
+    orientation: Option<PatientTransform>,
+    channels: usize,
+    times: usize,
+}
+
+/// Opens and checks a NRRD header.
+fn open(path: &Path) -> Result<Nrrd, VolumeError> {
     let (file, file_len) = io::open_regular(path)?;
     let mut reader = BufReader::new(file);
     let header = parse_header(path, &mut reader)?;
@@ -71,12 +148,29 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
             format!("{} sizes for dimension {dimension}", sizes.len()),
         ));
     }
-    let axes = spatial_axes(path, &sizes)?;
+    let roles = classify_axes(path, &header.fields, &sizes)?;
+    let axes = roles.spatial.clone();
     let dims = validate_dims(
         path,
         [0, 1, 2].map(|i| axes.get(i).map_or(1, |&a| sizes[a])),
     )?;
     let spacing = parse_spacing(path, &header.fields, dimension, &axes)?;
+    let size_of = |a: Option<usize>| a.map_or(Ok(1), |a| usize::try_from(sizes[a]));
+    let (channels, times) = match (size_of(roles.channel), size_of(roles.time)) {
+        (Ok(c), Ok(t)) if c >= 1 && t >= 1 => (c, t),
+        _ => {
+            return Err(malformed(
+                "sizes",
+                format!("{sizes:?}: the channel or time (T) axis is empty"),
+            ))
+        }
+    };
+    // Every byte offset below is within this product; a header whose sizes overflow it
+    // describes more data than any file holds.
+    sizes
+        .iter()
+        .try_fold(kind.bytes() as u64, |a, &n| a.checked_mul(n as u64))
+        .ok_or_else(|| malformed("sizes", format!("{sizes:?}: more data than a file holds")))?;
 
     let big_endian = match header.fields.get("endian").map(|s| s.trim()) {
         Some("little") => false,
@@ -113,7 +207,7 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         .fields
         .get("data file")
         .or_else(|| header.fields.get("datafile"));
-    let (data_path, mut data, data_len): (PathBuf, Box<dyn BufRead>, u64) = match data_field {
+    let (data_path, data_start, data_len): (PathBuf, u64, u64) = match data_field {
         Some(name) => {
             let name = name.trim();
             if name.starts_with("LIST") || name.contains(' ') || name.contains('%') {
@@ -126,7 +220,7 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
                 return Err(malformed("data file", "is empty".into()));
             }
             let p = resolve(path, name);
-            let (file, len) = io::open_regular(&p).map_err(|e| match e {
+            let (_, len) = io::open_regular(&p).map_err(|e| match e {
                 // Name the header too: it is what the user points at.
                 VolumeError::NotAFile { what, .. } => malformed(
                     "data file",
@@ -134,7 +228,7 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
                 ),
                 other => other,
             })?;
-            (p, Box::new(BufReader::new(file)), len)
+            (p, 0, len)
         }
         None if is_detached_header(path) => {
             return Err(malformed(
@@ -153,88 +247,234 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
                         .into(),
                 )
             })?;
-            (
-                path.to_path_buf(),
-                Box::new(reader),
-                file_len.saturating_sub(offset),
-            )
+            (path.to_path_buf(), offset, file_len.saturating_sub(offset))
         }
     };
-    let mut skipped_lines: u64 = 0;
-    for _ in 0..line_skip {
-        let mut line = Vec::new();
-        let n = (&mut data)
-            .take(MAX_HEADER_BYTES)
-            .read_until(b'\n', &mut line)
+    let encoding = field("encoding")?.trim().to_ascii_lowercase();
+    if !["raw", "gzip", "gz"].contains(&encoding.as_str()) {
+        return Err(VolumeError::Unsupported {
+            path: path.to_path_buf(),
+            reason: format!("NRRD encoding `{encoding}`; supported: raw, gzip"),
+        });
+    }
+    let orientation = patient_transform(&header.fields, &axes, spacing)
+        .map_err(|(field, problem)| malformed(field, problem))?;
+    Ok(Nrrd {
+        path: path.to_path_buf(),
+        data_path,
+        data_start,
+        data_len,
+        line_skip,
+        byte_skip,
+        encoding,
+        kind,
+        big_endian,
+        sizes,
+        axes: roles,
+        dims,
+        spacing,
+        orientation,
+        channels,
+        times,
+    })
+}
+
+impl Nrrd {
+    /// Channel `channel` at time point `time`, normalised through `window` where given.
+    fn volume(
+        &self,
+        channel: usize,
+        time: usize,
+        window: Option<(f64, f64)>,
+    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+        let path = self.path.as_path();
+        let bytes = self.read(channel, time)?;
+        let mut stored = Stored::plain(Samples::decode(self.kind, bytes, self.big_endian));
+        stored.orientation = self.orientation;
+        Volume::from_stored_in(path, name_of(path), self.dims, self.spacing, stored, window)
+    }
+
+    /// The bytes of one channel at one time point, x fastest: the span of the data from
+    /// its first voxel to its last is read (one time point's worth when channels are
+    /// interleaved), then gathered.
+    fn read(&self, channel: usize, time: usize) -> Result<Vec<u8>, VolumeError> {
+        let path = self.path.as_path();
+        let malformed = |field: &str, problem: String| VolumeError::MalformedHeader {
+            path: path.to_path_buf(),
+            field: field.to_string(),
+            problem,
+        };
+        let (kind, dims, byte_skip, line_skip) =
+            (self.kind, self.dims, self.byte_skip, self.line_skip);
+        let data_path = &self.data_path;
+        // Element strides of every axis (axis 0 fastest).
+        let mut stride = Vec::with_capacity(self.sizes.len());
+        let mut n = 1u64;
+        for &s in &self.sizes {
+            stride.push(n);
+            n *= s as u64;
+        }
+        let total_elements = n;
+        let b = kind.bytes() as u64;
+        let st = |a: Option<usize>| a.map_or(0, |a| stride[a]);
+        let base = channel as u64 * st(self.axes.channel) + time as u64 * st(self.axes.time);
+        let sp: Vec<u64> = (0..3)
+            .map(|i| st(self.axes.spatial.get(i).copied()))
+            .collect();
+        let span = 1
+            + (0..3)
+                .map(|i| (u64::from(dims[i]) - 1) * sp[i])
+                .sum::<u64>();
+        let last = base + span == total_elements;
+        let (file, _) = io::open_regular(data_path)?;
+        let mut file = BufReader::new(file);
+        file.seek(SeekFrom::Start(self.data_start))
             .map_err(|source| VolumeError::Io {
                 path: data_path.clone(),
                 source,
             })?;
-        if n == 0 || line.last() != Some(&b'\n') {
-            return Err(malformed(
-                "line skip",
-                format!("the data has fewer than {line_skip} lines"),
-            ));
-        }
-        skipped_lines += n as u64;
-    }
-    let region_len = data_len.saturating_sub(skipped_lines);
-    let expected = io::expected_bytes(dims, kind);
-    let skip_past_end = |got: u64| {
-        malformed(
-            "byte skip",
-            format!("skips {byte_skip} bytes, but the data has only {got}"),
-        )
-    };
-
-    let encoding = field("encoding")?.trim().to_ascii_lowercase();
-    let bytes = match encoding.as_str() {
-        "raw" => {
-            let skip = if byte_skip == -1 {
-                // -1: the data is the last `expected` bytes of the file.
-                region_len.saturating_sub(expected)
-            } else {
-                byte_skip as u64
-            };
-            if skip > region_len {
-                return Err(skip_past_end(region_len));
-            }
-            // Check the size before reading, so wrong dims on a huge file fail fast.
-            io::check_len(&data_path, dims, kind, region_len - skip)?;
-            io::read_bounded(&data_path, data, skip, expected, &skip_past_end)?
-        }
-        "gzip" | "gz" => {
-            if byte_skip < 0 {
+        let mut data = file;
+        let mut skipped_lines: u64 = 0;
+        for _ in 0..line_skip {
+            let mut line = Vec::new();
+            let n = (&mut data)
+                .take(MAX_HEADER_BYTES)
+                .read_until(b'\n', &mut line)
+                .map_err(|source| VolumeError::Io {
+                    path: data_path.clone(),
+                    source,
+                })?;
+            if n == 0 || line.last() != Some(&b'\n') {
                 return Err(malformed(
-                    "byte skip",
-                    "-1 is only allowed with raw encoding".into(),
+                    "line skip",
+                    format!("the data has fewer than {line_skip} lines"),
                 ));
             }
-            let mut gz = io::GzMembers::new(data);
-            let bytes = io::read_bounded(
-                &data_path,
-                &mut gz,
-                byte_skip as u64,
-                expected,
-                &skip_past_end,
-            )?;
-            if bytes.len() as u64 == expected {
-                io::note_trailing_bytes(&data_path, &gz);
+            skipped_lines += n as u64;
+        }
+        let region_len = self.data_len.saturating_sub(skipped_lines);
+        let expected = total_elements * b;
+        let skip_past_end = |got: u64| {
+            malformed(
+                "byte skip",
+                format!("skips {byte_skip} bytes, but the data has only {got}"),
+            )
+        };
+
+        let bytes = match self.encoding.as_str() {
+            "raw" => {
+                let skip = if byte_skip == -1 {
+                    // -1: the data is the last `expected` bytes of the file.
+                    region_len.saturating_sub(expected)
+                } else {
+                    byte_skip as u64
+                };
+                if skip > region_len {
+                    return Err(skip_past_end(region_len));
+                }
+                // Check the size before reading, so wrong dims on a huge file fail fast.
+                check_total(data_path, dims, kind, expected, region_len - skip)?;
+                // The length is checked: seek to the span rather than read up to it, so
+                // a late time point costs no more than the first.
+                let at = self.data_start + skipped_lines + skip + base * b;
+                data.seek(SeekFrom::Start(at))
+                    .map_err(|source| VolumeError::Io {
+                        path: data_path.clone(),
+                        source,
+                    })?;
+                io::read_bounded(data_path, data, 0, span * b, &skip_past_end)?
             }
-            bytes
+            "gzip" | "gz" => {
+                if byte_skip < 0 {
+                    return Err(malformed(
+                        "byte skip",
+                        "-1 is only allowed with raw encoding".into(),
+                    ));
+                }
+                let mut gz = io::GzMembers::new(data);
+                let mut bytes = io::read_bounded(
+                    data_path,
+                    &mut gz,
+                    byte_skip as u64 + base * b,
+                    span * b,
+                    &skip_past_end,
+                )?;
+                if last && bytes.len() as u64 == span * b {
+                    io::note_trailing_bytes(data_path, &gz);
+                }
+                if !last {
+                    // The byte past the span is the next one's.
+                    bytes.truncate((span * b) as usize);
+                }
+                bytes
+            }
+            other => {
+                return Err(VolumeError::Unsupported {
+                    path: path.to_path_buf(),
+                    reason: format!("NRRD encoding `{other}`; supported: raw, gzip"),
+                })
+            }
+        };
+        let mut bytes = bytes;
+        if self.encoding == "raw" {
+            bytes.truncate((span * b) as usize);
         }
-        other => {
-            return Err(VolumeError::Unsupported {
-                path: path.to_path_buf(),
-                reason: format!("NRRD encoding `{other}`; supported: raw, gzip"),
-            })
+        if (bytes.len() as u64) < span * b {
+            return Err(VolumeError::Truncated {
+                path: data_path.clone(),
+                expected,
+                found: base * b + bytes.len() as u64,
+            });
         }
-    };
-    io::check_len(&data_path, dims, kind, bytes.len() as u64)?;
-    let mut stored = Stored::plain(Samples::decode(kind, bytes, big_endian));
-    stored.orientation = patient_transform(&header.fields, &axes, spacing)
-        .map_err(|(field, problem)| malformed(field, problem))?;
-    Volume::from_stored(path, name_of(path), dims, spacing, stored)
+        if bytes.len() as u64 > span * b {
+            return Err(check_total(
+                data_path,
+                dims,
+                kind,
+                expected,
+                base * b + bytes.len() as u64,
+            )
+            .err()
+            .unwrap_or(VolumeError::Truncated {
+                path: data_path.clone(),
+                expected,
+                found: bytes.len() as u64,
+            }));
+        }
+        Ok(gather(bytes, b as usize, dims, [sp[0], sp[1], sp[2]]))
+    }
+}
+
+/// `Truncated` or `SizeMismatch` when `found` bytes are not the `expected` of every
+/// channel and time point.
+fn check_total(
+    path: &Path,
+    dims: [u32; 3],
+    kind: SampleKind,
+    expected: u64,
+    found: u64,
+) -> Result<(), VolumeError> {
+    if expected == io::expected_bytes(dims, kind) {
+        return io::check_len(path, dims, kind, found);
+    }
+    if found < expected {
+        Err(VolumeError::Truncated {
+            path: path.to_path_buf(),
+            expected,
+            found,
+        })
+    } else if found > expected {
+        Err(VolumeError::MalformedHeader {
+            path: path.to_path_buf(),
+            field: "sizes".into(),
+            problem: format!(
+                "the sizes need {expected} bytes of {} data, but the file holds {found}",
+                kind.name()
+            ),
+        })
+    } else {
+        Ok(())
+    }
 }
 
 /// True for a `.nhdr` file, which by definition keeps its data in another file.
@@ -332,27 +572,6 @@ fn parse_type(path: &Path, t: &str) -> Result<SampleKind, VolumeError> {
             path: path.to_path_buf(),
             datatype: other.to_string(),
             supported: SUPPORTED_TYPES,
-        }),
-    }
-}
-
-/// The axes that become x, y, z: all of them for 2D/3D data; for 4D, the three left
-/// when an axis of size 1 is dropped.
-fn spatial_axes(path: &Path, sizes: &[i64]) -> Result<Vec<usize>, VolumeError> {
-    match sizes.len() {
-        2 | 3 => Ok((0..sizes.len()).collect()),
-        4 => match sizes.iter().position(|&s| s == 1) {
-            Some(drop) => Ok((0..4).filter(|&a| a != drop).collect()),
-            None => Err(VolumeError::Unsupported {
-                path: path.to_path_buf(),
-                reason: format!("4D NRRD with sizes {sizes:?}: only one scalar 3D volume is read"),
-            }),
-        },
-        n => Err(VolumeError::Unsupported {
-            path: path.to_path_buf(),
-            reason: format!(
-                "NRRD dimension {n}: a volume needs 2 (one slice), 3, or 4 (with a size-1 axis)"
-            ),
         }),
     }
 }
@@ -565,5 +784,6 @@ fn resolve(header: &Path, name: &str) -> PathBuf {
     }
 }
 
+mod axes;
 #[cfg(test)]
 mod tests;

@@ -15,6 +15,7 @@
 
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
+use super::series::{channel_list, Source, SourceChannel, SourceInfo};
 use super::{io, name_of, validate_dims, validate_spacing, Volume, MAX_DIM};
 use std::path::Path;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
@@ -35,7 +36,20 @@ struct Pixels {
     times: u64,
     /// Pages between consecutive z slices (the sizes of the dimensions that run faster).
     z_stride: u64,
+    /// Pages between consecutive channels, and time points.
+    c_stride: u64,
+    t_stride: u64,
     spacing_mm: [f64; 3],
+    /// The `Channel` elements' `Name` and `Color`, in order.
+    channel_meta: Vec<SourceChannel>,
+}
+
+impl Pixels {
+    /// The page of z slice 0 of channel `c` at time point `t`.
+    fn first_page(&self, c: u64, t: u64) -> u64 {
+        c.saturating_mul(self.c_stride)
+            .saturating_add(t.saturating_mul(self.t_stride))
+    }
 }
 
 fn malformed(path: &Path, field: &str, problem: impl Into<String>) -> VolumeError {
@@ -114,18 +128,23 @@ fn parse_pixels(path: &Path, xml: &str) -> Result<Pixels, VolumeError> {
         path,
         [x, y, z].map(|n| i64::try_from(n).unwrap_or(i64::MAX)),
     )?;
-    let mut z_stride = 1u64;
-    for d in order[2..].chars().take_while(|&d| d != 'Z') {
-        z_stride = z_stride
-            .checked_mul(if d == 'C' { c } else { t })
-            .ok_or_else(|| {
-                malformed(
-                    path,
-                    "SizeC/SizeT",
-                    format!("{c} channels × {t} time points: more pages than a TIFF holds"),
-                )
-            })?;
+    // Each dimension's page stride: the product of the sizes of those that run faster.
+    let mut strides = [1u64; 3];
+    let mut stride = 1u64;
+    for d in order[2..].chars() {
+        let i = "ZCT".find(d).unwrap_or(0);
+        strides[i] = stride;
+        stride = stride.checked_mul([z, c, t][i]).ok_or_else(|| {
+            malformed(
+                path,
+                "SizeC/SizeT",
+                format!(
+                    "{z} slices × {c} channels × {t} time points: more pages than a TIFF holds"
+                ),
+            )
+        })?;
     }
+    let [z_stride, c_stride, t_stride] = strides;
     let mut spacing_mm = [1.0; 3];
     for (i, axis) in ["X", "Y", "Z"].iter().enumerate() {
         let value = attribute(tag, &format!("PhysicalSize{axis}"));
@@ -157,14 +176,115 @@ fn parse_pixels(path: &Path, xml: &str) -> Result<Pixels, VolumeError> {
         channels: c,
         times: t,
         z_stride,
+        c_stride,
+        t_stride,
         spacing_mm,
+        channel_meta: channel_meta(xml),
     })
 }
 
+/// `Name` and `Color` of each `Channel` element (OME's `Color` is a signed 32-bit RGBA).
+fn channel_meta(xml: &str) -> Vec<SourceChannel> {
+    let mut out = Vec::new();
+    let mut rest = xml;
+    while let Some(i) = rest.find("Channel") {
+        let before = rest[..i].chars().last();
+        let tail = &rest[i..];
+        let end = tail.find('>').unwrap_or(tail.len());
+        let is_element = matches!(before, Some('<') | Some(':'))
+            && tail[7..].starts_with(|ch: char| ch.is_whitespace() || ch == '/' || ch == '>');
+        if is_element {
+            let tag = &tail[..end];
+            let colour = attribute(tag, "Color")
+                .and_then(|c| c.parse::<i64>().ok())
+                .map(|c| {
+                    let rgba = c as u32;
+                    [(rgba >> 24) as u8, (rgba >> 16) as u8, (rgba >> 8) as u8]
+                });
+            out.push(SourceChannel {
+                name: attribute(tag, "Name").map(str::to_string),
+                colour,
+                display_window: None,
+            });
+            if out.len() >= 4096 {
+                break;
+            }
+        }
+        rest = &tail[end.max(1)..];
+    }
+    out
+}
+
 pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
-    let (file, _) = io::open_regular(path)?;
-    let bad = |e: tiff::TiffError| {
-        match e {
+    let pixels = read_pixels(path)?;
+    if let Some(p) = &pixels {
+        if p.channels > 1 || p.times > 1 {
+            log::warn!(
+                "{}: {} channel(s) × {} time point(s); rendering channel 0 at time 0 (open it \
+                 as a series for the others: `dvr info`)",
+                path.display(),
+                p.channels,
+                p.times
+            );
+        }
+    }
+    read_stack(path, pixels.as_ref(), 0, 0, None).map(|(v, _)| v)
+}
+
+/// Opens an OME-TIFF as a series of `SizeC` channels at `SizeT` time points (a plain
+/// stack is one of each).
+pub(crate) fn open_series(path: &Path) -> Result<Box<dyn Source>, VolumeError> {
+    let pixels = read_pixels(path)?;
+    let (dims, channels, times) = match &pixels {
+        Some(p) => {
+            let dims = validate_dims(path, p.size.map(|n| i64::try_from(n).unwrap_or(i64::MAX)))?;
+            let meta = channel_list(path, p.channels, p.channel_meta.clone())?;
+            (dims, meta, usize::try_from(p.times).unwrap_or(usize::MAX))
+        }
+        // A plain stack: its page count is known only once read.
+        None => {
+            let (v, _) = read_stack(path, None, 0, 0, None)?;
+            (v.dims, vec![SourceChannel::default()], 1)
+        }
+    };
+    let info = SourceInfo {
+        path: path.to_path_buf(),
+        name: name_of(path).trim_end_matches(".ome").to_string(),
+        dims,
+        orientation: None,
+        channels,
+        times,
+    };
+    Ok(Box::new(TiffSeries { info, pixels }))
+}
+
+struct TiffSeries {
+    info: SourceInfo,
+    pixels: Option<Pixels>,
+}
+
+impl Source for TiffSeries {
+    fn info(&self) -> &SourceInfo {
+        &self.info
+    }
+    fn read(
+        &self,
+        channel: usize,
+        time: usize,
+        window: Option<(f64, f64)>,
+    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+        read_stack(
+            &self.info.path,
+            self.pixels.as_ref(),
+            channel as u64,
+            time as u64,
+            window,
+        )
+    }
+}
+
+fn tiff_error(path: &Path, e: tiff::TiffError) -> VolumeError {
+    match e {
         tiff::TiffError::LimitsExceeded => malformed(
             path,
             "TIFF",
@@ -175,46 +295,73 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         ),
         e => malformed(path, "TIFF", e.to_string()),
     }
-    };
+}
+
+fn decoder(path: &Path) -> Result<Decoder<std::io::BufReader<std::fs::File>>, VolumeError> {
+    let (file, _) = io::open_regular(path)?;
     let mut limits = Limits::default();
     limits.decoding_buffer_size = MAX_PAGE_BYTES;
     limits.intermediate_buffer_size = MAX_CHUNK_BYTES;
-    let mut decoder = Decoder::new(std::io::BufReader::new(file))
-        .map_err(bad)?
-        .with_limits(limits);
+    Ok(Decoder::new(std::io::BufReader::new(file))
+        .map_err(|e| tiff_error(path, e))?
+        .with_limits(limits))
+}
+
+/// The OME-XML's pixels, `None` for a plain TIFF.
+fn read_pixels(path: &Path) -> Result<Option<Pixels>, VolumeError> {
+    let mut decoder = decoder(path)?;
     let description = decoder.get_tag_ascii_string(Tag::ImageDescription).ok();
     let ome = description
         .as_deref()
         .filter(|d| d.contains("<OME") || d.contains(":OME"));
-    let pixels = match ome {
-        Some(xml) => {
-            let p = parse_pixels(path, xml)?;
-            if p.channels > 1 || p.times > 1 {
-                log::warn!(
-                    "{}: {} channel(s) × {} time point(s); rendering channel 0 at time 0",
-                    path.display(),
-                    p.channels,
-                    p.times
-                );
-            }
-            Some(p)
-        }
+    match ome {
+        Some(xml) => parse_pixels(path, xml).map(Some),
         None => {
             log::info!(
                 "{}: no OME-XML; reading its pages as z slices of 1 mm voxels",
                 path.display()
             );
-            None
+            Ok(None)
+        }
+    }
+}
+
+/// The z stack of channel `c` at time point `t` (a plain TIFF: all its pages),
+/// normalised through `window` where given.
+fn read_stack(
+    path: &Path,
+    pixels: Option<&Pixels>,
+    c: u64,
+    t: u64,
+    window: Option<(f64, f64)>,
+) -> Result<(Volume, (f64, f64)), VolumeError> {
+    let bad = |e: tiff::TiffError| tiff_error(path, e);
+    let mut decoder = decoder(path)?;
+    if let Some(p) = pixels {
+        if c >= p.channels || t >= p.times {
+            return Err(malformed(
+                path,
+                "SizeC/SizeT",
+                format!(
+                    "channel {c} at time point {t} is past the {} channel(s) × {} time point(s)",
+                    p.channels, p.times
+                ),
+            ));
+        }
+    }
+    // Page `page` is a z slice: every page of a plain stack; of an OME-TIFF, the pages
+    // `first + z * z_stride` of channel c at time point t.
+    let first = pixels.map_or(0, |p| p.first_page(c, t));
+    let wanted = |page: u64| match pixels {
+        None => true,
+        Some(p) => {
+            page >= first
+                && (page - first).is_multiple_of(p.z_stride)
+                && (page - first) / p.z_stride < p.size[2]
         }
     };
-    // Page `page` is a z slice: every page of a plain stack; channel 0 at time 0 of each
-    // z of an OME-TIFF (pages `z * z_stride`).
-    let wanted = |page: u64| match &pixels {
-        None => true,
-        Some(p) => page.is_multiple_of(p.z_stride) && page / p.z_stride < p.size[2],
-    };
     let (width, height) = decoder.dimensions().map_err(bad)?;
-    if let Some(p) = &pixels {
+    if let Some(p) = pixels {
         if (u64::from(width), u64::from(height)) != (p.size[0], p.size[1]) {
             return Err(malformed(
                 path,
@@ -252,16 +399,14 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
             )?;
             slices.push(decoder.read_image().map_err(bad)?);
         }
-        let done = pixels
-            .as_ref()
-            .is_some_and(|p| slices.len() as u64 == p.size[2]);
+        let done = pixels.is_some_and(|p| slices.len() as u64 == p.size[2]);
         if done || !decoder.more_images() {
             break;
         }
         decoder.next_image().map_err(bad)?;
         page += 1;
     }
-    if let Some(p) = &pixels {
+    if let Some(p) = pixels {
         if slices.len() as u64 != p.size[2] {
             return Err(VolumeError::Truncated {
                 path: path.to_path_buf(),
@@ -278,12 +423,13 @@ pub(crate) fn load(path: &Path) -> Result<Volume, VolumeError> {
         "PhysicalSizeX/Y/Z",
         pixels.map_or([1.0; 3], |p| p.spacing_mm),
     )?;
-    Volume::from_stored(
+    Volume::from_stored_in(
         path,
         name_of(path).trim_end_matches(".ome").to_string(),
         dims,
         spacing,
         Stored::plain(samples),
+        window,
     )
 }
 

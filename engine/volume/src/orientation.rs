@@ -295,6 +295,42 @@ fn resample(path: &Path, v: Volume, t: PatientTransform) -> Result<Volume, Volum
     })
 }
 
+/// `v` resampled (trilinear, in patient space) onto the grid of `dims` voxels placed by
+/// `onto`: how a channel from another file lands on a series' first file's grid (a 3 mm
+/// statistical map on a 1 mm T1). Points outside `v`'s voxel centres are empty (0); the
+/// samples keep `v`'s type and window.
+pub(crate) fn resample_onto(v: &Volume, dims: [u32; 3], onto: &PatientTransform) -> Volume {
+    let inverse = invert(v.to_patient);
+    let n = crate::voxel_count(dims) as usize;
+    let mut out = Vec::with_capacity(n);
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            for i in 0..dims[0] {
+                let p = onto.apply([f64::from(i), f64::from(j), f64::from(k)]);
+                out.push(trilinear(v, inverse(p)));
+            }
+        }
+    }
+    let data = match v.data {
+        VolumeData::U8(_) => {
+            VolumeData::U8(out.iter().map(|&x| (x * 255.0).round() as u8).collect())
+        }
+        VolumeData::U16(_) => {
+            VolumeData::U16(out.iter().map(|&x| (x * 65535.0).round() as u16).collect())
+        }
+        VolumeData::F32(_) => VolumeData::F32(out),
+    };
+    Volume {
+        name: v.name.clone(),
+        dims,
+        spacing: onto.spacing().map(|s| s as f32),
+        to_patient: *onto,
+        window: v.window,
+        sample_kind: v.sample_kind,
+        data,
+    }
+}
+
 /// Patient mm to (fractional) index.
 fn invert(t: PatientTransform) -> impl Fn([f64; 3]) -> [f64; 3] {
     let m = t.axes; // columns

@@ -142,6 +142,20 @@ pub(crate) fn nifti(
     data: &NiftiData,
     scale: Option<(f32, f32)>,
 ) {
+    nifti_series(path, dims, [1, 1], spacing, data, scale, None);
+}
+
+/// [`nifti`] of `extra = [dim[4], dim[5]]` time points and channels (the data holds
+/// them time fastest, then channel, after x, y, z), with an sform where given.
+pub(crate) fn nifti_series(
+    path: &Path,
+    dims: [u32; 3],
+    extra: [u32; 2],
+    spacing: [f32; 3],
+    data: &NiftiData,
+    scale: Option<(f32, f32)>,
+    sform: Option<[[f32; 4]; 3]>,
+) {
     let (code, bitpix, payload): (i16, i16, Vec<u8>) = match data {
         NiftiData::U8(v) => (2, 8, v.clone()),
         NiftiData::I16(v) => (4, 16, v.iter().flat_map(|x| x.to_le_bytes()).collect()),
@@ -151,13 +165,20 @@ pub(crate) fn nifti(
     let mut h = vec![0u8; 352];
     let put = |h: &mut Vec<u8>, at: usize, b: &[u8]| h[at..at + b.len()].copy_from_slice(b);
     put(&mut h, 0, &348i32.to_le_bytes());
+    let ndim = if extra[1] > 1 {
+        5
+    } else if extra[0] > 1 {
+        4
+    } else {
+        3
+    };
     let dim: [i16; 8] = [
-        3,
+        ndim,
         dims[0] as i16,
         dims[1] as i16,
         dims[2] as i16,
-        1,
-        1,
+        extra[0] as i16,
+        extra[1] as i16,
         1,
         1,
     ];
@@ -177,6 +198,14 @@ pub(crate) fn nifti(
     put(&mut h, 112, &slope.to_le_bytes());
     put(&mut h, 116, &inter.to_le_bytes());
     h[123] = 2; // mm
+    if let Some(rows) = sform {
+        put(&mut h, 254, &1i16.to_le_bytes());
+        for (r, row) in rows.iter().enumerate() {
+            for (i, x) in row.iter().enumerate() {
+                put(&mut h, 280 + 16 * r + 4 * i, &x.to_le_bytes());
+            }
+        }
+    }
     put(&mut h, 344, b"n+1\0");
     h.extend_from_slice(&payload);
     let gz = path.extension().is_some_and(|e| e == "gz");
@@ -329,4 +358,24 @@ pub(crate) fn dicom(path: &Path, s: &DicomSlice) {
     );
     out.extend_from_slice(&d);
     bytes(path, &out);
+}
+
+/// An OME-TIFF of uint8 pages `width`×`height`, `pages` in file order, with `xml` as
+/// the first page's ImageDescription.
+pub(crate) fn ome_tiff(path: &Path, width: u32, height: u32, pages: &[Vec<u8>], xml: &str) {
+    use tiff::encoder::{colortype, TiffEncoder};
+    let file = std::fs::File::create(path).expect("create tiff");
+    let mut enc = TiffEncoder::new(std::io::BufWriter::new(file)).expect("tiff encoder");
+    for (i, page) in pages.iter().enumerate() {
+        let mut image = enc
+            .new_image::<colortype::Gray8>(width, height)
+            .expect("tiff page");
+        if i == 0 {
+            image
+                .encoder()
+                .write_tag(tiff::tags::Tag::ImageDescription, xml)
+                .expect("description");
+        }
+        image.write_data(page).expect("tiff data");
+    }
 }

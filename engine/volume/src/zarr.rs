@@ -21,18 +21,22 @@
 //! not state a decoded size past its chunk's (see `zarr/bounded.rs`).
 
 mod bounded;
+mod chunks;
+mod omero;
 
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
+use super::series::{channel_list, Source, SourceChannel, SourceInfo};
 use super::{name_of, validate_spacing, Volume, MAX_DIM, MAX_VOXELS};
 use crate::bytes::human_bytes;
 use bounded::BoundedStore;
+use chunks::{absent_chunks, check_chunks};
 use ome_zarr_metadata::v0_4::{Axis, AxisType, CoordinateTransform, CoordinateTransformScale};
 use ome_zarr_metadata::AnyOmeFields;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use zarrs::array::{Array, ArraySubset};
+use zarrs::array::Array;
 use zarrs::group::Group;
 
 /// Largest metadata file read (`zarr.json`, `.zattrs`, `.zarray`, `.zgroup`): an
@@ -75,6 +79,11 @@ struct Image {
     group: PathBuf,
     axes: Vec<Axis>,
     levels: Vec<Level>,
+    /// The axis of type `channel` (or named `c`), and of type `time` (or named `t`).
+    channel_axis: Option<usize>,
+    time_axis: Option<usize>,
+    /// `omero.channels`: labels, colours and display windows (`omero.rs`).
+    omero: Vec<SourceChannel>,
 }
 
 fn malformed(path: &Path, field: &str, problem: impl Into<String>) -> VolumeError {
@@ -87,6 +96,23 @@ fn malformed(path: &Path, field: &str, problem: impl Into<String>) -> VolumeErro
 
 pub(crate) fn load(path: &Path, budget: Option<u64>) -> Result<Volume, VolumeError> {
     bounded::register_bounded_codecs();
+    let (image, index) = image_and_level(path, budget)?;
+    for (axis, &len) in image.axes.iter().zip(&level_shape(path, &image, index)?) {
+        if len > 1 && !is_spatial(axis) {
+            log::warn!(
+                "{}: axis {} has {len} entries; rendering the first (open it as a series \
+                 for its channels and time points: `dvr info`)",
+                path.display(),
+                axis.name
+            );
+        }
+    }
+    read_level(path, &image, index, [0, 0], None).map(|(v, _)| v)
+}
+
+/// The image (and level) `path` names: its group and the level's index (the finest
+/// that fits `budget`, or the level `path` is).
+fn image_and_level(path: &Path, budget: Option<u64>) -> Result<(Image, usize), VolumeError> {
     // A level's array names its group as its parent folder.
     let is_array = path.join(".zarray").is_file() || array_metadata_v3(path);
     let (group, wanted) = match (is_array, path.parent(), path.file_name()) {
@@ -118,7 +144,97 @@ pub(crate) fn load(path: &Path, budget: Option<u64>) -> Result<Volume, VolumeErr
             })?,
         None => finest_that_fits(&image, budget)?,
     };
-    read_level(path, &image, index)
+    Ok((image, index))
+}
+
+/// The shape of level `index`'s array, checked against the image's axes: as many
+/// dimensions, none of length 0.
+fn level_shape(path: &Path, image: &Image, index: usize) -> Result<Vec<u64>, VolumeError> {
+    let level = &image.levels[index];
+    let array = open_array(image, level, MAX_METADATA_BYTES, None)?;
+    let shape = array.shape().to_vec();
+    if shape.len() != image.axes.len() {
+        return Err(malformed(
+            path,
+            "shape",
+            format!(
+                "level {} has {} dimensions, the image's axes {}",
+                level.path,
+                shape.len(),
+                image.axes.len()
+            ),
+        ));
+    }
+    for (i, (axis, &len)) in image.axes.iter().zip(&shape).enumerate() {
+        if len == 0 {
+            let what = if Some(i) == image.time_axis {
+                " (the T axis is empty: no time points)"
+            } else {
+                ""
+            };
+            return Err(malformed(
+                path,
+                "shape",
+                format!(
+                    "level {}: axis {} has no entries{what}",
+                    level.path, axis.name
+                ),
+            ));
+        }
+    }
+    Ok(shape)
+}
+
+fn is_spatial(a: &Axis) -> bool {
+    a.r#type == Some(AxisType::Space) || ["x", "y", "z"].contains(&a.name.as_str())
+}
+
+/// Opens an OME-Zarr image (or one level) as a series: its channel and time axes, and
+/// `omero.channels`; the finest level within the volume limits.
+pub(crate) fn open_series(path: &Path) -> Result<Box<dyn Source>, VolumeError> {
+    bounded::register_bounded_codecs();
+    let (image, index) = image_and_level(path, None)?;
+    let shape = level_shape(path, &image, index)?;
+    let n = shape.len();
+    let dims_u64 = [shape[n - 1], shape[n - 2], shape[n - 3]];
+    let dims = super::validate_dims(path, dims_u64.map(|d| i64::try_from(d).unwrap_or(i64::MAX)))?;
+    let count = |a: Option<usize>| a.map_or(1, |a| shape[a]);
+    let meta = channel_list(path, count(image.channel_axis), image.omero.clone())?;
+    let info = SourceInfo {
+        path: path.to_path_buf(),
+        name: name_of(&image.group),
+        dims,
+        orientation: None,
+        channels: meta,
+        times: usize::try_from(count(image.time_axis)).unwrap_or(usize::MAX),
+    };
+    Ok(Box::new(ZarrSeries { info, image, index }))
+}
+
+struct ZarrSeries {
+    info: SourceInfo,
+    image: Image,
+    index: usize,
+}
+
+impl Source for ZarrSeries {
+    fn info(&self) -> &SourceInfo {
+        &self.info
+    }
+    fn read(
+        &self,
+        channel: usize,
+        time: usize,
+        window: Option<(f64, f64)>,
+    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+        read_level(
+            &self.info.path,
+            &self.image,
+            self.index,
+            [channel as u64, time as u64],
+            window,
+        )
+    }
 }
 
 /// Whether `path/zarr.json` describes an array (Zarr v3).
@@ -146,7 +262,15 @@ fn store(path: &Path, max_read: u64) -> Result<Arc<Store>, VolumeError> {
 fn read_image(group: &Path) -> Result<Image, VolumeError> {
     let group_node = Group::open(store(group, MAX_METADATA_BYTES)?, "/")
         .map_err(|e| malformed(group, "zarr group", e.to_string()))?;
-    let attributes = serde_json::Value::Object(group_node.attributes().clone());
+    // `omero` is read by `omero.rs`, leniently (the metadata crate requires every
+    // channel's colour and full window, which writers often leave out).
+    let mut attributes = serde_json::Value::Object(group_node.attributes().clone());
+    if let Some(a) = attributes.as_object_mut() {
+        a.remove("omero");
+    }
+    if let Some(a) = attributes.get_mut("ome").and_then(|o| o.as_object_mut()) {
+        a.remove("omero");
+    }
     let ome: AnyOmeFields = serde_json::from_value(attributes).map_err(|e| {
         malformed(
             group,
@@ -166,6 +290,7 @@ fn read_image(group: &Path) -> Result<Image, VolumeError> {
                 .collect::<Vec<_>>()
         }),
     };
+    let omero = omero::channels(group, group_node.attributes())?;
     let Some((axes, datasets, global)) = multiscales.and_then(|v| v.into_iter().next()) else {
         return Err(malformed(
             group,
@@ -215,10 +340,28 @@ fn read_image(group: &Path) -> Result<Image, VolumeError> {
             "the image lists no resolution level",
         ));
     }
+    let find = |ty: AxisType, name: &str| -> Result<Option<usize>, VolumeError> {
+        let found: Vec<usize> = (0..n - 3)
+            .filter(|&i| axes[i].r#type == Some(ty.clone()) || axes[i].name == name)
+            .collect();
+        if found.len() > 1 {
+            return Err(malformed(
+                group,
+                "axes",
+                format!("{} axes of type {name}: at most one", found.len()),
+            ));
+        }
+        Ok(found.first().copied())
+    };
+    let channel_axis = find(AxisType::Channel, "c")?;
+    let time_axis = find(AxisType::Time, "t")?;
     Ok(Image {
         group: group.to_path_buf(),
         axes,
         levels,
+        channel_axis,
+        time_axis,
+        omero,
     })
 }
 
@@ -389,38 +532,19 @@ fn spatial_dims(array: &Array<Store>) -> [u64; 3] {
     [s[n - 1], s[n - 2], s[n - 3]]
 }
 
-fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, VolumeError> {
+/// Level `index` at channel `at[0]` and time point `at[1]` (other non-spatial axes at
+/// index 0), normalised through `window` where given.
+fn read_level(
+    path: &Path,
+    image: &Image,
+    index: usize,
+    at: [u64; 2],
+    window: Option<(f64, f64)>,
+) -> Result<(Volume, (f64, f64)), VolumeError> {
     let level = &image.levels[index];
+    let shape = level_shape(path, image, index)?;
     let array = open_array(image, level, MAX_METADATA_BYTES, None)?;
-    let shape = array.shape().to_vec();
     let n = image.axes.len();
-    if shape.len() != n {
-        return Err(malformed(
-            path,
-            "shape",
-            format!(
-                "level {} has {} dimensions, the image's axes {n}",
-                level.path,
-                shape.len()
-            ),
-        ));
-    }
-    for (axis, &len) in image.axes.iter().zip(&shape).take(n - 3) {
-        if len == 0 {
-            return Err(malformed(
-                path,
-                "shape",
-                format!("level {}: axis {} has no entries", level.path, axis.name),
-            ));
-        }
-        if len > 1 {
-            log::warn!(
-                "{}: axis {} has {len} entries; rendering the first",
-                path.display(),
-                axis.name
-            );
-        }
-    }
     let dims_i64 = spatial_dims(&array).map(|d| i64::try_from(d).unwrap_or(i64::MAX));
     let dims = super::validate_dims(path, dims_i64)?;
     let dtype = dtype_name(&array);
@@ -434,8 +558,28 @@ fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, Volume
     let ranges: Vec<Range<u64>> = shape
         .iter()
         .enumerate()
-        .map(|(i, &len)| if i < n - 3 { 0..len.min(1) } else { 0..len })
+        .map(|(i, &len)| {
+            if Some(i) == image.channel_axis {
+                at[0]..at[0] + 1
+            } else if Some(i) == image.time_axis {
+                at[1]..at[1] + 1
+            } else if i < n - 3 {
+                0..len.min(1)
+            } else {
+                0..len
+            }
+        })
         .collect();
+    if ranges.iter().zip(&shape).any(|(r, &len)| r.end > len) {
+        return Err(malformed(
+            path,
+            "shape",
+            format!(
+                "channel {} or time point {} is past the axes' {shape:?}",
+                at[0], at[1]
+            ),
+        ));
+    }
     let largest_chunk = check_chunks(path, level, &array, &ranges)?;
     // Reopened through a store that reads no more than the largest chunk at a time (with
     // a little over for headers and incompressible data, and a shard's index). A Zarr v2
@@ -492,7 +636,7 @@ fn read_level(path: &Path, image: &Image, index: usize) -> Result<Volume, Volume
         );
     }
     let name = name_of(&image.group);
-    Volume::from_stored(path, name, dims, spacing, Stored::plain(samples))
+    Volume::from_stored_in(path, name, dims, spacing, Stored::plain(samples), window)
 }
 
 /// The elements of `subset`, decoded, in C order.
@@ -504,180 +648,6 @@ fn read<T: zarrs::array::ElementOwned>(
     array
         .retrieve_array_subset::<Vec<T>>(&subset)
         .map_err(|e| malformed(path, "chunks", e.to_string()))
-}
-
-/// How many of the chunks under `ranges` have no stored data. Only the chunks the
-/// ranges touch are visited (time and channel axes past index 0 are not).
-fn absent_chunks(array: &Array<Store>, ranges: &[Range<u64>]) -> Result<u64, VolumeError> {
-    let chunk: Vec<u64> = array
-        .chunk_shape(&vec![0; ranges.len()])
-        .map(|s| s.iter().map(|c| c.get()).collect())
-        .unwrap_or_default();
-    if chunk.len() != ranges.len() {
-        return Ok(0); // an irregular grid: nothing to count by
-    }
-    let spans: Vec<Range<u64>> = ranges
-        .iter()
-        .zip(&chunk)
-        .map(|(r, &c)| r.start / c..r.end.div_ceil(c))
-        .collect();
-    let mut absent = 0;
-    let mut index: Vec<u64> = spans.iter().map(|s| s.start).collect();
-    if spans.iter().any(|s| s.is_empty()) {
-        return Ok(0);
-    }
-    'all: loop {
-        if !array_store_has(array, &array.chunk_key(&index)) {
-            absent += 1;
-        }
-        for d in (0..spans.len()).rev() {
-            index[d] += 1;
-            if index[d] < spans[d].end {
-                continue 'all;
-            }
-            index[d] = spans[d].start;
-        }
-        break;
-    }
-    Ok(absent)
-}
-
-fn array_store_has(array: &Array<Store>, key: &zarrs::storage::StoreKey) -> bool {
-    use zarrs::storage::ReadableStorageTraits;
-    array.storage().size_key(key).ok().flatten().is_some()
-}
-
-/// Checks the chunks a read of `ranges` decodes against [`MAX_CHUNKS`],
-/// [`CHUNK_OVER_READ`] and [`MIN_CHUNK_ELEMENTS`], before any is read: the chunk grid's
-/// chunks and, through each `sharding_indexed` codec, the inner chunks of its shards.
-/// Returns the most bytes one chunk or shard holds once decoded.
-fn check_chunks(
-    path: &Path,
-    level: &Level,
-    array: &Array<Store>,
-    ranges: &[Range<u64>],
-) -> Result<u64, VolumeError> {
-    let bad =
-        |problem: String| malformed(path, "chunks", format!("level {}: {problem}", level.path));
-    let read: u64 = ranges.iter().map(|r| r.end - r.start).product();
-    let most_elements = read.saturating_mul(CHUNK_OVER_READ).max(MIN_CHUNK_ELEMENTS);
-    let grid = array
-        .chunks_in_array_subset(&ArraySubset::new_with_ranges(ranges))
-        .ok()
-        .flatten()
-        .ok_or_else(|| bad("the chunk grid does not cover the array".into()))?;
-    let mut chunks = grid
-        .shape()
-        .iter()
-        .try_fold(1u64, |a, &c| a.checked_mul(c))
-        .filter(|&c| c <= MAX_CHUNKS)
-        .ok_or_else(|| {
-            bad(format!(
-                "the volume read spans {:?} chunks, more than {MAX_CHUNKS} (chunks this \
-                 small make reading take minutes)",
-                grid.shape()
-            ))
-        })?;
-    // The largest chunk along each axis (a rectangular grid's differ).
-    let mut shape = Vec::with_capacity(ranges.len());
-    for d in 0..ranges.len() {
-        let mut largest = 0;
-        let mut index = grid.start().to_vec();
-        for i in grid.start()[d]..grid.start()[d] + grid.shape()[d] {
-            index[d] = i;
-            let c = array.chunk_shape(&index).map_err(|e| bad(e.to_string()))?;
-            largest = largest.max(c[d].get());
-        }
-        shape.push(largest);
-    }
-    let json = serde_json::to_value(array.metadata()).unwrap_or_default();
-    let mut largest_elements = 0u64;
-    let mut codecs = json.get("codecs").cloned().unwrap_or_default();
-    loop {
-        let elements = shape
-            .iter()
-            .try_fold(1u64, |a, &c| a.checked_mul(c))
-            .filter(|&e| e <= most_elements)
-            .ok_or_else(|| {
-                bad(format!(
-                    "a chunk of shape {shape:?} holds more than {most_elements} elements \
-                     ({CHUNK_OVER_READ} times the {read} voxels read, or \
-                     {MIN_CHUNK_ELEMENTS}): chunks are decoded whole"
-                ))
-            })?;
-        largest_elements = largest_elements.max(elements);
-        // The next level: the inner chunks of a sharding codec (after the transposes
-        // that reorder the shard's axes before it).
-        let mut inner = None;
-        for codec in codecs.as_array().map(Vec::as_slice).unwrap_or_default() {
-            let config = &codec["configuration"];
-            match codec["name"].as_str() {
-                Some("transpose") => {
-                    let order: Option<Vec<usize>> = config["order"].as_array().and_then(|o| {
-                        o.iter()
-                            .map(|i| i.as_u64().and_then(|i| usize::try_from(i).ok()))
-                            .collect()
-                    });
-                    match order {
-                        Some(o) if o.len() == shape.len() && o.iter().all(|&i| i < shape.len()) => {
-                            shape = o.iter().map(|&i| shape[i]).collect();
-                        }
-                        _ => {
-                            return Err(bad(format!(
-                                "a transpose order {} for {} axes",
-                                config["order"],
-                                shape.len()
-                            )))
-                        }
-                    }
-                }
-                Some("sharding_indexed") => {
-                    let inner_shape: Option<Vec<u64>> = config["chunk_shape"]
-                        .as_array()
-                        .and_then(|s| s.iter().map(serde_json::Value::as_u64).collect());
-                    match inner_shape {
-                        Some(s) if s.len() == shape.len() && s.iter().all(|&c| c > 0) => {
-                            inner = Some((s, config["codecs"].clone()));
-                        }
-                        _ => {
-                            return Err(bad(format!(
-                                "a shard's inner chunk shape {} for {} axes",
-                                config["chunk_shape"],
-                                shape.len()
-                            )))
-                        }
-                    }
-                    break;
-                }
-                _ => {}
-            }
-        }
-        let Some((inner_shape, inner_codecs)) = inner else {
-            break;
-        };
-        let per_shard = shape
-            .iter()
-            .zip(&inner_shape)
-            .try_fold(1u64, |a, (&s, &c)| a.checked_mul(s.div_ceil(c)))
-            .filter(|&n| n <= MAX_CHUNKS)
-            .ok_or_else(|| {
-                bad(format!(
-                    "shards of shape {shape:?} in inner chunks of {inner_shape:?}: more than \
-                     {MAX_CHUNKS} inner chunks per shard"
-                ))
-            })?;
-        chunks = chunks
-            .checked_mul(per_shard)
-            .filter(|&c| c <= MAX_CHUNKS)
-            .ok_or_else(|| {
-                bad(format!(
-                    "the volume read spans more than {MAX_CHUNKS} inner chunks of {inner_shape:?}"
-                ))
-            })?;
-        shape = inner_shape;
-        codecs = inner_codecs;
-    }
-    Ok(largest_elements * voxel_bytes(array))
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ fn run(samples: Samples, rescale: Rescale, dims: [u32; 3]) -> Normalised {
         rescale,
         orientation: None,
     };
-    normalise(Path::new("t.raw"), dims, stored).expect("normalise")
+    normalise(Path::new("t.raw"), dims, stored, None).expect("normalise")
 }
 
 #[test]
@@ -130,7 +130,7 @@ fn nan_is_an_error_naming_the_first_voxel() {
         f32::INFINITY,
         0.0,
     ]));
-    let err = normalise(Path::new("bad.raw"), [3, 1, 2], stored).unwrap_err();
+    let err = normalise(Path::new("bad.raw"), [3, 1, 2], stored, None).unwrap_err();
     assert!(matches!(
         err,
         VolumeError::NonFinite {
@@ -154,7 +154,7 @@ fn dicom_bits_stored_range_is_the_type_range() {
         rescale: Rescale::Uniform(Affine::IDENTITY),
         orientation: None,
     };
-    let n = normalise(Path::new("x.dcm"), [2, 1, 1], stored).expect("normalise");
+    let n = normalise(Path::new("x.dcm"), [2, 1, 1], stored, None).expect("normalise");
     assert_eq!(n.window, [0.0, 4095.0]);
     assert_eq!(n.data, VolumeData::U16(vec![0, 65535]));
     assert_eq!(SampleKind::I16.full_range(), Some((-32768.0, 32767.0)));
