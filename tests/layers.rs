@@ -13,6 +13,7 @@ const APP_LAYERS: &[(&str, u32)] = &[
     ("demo", 3),
     ("eval", 2),
     ("explore", 2),
+    ("info", 1),
     ("setup", 1),
     ("shard", 1),
     ("video", 1),
