@@ -37,7 +37,7 @@ const GAP: u32 = 4;
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct VideoArgs {
     /// Also write each method's frames as an H.264 MP4, and a side-by-side comparison
-    /// with labels, to <out>/videos/ (needs `ffmpeg` on PATH).
+    /// with labels, to `<out>/videos/` (needs `ffmpeg` on PATH).
     #[arg(long)]
     pub video: bool,
     /// Frames per second of the videos.

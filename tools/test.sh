@@ -33,7 +33,7 @@ rm -rf target/wheels
 "$py" -m maturin build --quiet -m python/Cargo.toml -o target/wheels
 "$py" -m pip install --quiet --disable-pip-version-check --force-reinstall --no-deps target/wheels/dvr-*.whl
 # The Python reference from the installed package's docstrings, then the book's links.
-"$py" -m pdoc dvr -o docs/book/api/python >/dev/null
+"$py" -m pdoc dvr dvr.viewer -o docs/book/api/python >/dev/null 2>&1
 python3 tools/check_docs.py
 # From outside the checkout, so `import dvr` is the installed wheel, not python/dvr.
 (cd target && DVR_VALIDATION=1 DVR_BIN="$PWD/debug/dvr" "$PWD/py/bin/python" -m pytest -q ../python/tests)

@@ -123,7 +123,7 @@ impl PatientTransform {
         out
     }
 
-    /// Whether any axis is further than [`OBLIQUE_SINE`] from the RAS axis it is
+    /// Whether any axis is further than `OBLIQUE_SINE` from the RAS axis it is
     /// nearest to.
     pub fn is_oblique(&self) -> bool {
         let near = self.nearest_ras();
