@@ -142,6 +142,7 @@ fn a_volume_past_the_device_limits_is_paged_and_a_mis_sized_one_refused_before_a
         format: VolumeFormat::R16,
         bytes: Vec::new(),
         blocks: None,
+        extra_channels: Vec::new(),
         world_size: [1.0; 3],
         window: [0.0, 1.0],
         mm_per_unit: 1.0,

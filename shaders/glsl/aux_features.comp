@@ -74,14 +74,14 @@ void main() {
                 float step_len = base_step;
                 for (; t < cell_exit && alpha < stop; t += step_len) {
                     vec3 p = o + d * t;
-                    float density = density_at(p);
-                    vec4 tf = tf_albedo_opacity(density);
+                    MediumPoint m = medium_point(p);
+                    vec4 tf = m.albedo_opacity;
                     float a = step_opacity(tf.a * frame.box_min.w, step_len);
                     crossing_step(c, t, a, threshold);
                     if (a <= 0.0) continue;
                     float weight = (1.0 - alpha) * a;
                     if (GUIDE_NORMALS) {
-                        vec3 g = density_gradient(p);
+                        vec3 g = medium_gradient(m);
                         vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
                         if (cut_entry && t - span.x < CUT_FACE_STEPS * base_step) n = cut_normal;
                         if (dot(n, d) > 0.0) n = -n;

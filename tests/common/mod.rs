@@ -46,6 +46,7 @@ pub fn constant_volume(n: u32, d: f32) -> VolumeUpload {
         format: VolumeFormat::R8,
         bytes: vec![v; (n * n * n) as usize],
         blocks: None,
+        extra_channels: Vec::new(),
         world_size: [1.0, 1.0, 1.0],
         window: [0.0, 1.0],
         mm_per_unit: 1.0,

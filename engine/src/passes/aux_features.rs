@@ -7,7 +7,7 @@
 //! threshold surface and writes the surface features, so a frame that needs both marches
 //! once.
 
-use super::path_trace::volume_specialization;
+use super::path_trace::{volume_specialization, VolumeLayout};
 use super::surface_features::{FeatureImages, STEP_VOXELS};
 use super::SceneBindings;
 use crate::error::Result;
@@ -38,14 +38,13 @@ pub struct AuxFeatures {
 }
 
 impl AuxFeatures {
-    /// `pooled`: the volume is paged through the brick pool.
-    pub fn new(ctx: &GpuContext, pooled: bool) -> Result<Self> {
-        let volume = volume_specialization(pooled);
+    pub fn new(ctx: &GpuContext, volume: VolumeLayout) -> Result<Self> {
+        let [pooled, channels] = volume_specialization(volume);
         Ok(Self {
-            pipeline: ctx.pipeline("aux_features", &[volume])?,
+            pipeline: ctx.pipeline("aux_features", &[pooled, channels])?,
             albedo_only: ctx.pipeline(
                 "aux_features",
-                &[("GUIDE_NORMALS", SpecValue::Bool(false)), volume],
+                &[("GUIDE_NORMALS", SpecValue::Bool(false)), pooled, channels],
             )?,
         })
     }

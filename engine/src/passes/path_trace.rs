@@ -23,39 +23,58 @@ gpu_block! {
     }
 }
 
+/// How the volume is held, which every pipeline that reads it is specialised for
+/// (include/volume.glsl): dense or paged through the brick pool, and how many channels
+/// its texels pack (1–4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct VolumeLayout {
+    pub pooled: bool,
+    pub channels: u32,
+}
+
+impl Default for VolumeLayout {
+    fn default() -> Self {
+        Self {
+            pooled: false,
+            channels: 1,
+        }
+    }
+}
+
 /// What the pipeline is specialised for (what the scene uses): the render settings'
-/// [`PipelineKey`], whether an environment map is bound and whether the volume is paged
-/// through the brick pool.
+/// [`PipelineKey`], whether an environment map is bound and how the volume is held.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub struct PathTraceFeatures {
     pub estimator: Estimator,
     pub phase: Phase,
     pub emission: bool,
     pub environment_map: bool,
-    pub pooled_volume: bool,
+    pub volume: VolumeLayout,
 }
 
 impl PathTraceFeatures {
-    pub fn new(key: PipelineKey, environment_map: bool, pooled_volume: bool) -> Self {
+    pub fn new(key: PipelineKey, environment_map: bool, volume: VolumeLayout) -> Self {
         Self {
             estimator: key.estimator,
             phase: key.phase,
             emission: key.emission,
             environment_map,
-            pooled_volume,
+            volume,
         }
     }
 }
 
-/// The specialisation of a pipeline that reads the volume (include/volume.glsl): the
-/// dense texture, or the brick pool.
-pub fn volume_specialization(pooled: bool) -> (&'static str, SpecValue) {
-    ("POOLED_VOLUME", SpecValue::Bool(pooled))
+/// The specialisation of a pipeline that reads the volume (include/volume.glsl).
+pub fn volume_specialization(volume: VolumeLayout) -> [(&'static str, SpecValue); 2] {
+    [
+        ("POOLED_VOLUME", SpecValue::Bool(volume.pooled)),
+        ("CHANNELS", SpecValue::I32(volume.channels as i32)),
+    ]
 }
 
 /// The specialisation constants of a pipeline that traces paths (include/path.glsl):
 /// the path tracer's, and ours' temporal-gradient pass, which must trace the same paths.
-pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue); 5] {
+pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue); 6] {
     let estimator = match features.estimator {
         Estimator::Delta => ESTIMATOR_DELTA,
         Estimator::RayMarch => ESTIMATOR_RAY_MARCH,
@@ -65,12 +84,14 @@ pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue)
         Phase::Hg => PHASE_HG,
         Phase::Hybrid => PHASE_HYBRID,
     };
+    let [pooled, channels] = volume_specialization(features.volume);
     [
         ("ESTIMATOR", SpecValue::I32(estimator)),
         ("PHASE", SpecValue::I32(phase)),
         ("USE_EMISSION", SpecValue::Bool(features.emission)),
         ("HAS_ENV_MAP", SpecValue::Bool(features.environment_map)),
-        volume_specialization(features.pooled_volume),
+        pooled,
+        channels,
     ]
 }
 

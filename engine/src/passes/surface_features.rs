@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline};
 use crate::gpu_block;
 use crate::graph::{Bindings, Extent, Frame, History, ImageHandle, RenderGraph};
-use crate::passes::path_trace::volume_specialization;
+use crate::passes::path_trace::{volume_specialization, VolumeLayout};
 use ash::vk;
 
 gpu_block! {
@@ -58,10 +58,9 @@ impl FeatureImages {
 }
 
 impl SurfaceFeatures {
-    /// `pooled`: the volume is paged through the brick pool.
-    pub fn new(ctx: &GpuContext, pooled: bool) -> Result<Self> {
+    pub fn new(ctx: &GpuContext, volume: VolumeLayout) -> Result<Self> {
         Ok(Self {
-            pipeline: ctx.pipeline("surface_features", &[volume_specialization(pooled)])?,
+            pipeline: ctx.pipeline("surface_features", &volume_specialization(volume))?,
         })
     }
 

@@ -459,6 +459,7 @@ mod tests {
             format: VolumeFormat::R8,
             bytes: bytes.clone(),
             blocks: None,
+            extra_channels: Vec::new(),
             world_size: [1.0; 3],
             window: [0.0, 1.0],
             mm_per_unit: 1.0,

@@ -5,6 +5,8 @@
 
 pub mod brick_pool;
 mod inputs;
+pub mod medium;
+pub mod packing;
 pub mod present;
 mod reference;
 pub mod scene_gpu;
@@ -27,7 +29,7 @@ use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
 use crate::passes::accumulate::Accumulate;
 use crate::passes::aux_features::{self, AuxFeatures};
 use crate::passes::motion::Motion;
-use crate::passes::path_trace::{PathTrace, PathTraceFeatures};
+use crate::passes::path_trace::{PathTrace, PathTraceFeatures, VolumeLayout};
 use crate::passes::present::Present;
 use crate::passes::surface_features::{FeatureImages, SurfaceFeatures};
 use crate::passes::SceneBindings;
@@ -204,13 +206,16 @@ impl Renderer {
         // So is a volume not even a brick pool can hold in the budget: found here, the
         // error is not preceded by the allocator's reports of leaked buffers.
         let volume_path = scene_gpu::plan_volume(&ctx, &volume, config.gpu_memory)?;
-        let pooled = matches!(volume_path, VolumePath::Pool(_));
+        let layout = VolumeLayout {
+            pooled: matches!(volume_path, VolumePath::Pool(_)),
+            channels: volume.channels(),
+        };
         let features =
-            PathTraceFeatures::new(settings.pipeline_key(), environment.is_some(), pooled);
+            PathTraceFeatures::new(settings.pipeline_key(), environment.is_some(), layout);
         let denoisers = create_methods(&ctx, &config, features, denoisers)?;
         let mut graph = RenderGraph::new(&ctx)?;
         let passes = Passes {
-            features: SurfaceFeatures::new(&ctx, pooled)?,
+            features: SurfaceFeatures::new(&ctx, layout)?,
             path_trace: PathTrace::new(&ctx, features)?,
             motion: Motion::new(&ctx)?,
             accumulate: Accumulate::new(&ctx)?,
@@ -455,7 +460,7 @@ impl Renderer {
         let guide_readers = readers(&self.denoisers, |m| m.info.guides());
         let guides = !guide_readers.is_empty();
         if (request.aux || guides) && self.passes.aux.is_none() {
-            self.passes.aux = Some(AuxFeatures::new(&self.ctx, self.features.pooled_volume)?);
+            self.passes.aux = Some(AuxFeatures::new(&self.ctx, self.features.volume)?);
         }
         let reset = request.reset || std::mem::take(&mut self.pending_reset);
         let changes = self.changes(inputs, reset);

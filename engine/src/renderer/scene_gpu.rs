@@ -93,7 +93,7 @@ pub fn default_budget(ctx: &GpuContext) -> u64 {
 /// not even a pool fits, or where the bytes do not match the header.
 pub fn plan_volume(ctx: &GpuContext, v: &VolumeUpload, budget: Option<u64>) -> Result<VolumePath> {
     let texels: u64 = v.dims.iter().map(|&d| d as u64).product();
-    let needed = texels * v.format.bytes() as u64;
+    let needed = texels * v.texel_bytes() as u64;
     if v.blocks.is_none() && needed != v.bytes.len() as u64 {
         return Err(EngineError::Resource {
             resource: v.name.clone(),
@@ -114,10 +114,48 @@ pub fn plan_volume(ctx: &GpuContext, v: &VolumeUpload, budget: Option<u64>) -> R
             heap => heap,
         },
     };
+    if v.channels() > 1 {
+        return plan_channels(ctx, v, needed, &limits);
+    }
     brick_pool::plan(v.dims, v.format, &limits).map_err(|why| EngineError::TooLarge {
         what: format!(
             "volume {:?} ({:?} voxels, {:?}): {why}",
             v.name, v.dims, v.format
+        ),
+        needed,
+        limit: limits.budget,
+        device: ctx.info.name.clone(),
+    })
+}
+
+/// A multi-channel medium is held dense (the brick pool pages one field): it must fit
+/// the budget and the device's 3D image size.
+fn plan_channels(
+    ctx: &GpuContext,
+    v: &VolumeUpload,
+    needed: u64,
+    limits: &Limits,
+) -> Result<VolumePath> {
+    let largest = v.dims.iter().copied().max().unwrap_or(0);
+    let why = if largest > limits.max_image_dimension_3d {
+        format!(
+            "{largest} voxels along an axis; the device's 3D images reach {}",
+            limits.max_image_dimension_3d
+        )
+    } else if needed > limits.budget.min(limits.max_allocation) {
+        "a medium of several channels is held as one dense texture and does not fit \
+         (raise --gpu-memory, or pick fewer channels)"
+            .to_string()
+    } else {
+        return Ok(VolumePath::Dense);
+    };
+    Err(EngineError::TooLarge {
+        what: format!(
+            "volume {:?} ({:?} voxels, {} channels of {:?}): {why}",
+            v.name,
+            v.dims,
+            v.channels(),
+            v.format
         ),
         needed,
         limit: limits.budget,
@@ -138,7 +176,7 @@ pub fn create<'f>(
     environment: Option<&EnvironmentUpload>,
     lut_size: u32,
 ) -> Result<SceneImages> {
-    let format = volume.format.vk();
+    let format = volume.vk_format();
     // Dense: the volume itself, and 1×1×1 pool and table no shader reads. Pooled: the
     // coarse copy, the pool (slots are written as the TF makes their bricks visible, and
     // read only through the table, which starts with no slot) and the table.
@@ -160,7 +198,11 @@ pub fn create<'f>(
     let entries = vec![[-1f32, no_slot]; table_desc.texel_count() as usize];
     let entries = bytemuck::cast_slice(&entries);
     add_upload(ctx, graph, frame, "upload_brick_table", table, entries)?;
-    let lut_desc = ImageDesc::d1(lut_size, vk::Format::R32G32B32A32_SFLOAT);
+    // One LUT segment per channel (include/volume.glsl, channel_lut_coord).
+    let lut_desc = ImageDesc::d1(
+        lut_size * volume.channels(),
+        vk::Format::R32G32B32A32_SFLOAT,
+    );
     let tf = [
         graph.image(ctx, "scene.tf_diffuse_opacity", lut_desc)?,
         graph.image(ctx, "scene.tf_specular_roughness", lut_desc)?,

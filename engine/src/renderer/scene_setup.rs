@@ -54,10 +54,40 @@ impl SceneSetup {
         spp: Option<u32>,
         volume_size: u32,
     ) -> Result<Self, SetupError> {
+        if let Some(channels) = super::medium::load_channels(&scene)? {
+            return Self::with_channels(scene, &channels, size, spp);
+        }
         let upload = match on_demand(&scene, volume_size) {
             Some(v) => VolumeUpload::on_demand(v.name, v.blocks),
             None => VolumeUpload::from_volume(&load_volume(&scene, volume_size)?),
         };
+        Self::with_upload(scene, upload, size, spp)
+    }
+
+    /// [`SceneSetup::new`] for a medium of several channels: packed into one upload, each
+    /// channel's view from its section and the file (see [`super::medium`]).
+    pub fn with_channels(
+        mut scene: Scene,
+        channels: &super::medium::Channels,
+        size: Extent,
+        spp: Option<u32>,
+    ) -> Result<Self, SetupError> {
+        let upload = VolumeUpload::from_channels(&channels.volumes).map_err(|problem| {
+            SetupError::Invalid {
+                scene: scene.name.clone(),
+                problem,
+            }
+        })?;
+        let views = super::medium::channel_views(&scene, channels);
+        if let Some(c0) = views.first() {
+            // Channel 0's TF is the scene's `transfer.a`, over the channel's window
+            // (in density now, so the data-unit mapping of `with_upload` keeps it).
+            scene.tf_a = c0.density_tf();
+            scene.tf_b = scene
+                .tf_b
+                .map(|b| crate::scene::channel::over_window(&b, c0.window, c0.data_window));
+        }
+        scene.channel_views = views;
         Self::with_upload(scene, upload, size, spp)
     }
 
@@ -120,7 +150,7 @@ impl SceneSetup {
     /// takes too.
     pub fn frame_inputs(&self, f: u32) -> FrameInputs {
         let view = self.scene.view_at(f);
-        inputs_for_view(&view, self.config.size.aspect(), &view.tf.lut())
+        inputs_for_view(&view, self.config.size.aspect(), &view.lut())
     }
 }
 
@@ -182,6 +212,9 @@ pub fn load_volume(scene: &Scene, volume_size: u32) -> Result<Volume, VolumeErro
         VolumeSource::Builtin { dataset, size } => {
             Volume::builtin(dataset.name(), size.unwrap_or(volume_size))
         }
+        VolumeSource::Files { paths } => {
+            Volume::load_within(&paths[0], None, scene.render.gpu_memory())
+        }
         VolumeSource::File { path, raw } => {
             let params = raw.as_ref().map(|r| RawParams {
                 dims: r.dims,
@@ -201,7 +234,7 @@ pub fn renderer_config(scene: &Scene, size: Extent) -> RendererConfig {
         density_scale: scene.volume.density_scale as f32,
         dataset: match &scene.volume.source {
             VolumeSource::Builtin { dataset, .. } => Some(dataset.name()),
-            VolumeSource::File { .. } => None,
+            VolumeSource::File { .. } | VolumeSource::Files { .. } => None,
         },
         gpu_memory: scene.render.gpu_memory(),
         ..Default::default()

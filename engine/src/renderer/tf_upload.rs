@@ -24,13 +24,15 @@ impl Renderer {
         stream: bool,
     ) -> Result<f32> {
         let (lut, cut) = (&inputs.lut, &inputs.cut);
-        if lut.diffuse_opacity.len() != self.lut_size as usize {
+        let channels = self.volume.channels() as usize;
+        let n = self.lut_size as usize;
+        if lut.diffuse_opacity.len() != n * channels {
             return Err(EngineError::Resource {
                 resource: "transfer function".into(),
                 problem: format!(
-                    "LUT has {} entries, renderer expects {}",
+                    "LUT has {} entries, renderer expects {} ({channels} channel(s) of {n})",
                     lut.diffuse_opacity.len(),
-                    self.lut_size
+                    n * channels,
                 ),
             });
         }
@@ -39,7 +41,13 @@ impl Renderer {
             let opacity: Vec<f32> = lut.diffuse_opacity.iter().map(|c| c[3]).collect();
             let scale = self.config.density_scale;
             let (dims, world) = (self.volume_dims, self.world_size);
-            let mut majorants = scene_gpu::majorants(&self.bricks, &opacity, scale);
+            // The medium's extinction is the channels' sum: so is each brick's majorant.
+            let mut majorants = scene_gpu::majorants(&self.bricks, &opacity[..n], scale);
+            for (c, extra) in self.volume.extra_channels.iter().enumerate() {
+                let segment = &opacity[(c + 1) * n..(c + 2) * n];
+                let m = scene_gpu::majorants(&extra.bricks, segment, scale);
+                majorants.iter_mut().zip(m).for_each(|(a, b)| *a += b);
+            }
             scene_gpu::mask_cut(&mut majorants, &self.bricks, dims, world, cut);
             self.majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
             let (ctx, graph) = (&self.ctx, &mut self.graph);

@@ -17,13 +17,27 @@ pub enum VolumeFormat {
 }
 
 impl VolumeFormat {
+    /// The one-channel texel format.
     pub fn vk(self) -> vk::Format {
-        match self {
-            VolumeFormat::R8 => vk::Format::R8_UNORM,
-            VolumeFormat::R16 => vk::Format::R16_UNORM,
-            VolumeFormat::R32F => vk::Format::R32_SFLOAT,
+        self.vk_components(1)
+    }
+
+    /// The texel format of `components` (1, 2 or 4) of this type.
+    pub fn vk_components(self, components: u32) -> vk::Format {
+        use vk::Format as F;
+        match (self, components) {
+            (VolumeFormat::R8, 1) => F::R8_UNORM,
+            (VolumeFormat::R8, 2) => F::R8G8_UNORM,
+            (VolumeFormat::R8, _) => F::R8G8B8A8_UNORM,
+            (VolumeFormat::R16, 1) => F::R16_UNORM,
+            (VolumeFormat::R16, 2) => F::R16G16_UNORM,
+            (VolumeFormat::R16, _) => F::R16G16B16A16_UNORM,
+            (VolumeFormat::R32F, 1) => F::R32_SFLOAT,
+            (VolumeFormat::R32F, 2) => F::R32G32_SFLOAT,
+            (VolumeFormat::R32F, _) => F::R32G32B32A32_SFLOAT,
         }
     }
+    /// Bytes of one component.
     pub fn bytes(self) -> usize {
         match self {
             VolumeFormat::R8 => 1,
@@ -44,13 +58,24 @@ pub struct BrickRanges {
     pub max: Vec<f32>,
 }
 
+/// A channel of a multi-channel volume past the first (see `packing.rs`).
+#[derive(Clone, Debug)]
+pub struct ChannelUpload {
+    pub name: String,
+    /// The physical values at density 0 and 1 of this channel.
+    pub window: [f32; 2],
+    pub bricks: BrickRanges,
+}
+
 /// A volume ready for upload.
 #[derive(Clone, Debug)]
 pub struct VolumeUpload {
     pub name: String,
     pub dims: [u32; 3],
+    /// The type of each texel component.
     pub format: VolumeFormat,
-    /// Texel bytes, x fastest; empty when `blocks` makes them.
+    /// Texel bytes, x fastest, every channel's component of a texel together; empty when
+    /// `blocks` makes them.
     pub bytes: Vec<u8>,
     /// A volume made block by block on demand (R16), whose dense bytes never exist.
     pub blocks: Option<Arc<dyn VoxelBlocks>>,
@@ -60,12 +85,32 @@ pub struct VolumeUpload {
     pub window: [f32; 2],
     /// Millimetres per world unit: the volume's longest physical side (the scale bar).
     pub mm_per_unit: f32,
+    /// Channel 0's brick ranges.
     pub bricks: BrickRanges,
+    /// Channels 1.. of a multi-channel medium, packed into the same texels (empty for
+    /// one field).
+    pub extra_channels: Vec<ChannelUpload>,
 }
 
 impl VolumeUpload {
     /// Brick edge of the majorant grid, in voxels.
     pub const BRICK: u32 = 8;
+
+    /// The fields in the medium (1–4).
+    pub fn channels(&self) -> u32 {
+        1 + self.extra_channels.len() as u32
+    }
+
+    /// The texture's texel format (see [`super::packing::components`]).
+    pub fn vk_format(&self) -> vk::Format {
+        self.format
+            .vk_components(super::packing::components(self.channels()))
+    }
+
+    /// Bytes of one texel.
+    pub fn texel_bytes(&self) -> usize {
+        self.format.bytes() * super::packing::components(self.channels()) as usize
+    }
 
     /// A loaded volume as a texture upload: world space is the volume centred at the
     /// origin with its longest side 1 unit; bricks of [`Self::BRICK`] voxels.
@@ -94,6 +139,7 @@ impl VolumeUpload {
                 min: grid.min,
                 max: grid.max,
             },
+            extra_channels: Vec::new(),
         }
     }
 }
@@ -121,6 +167,7 @@ impl VolumeUpload {
                 max,
             },
             blocks: Some(blocks),
+            extra_channels: Vec::new(),
         }
     }
 

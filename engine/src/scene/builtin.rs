@@ -326,6 +326,7 @@ pub(crate) fn build(name: &str) -> Result<Scene, SceneError> {
                 size: None,
             },
             density_scale: look.density_scale,
+            channels: None,
         },
         transfer,
         tf_a,
@@ -341,6 +342,8 @@ pub(crate) fn build(name: &str) -> Result<Scene, SceneError> {
         cut: Default::default(),
         frames: DEFAULT_FRAMES,
         animation,
+        channels: Vec::new(),
+        channel_views: Vec::new(),
     };
     scene.check(&ctx)?;
     Ok(scene)

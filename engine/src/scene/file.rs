@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use super::animation::AnimationFile;
 use super::camera::CameraSpec;
+use super::channel::{ChannelFile, ChannelSpec};
 use super::cut::{ClipPlane, CropBox, Cut};
 use super::error::{Ctx, SceneError};
 use super::light::LightFile;
@@ -40,6 +41,8 @@ struct SceneFile {
     clip: Vec<ClipPlane>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     crop: Option<CropBox>,
+    #[serde(default, rename = "channel", skip_serializing_if = "Vec::is_empty")]
+    channels: Vec<ChannelFile>,
     #[serde(default)]
     animation: AnimationFile,
 }
@@ -55,6 +58,7 @@ pub(crate) fn parse(text: &str, origin: &str, base: Option<&Path>) -> Result<Sce
     let volume = file.volume.into_spec(&ctx)?;
     let (transfer, tf_a, tf_b) = file.transfer.resolve(&ctx)?;
     let lights = LightFile::into_lights(file.lights, &ctx)?;
+    let channels = ChannelSpec::resolve(file.channels, &ctx)?;
     let (frames, animation) = file.animation.split();
     animation.check_unique_frames(&ctx)?;
     let scene = Scene {
@@ -72,6 +76,8 @@ pub(crate) fn parse(text: &str, origin: &str, base: Option<&Path>) -> Result<Sce
         },
         frames,
         animation,
+        channels,
+        channel_views: Vec::new(),
     };
     scene.check(&ctx)?;
     Ok(scene)
@@ -95,6 +101,7 @@ pub(crate) fn write(scene: &Scene) -> Result<String, SceneError> {
         render: scene.render,
         clip: scene.cut.planes.clone(),
         crop: scene.cut.crop,
+        channels: scene.channels.iter().map(|c| c.file.clone()).collect(),
         animation: AnimationFile::join(scene.frames, &scene.animation),
     };
     let body = toml::to_string(&file).map_err(|source| SceneError::Serialize {

@@ -38,6 +38,7 @@
 pub mod animation;
 pub mod builtin;
 pub mod camera;
+pub mod channel;
 pub mod cut;
 pub mod error;
 mod file;
@@ -58,6 +59,7 @@ pub use animation::{
     Animation, CameraKey, ClipKey, CropKey, Interpolation, LightKey, Orbit, TfKey, DEFAULT_FRAMES,
 };
 pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR, MAX_CAMERA_DISTANCE};
+pub use channel::{ChannelFile, ChannelSpec, ChannelView, MAX_CHANNELS};
 pub use cut::{ClipPlane, CropBox, CropUnits, Cut, MAX_CLIP_PLANES};
 pub use error::SceneError;
 pub use frame::{changed, Change, FrameState};
@@ -96,6 +98,12 @@ pub struct Scene {
     /// Number of frames in the scripted sequence (>= 1).
     pub frames: u32,
     pub animation: Animation,
+    /// The `[[channel]]` sections, in channel order.
+    pub channels: Vec<ChannelSpec>,
+    /// Every channel of a multi-channel medium as its views start (empty for one
+    /// field): filled when the scene meets its volume (`SceneSetup`), which knows the
+    /// channels' names, windows and colours.
+    pub channel_views: Vec<ChannelView>,
 }
 
 /// Longest scene name, in bytes (see [`Scene::check`]).

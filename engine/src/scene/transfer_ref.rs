@@ -44,7 +44,7 @@ impl TransferSpec {
     }
 }
 
-fn resolve_one(
+pub(crate) fn resolve_one(
     ctx: &Ctx,
     field: &str,
     spec: &str,

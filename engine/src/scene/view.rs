@@ -8,6 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::camera::CameraSpec;
+use super::channel::ChannelView;
 use super::cut::{ClipPlane, CropBox, Cut};
 use super::error::{Ctx, SceneError};
 use super::light::{check_lights, Light, LightFile};
@@ -61,6 +62,16 @@ pub struct View {
     pub tf: TfState,
     /// The clip planes and crop box.
     pub cut: Cut,
+    /// Each channel of a multi-channel medium (empty for one field).
+    pub channels: Vec<ChannelView>,
+}
+
+impl View {
+    /// The LUTs the renderer uploads: the TF state's, and with several channels every
+    /// channel's segment after it ([`super::channel::medium_lut`]).
+    pub fn lut(&self) -> TfLut {
+        super::channel::medium_lut(self.tf.lut(), &self.channels)
+    }
 }
 
 impl Scene {
@@ -79,6 +90,7 @@ impl Scene {
                 shift: state.tf_shift,
             },
             cut: self.cut_at(frame),
+            channels: self.channel_views.clone(),
         }
     }
 }

@@ -79,6 +79,9 @@ pub enum VolumeSource {
         path: PathBuf,
         raw: Option<RawLayout>,
     },
+    /// Several files, one channel each, resampled by their affines onto the first
+    /// file's grid (`files = [..]`); paths already joined.
+    Files { paths: Vec<PathBuf> },
 }
 
 /// The `[volume]` section, checked.
@@ -87,6 +90,9 @@ pub struct VolumeSpec {
     pub source: VolumeSource,
     /// Extinction per world unit at opacity 1 (`μt = opacity × density_scale`).
     pub density_scale: f64,
+    /// Which channels of the file (its C axis) or of `files`, in this order; `None`:
+    /// all of them.
+    pub channels: Option<Vec<usize>>,
 }
 
 impl VolumeSpec {
@@ -114,7 +120,20 @@ impl VolumeSpec {
                     path.display()
                 ),
             )),
-            VolumeSource::File { raw: None, .. } => Ok(()),
+            VolumeSource::File { raw: None, .. } => self.check_channels(ctx),
+            VolumeSource::Files { paths } => {
+                if paths.is_empty() {
+                    return Err(ctx.invalid("volume.files", "is empty; list one file per channel"));
+                }
+                for p in paths {
+                    if !p.exists() {
+                        return Err(
+                            ctx.invalid("volume.files", format!("{} does not exist", p.display()))
+                        );
+                    }
+                }
+                self.check_channels(ctx)
+            }
             VolumeSource::File { raw: Some(r), .. } => {
                 if r.dims.contains(&0) {
                     return Err(
@@ -134,9 +153,27 @@ impl VolumeSpec {
             }
         }
     }
+
+    fn check_channels(&self, ctx: &Ctx) -> Result<(), SceneError> {
+        match &self.channels {
+            Some(c) if c.is_empty() => Err(ctx.invalid(
+                "volume.channels",
+                "is empty; list the channels to show, e.g. [0, 2]",
+            )),
+            Some(c) if c.len() > super::channel::MAX_CHANNELS => Err(ctx.invalid(
+                "volume.channels",
+                format!(
+                    "{c:?} picks {} channels; a medium holds at most {}",
+                    c.len(),
+                    super::channel::MAX_CHANNELS
+                ),
+            )),
+            _ => Ok(()),
+        }
+    }
 }
 
-/// `[volume]` as written: either `builtin` (+ `size`) or `file` (+ raw layout).
+/// `[volume]` as written: either `builtin` (+ `size`), `file` (+ raw layout) or `files`.
 #[derive(Debug, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct VolumeFile {
@@ -146,6 +183,10 @@ pub(crate) struct VolumeFile {
     size: Option<u32>,
     #[serde(skip_serializing_if = "Option::is_none")]
     file: Option<PathBuf>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    files: Option<Vec<PathBuf>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    channels: Option<Vec<usize>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     dims: Option<[u32; 3]>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -164,6 +205,33 @@ impl VolumeFile {
     /// Structure only (builtin xor file, raw layout complete); values are checked by
     /// [`VolumeSpec::check`].
     pub fn into_spec(self, ctx: &Ctx) -> Result<VolumeSpec, SceneError> {
+        if let Some(paths) = self.files {
+            if self.builtin.is_some() || self.file.is_some() {
+                return Err(ctx.invalid(
+                    "volume",
+                    "give one of `builtin`, `file` or `files` (one channel per file)",
+                ));
+            }
+            if self.dims.is_some() || self.format.is_some() || self.size.is_some() {
+                return Err(ctx.invalid(
+                    "volume.files",
+                    "takes files that describe themselves (no raw layout, no size)",
+                ));
+            }
+            return Ok(VolumeSpec {
+                source: VolumeSource::Files {
+                    paths: paths.iter().map(|p| ctx.resolve(p)).collect(),
+                },
+                density_scale: self.density_scale,
+                channels: self.channels,
+            });
+        }
+        if self.channels.is_some() && self.file.is_none() {
+            return Err(ctx.invalid(
+                "volume.channels",
+                "picks channels of `file` or `files`; a built-in volume has one",
+            ));
+        }
         let source =
             match (self.builtin, self.file) {
                 (Some(_), Some(_)) => {
@@ -228,12 +296,14 @@ impl VolumeFile {
         Ok(VolumeSpec {
             source,
             density_scale: self.density_scale,
+            channels: self.channels,
         })
     }
 
     pub fn from_spec(v: &VolumeSpec) -> Self {
         let mut f = Self {
             density_scale: v.density_scale,
+            channels: v.channels.clone(),
             ..Self::default()
         };
         match &v.source {
@@ -249,6 +319,7 @@ impl VolumeFile {
                     f.spacing = Some(r.spacing);
                 }
             }
+            VolumeSource::Files { paths } => f.files = Some(paths.clone()),
         }
         f
     }

@@ -122,7 +122,7 @@ impl Session {
         let renderer = setup.renderer(Arc::clone(&ctx), &names)?;
         let view = setup.scene.view_at(0);
         Ok(Self {
-            lut: view.tf.lut(),
+            lut: view.lut(),
             orbit: OrbitCamera::from_spec(&view.camera),
             view_size: setup.config.size,
             view,
@@ -290,7 +290,7 @@ impl Session {
     /// leaving the current view as it is.
     pub fn reference_at(&mut self, frame: u32, spp: u32, batch: u32) -> Result<Vec<[f32; 4]>> {
         let view = self.setup.scene.view_at(frame);
-        let inputs = inputs_for_view(&view, self.view_size.aspect(), &view.tf.lut());
+        let inputs = inputs_for_view(&view, self.view_size.aspect(), &view.lut());
         Ok(self.renderer_mut()?.reference(&inputs, spp, batch)?)
     }
 
@@ -308,8 +308,8 @@ impl Session {
 
     fn set_tf(&mut self, tf: TfState) {
         if tf != self.view.tf {
-            self.lut = tf.lut();
             self.view.tf = tf;
+            self.lut = self.view.lut();
         }
     }
 

@@ -57,15 +57,15 @@ void crossing_features(Crossing c, vec3 o, vec3 d, float entry, vec3 cut_normal,
         float f = (threshold - c.prev_alpha) / max(c.alpha - c.prev_alpha, 1e-6);
         float th = c.t_hit - step_len * (1.0 - clamp(f, 0.0, 1.0));
         vec3 ph = o + d * th;
-        float density = density_at(ph);
-        vec3 g = density_gradient(ph);
+        MediumPoint m = medium_point(ph);
+        vec3 g = medium_gradient(m);
         vec3 n = length(g) > 1e-6 ? -normalize(g) : -d;
         bool cut_entry = any(notEqual(cut_normal, vec3(0.0)));
         if (cut_entry && th - entry < CUT_FACE_STEPS * step_len) n = cut_normal;
         if (dot(n, d) > 0.0) n = -n;
         pos = vec4(ph, 1.0);
         nrm = vec4(n, th);
-        alb = vec4(tf_albedo_opacity(density).rgb, 1.0);
+        alb = vec4(m.albedo_opacity.rgb, 1.0);
     } else if (c.alpha >= MIN_VISIBLE_OPACITY) {
         pos = vec4(o + d * (c.mean_t / c.alpha), 1.0);
     }

@@ -37,25 +37,27 @@ vec3 trace_path(vec3 o, vec3 d, inout Rng rng, out float first_t) {
         }
         vec3 p = o + d * t;
         if (bounce == 0) first_t = t;
-        float density = density_at(p);
-        vec4 ao = tf_albedo_opacity(density);
+        MediumPoint m = medium_point(p);
+        vec4 ao = m.albedo_opacity;
         vec3 albedo = ao.rgb;
-        if (USE_EMISSION) result += throughput * tf_emission(density);
+        if (USE_EMISSION) result += throughput * medium_emission(m);
 
         // Scattering model at this vertex.
         bool surface = false;
         vec3 n = vec3(0.0);
         vec4 spec = vec4(0.0);
         if (PHASE == PHASE_HYBRID) {
-            vec3 g = density_gradient(p);
+            vec3 g = medium_gradient(m);
             float gm = length(g);
-            // Exposure Render: P_brdf grows with opacity and normalised gradient magnitude.
-            float p_brdf = ao.a * (1.0 - exp(-gm * 25.0));
+            // Exposure Render: P_brdf grows with opacity and normalised gradient magnitude
+            // (several channels' opacities sum, and may pass 1).
+            float opacity = CHANNELS > 1 ? min(ao.a, 1.0) : ao.a;
+            float p_brdf = opacity * (1.0 - exp(-gm * 25.0));
             if (gm > 1e-5 && rng_next(rng) < p_brdf) {
                 surface = true;
                 n = -g / gm;
                 if (dot(n, d) > 0.0) n = -n;
-                spec = tf_specular(density);
+                spec = medium_specular(m);
             }
         }
 

@@ -17,5 +17,8 @@ layout(constant_id = 3) const bool HAS_ENV_MAP = false;
 // uniform: a branch on a uniform in every density lookup made the dense path's path
 // tracer and temporal gradients twice as slow on lavapipe.
 layout(constant_id = 4) const bool POOLED_VOLUME = false;
+// Fields in the medium (1–4), packed as the volume texture's components; channel c's TF
+// is the c-th segment of each LUT. One channel compiles today's single-field code.
+layout(constant_id = 5) const int CHANNELS = 1;
 
 #endif

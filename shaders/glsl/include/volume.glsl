@@ -69,8 +69,43 @@ vec4 tf_albedo_opacity(float d) { return texture(tf_diffuse_opacity, lut_coord(d
 vec4 tf_specular(float d) { return texture(tf_specular_roughness, lut_coord(d)); }
 vec3 tf_emission(float d) { return texture(tf_emissive, lut_coord(d)).rgb; }
 
-// Extinction coefficient at p (per world unit).
+// Every channel's density at p (the volume's components; dense volumes only: a
+// multi-channel medium is never paged).
+vec4 densities_at(vec3 p) { return texture(volume_density, to_uvw(p)); }
+
+// Channel c's LUTs: the c-th of CHANNELS equal segments, texel centres as lut_coord.
+float channel_lut_coord(float d, int c) {
+    float n = float(textureSize(tf_diffuse_opacity, 0) / CHANNELS);
+    return (float(c) * n + clamp(d, 0.0, 1.0) * (n - 1.0) + 0.5) / (n * float(CHANNELS));
+}
+
+// The medium's albedo (the channels' albedos weighted by their shares of the extinction)
+// and opacity (their sum), with each channel's share.
+vec4 medium_albedo_opacity(vec4 dens, out vec4 share) {
+    vec3 albedo = vec3(0.0);
+    float opacity = 0.0;
+    share = vec4(0.0);
+    for (int c = 0; c < CHANNELS; ++c) {
+        vec4 t = texture(tf_diffuse_opacity, channel_lut_coord(dens[c], c));
+        share[c] = t.a;
+        albedo += t.a * t.rgb;
+        opacity += t.a;
+    }
+    float inv = opacity > 0.0 ? 1.0 / opacity : 0.0;
+    share *= inv;
+    return vec4(albedo * inv, opacity);
+}
+
+// Extinction coefficient at p (per world unit): with several channels, the sum of theirs.
 float extinction_at(vec3 p) {
+    if (CHANNELS > 1) {
+        vec4 dens = densities_at(p);
+        float opacity = 0.0;
+        for (int c = 0; c < CHANNELS; ++c) {
+            opacity += texture(tf_diffuse_opacity, channel_lut_coord(dens[c], c)).a;
+        }
+        return opacity * frame.box_min.w;
+    }
     return tf_albedo_opacity(density_at(p)).a * frame.box_min.w;
 }
 
@@ -91,6 +126,67 @@ vec3 density_gradient(vec3 p) {
         density_at(p + vec3(h.x, 0, 0)) - density_at(p - vec3(h.x, 0, 0)),
         density_at(p + vec3(0, h.y, 0)) - density_at(p - vec3(0, h.y, 0)),
         density_at(p + vec3(0, 0, h.z)) - density_at(p - vec3(0, 0, h.z)));
+}
+
+// A point of the medium where something happens (a collision, a features crossing): its
+// density and TF values, one channel's or the channels' mix (see medium_albedo_opacity).
+struct MediumPoint {
+    vec3 p;
+    float density;        // one channel
+    vec4 dens;            // several: each channel's density
+    vec4 share;           // several: each channel's share of the extinction
+    vec4 albedo_opacity;  // albedo, opacity (several: the sum, which may pass 1)
+};
+
+MediumPoint medium_point(vec3 p) {
+    MediumPoint m;
+    m.p = p;
+    m.density = 0.0;
+    m.dens = vec4(0.0);
+    m.share = vec4(0.0);
+    if (CHANNELS > 1) {
+        m.dens = densities_at(p);
+        m.albedo_opacity = medium_albedo_opacity(m.dens, m.share);
+    } else {
+        m.density = density_at(p);
+        m.albedo_opacity = tf_albedo_opacity(m.density);
+    }
+    return m;
+}
+
+vec3 medium_emission(MediumPoint m) {
+    if (CHANNELS > 1) {
+        vec3 e = vec3(0.0);
+        for (int c = 0; c < CHANNELS; ++c) {
+            e += m.share[c] * texture(tf_emissive, channel_lut_coord(m.dens[c], c)).rgb;
+        }
+        return e;
+    }
+    return tf_emission(m.density);
+}
+
+vec4 medium_specular(MediumPoint m) {
+    if (CHANNELS > 1) {
+        vec4 s = vec4(0.0);
+        for (int c = 0; c < CHANNELS; ++c) {
+            s += m.share[c] * texture(tf_specular_roughness, channel_lut_coord(m.dens[c], c));
+        }
+        return s;
+    }
+    return tf_specular(m.density);
+}
+
+// The density gradient (density per voxel); with several channels, the channels'
+// gradients weighted by their shares of the extinction at the point.
+vec3 medium_gradient(MediumPoint m) {
+    if (CHANNELS > 1) {
+        vec3 h = box_size() / vec3(frame.dims.xyz);
+        vec4 gx = densities_at(m.p + vec3(h.x, 0, 0)) - densities_at(m.p - vec3(h.x, 0, 0));
+        vec4 gy = densities_at(m.p + vec3(0, h.y, 0)) - densities_at(m.p - vec3(0, h.y, 0));
+        vec4 gz = densities_at(m.p + vec3(0, 0, h.z)) - densities_at(m.p - vec3(0, 0, h.z));
+        return 0.5 * vec3(dot(m.share, gx), dot(m.share, gy), dot(m.share, gz));
+    }
+    return density_gradient(m.p);
 }
 
 // The interval of the ray o + t d (t >= 0) inside what the cut keeps: the crop box (the
