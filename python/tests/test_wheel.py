@@ -56,9 +56,10 @@ def test_the_wheel_carries_its_assets_and_stays_small():
     # Only the three folders the engine reads, not assets/ whole (results, gallery, scenes).
     assert not [n for n in names if n.startswith("dvr/assets/") and n.split("/")[2] not in ("transfer", "volumes", "rae")]
     assert wheel.stat().st_size < 60 << 20
-    # python/dvr/assets links file by file: a new preset or network needs its link.
+    # python/dvr/assets links file by file: a new preset or network needs its link, and a
+    # volume stored as a folder (OME-Zarr) a link per file inside it.
     shipped = {f"dvr/assets/{p.relative_to(ROOT / 'assets')}" for d in ("transfer", "rae", "volumes")
-               for p in (ROOT / "assets" / d).iterdir() if p.name != "README.md"}
+               for p in (ROOT / "assets" / d).rglob("*") if p.is_file() and p.name != "README.md"}
     assert not shipped - set(names), f"not linked under python/dvr/assets: {sorted(shipped - set(names))}"
 
 
