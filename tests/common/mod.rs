@@ -154,6 +154,7 @@ pub fn inputs(camera: CameraMatrices, lights: Vec<GpuLight>, lut: LutUpload) -> 
         lights,
         lut,
         cut: Default::default(),
+        time: None,
     }
 }
 

@@ -53,6 +53,23 @@ pub struct FrameInputs {
     pub lut: LutUpload,
     /// The clip planes and crop box.
     pub cut: Cut,
+    /// The time point of a series this frame shows (`None`: the volume as set up).
+    pub time: Option<SeriesTime>,
+}
+
+/// A time point of a series: the renderer uploads the volume it names when it differs
+/// from the one on the device.
+#[derive(Clone, Debug)]
+pub struct SeriesTime {
+    pub timeline: std::sync::Arc<super::timeline::Timeline>,
+    /// Fractional: the two time points around it interpolated.
+    pub time: f64,
+}
+
+impl PartialEq for SeriesTime {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.timeline, &other.timeline) && self.time == other.time
+    }
 }
 
 /// What one frame should produce.

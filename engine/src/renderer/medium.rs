@@ -12,8 +12,9 @@ pub struct Channels {
     pub series: Series,
 }
 
-/// The scene's channels when its volume has several (or the scene picks some):
-/// `None` for one field, which loads as a single volume.
+/// The scene's channels at time point 0 when its volume has several channels or time
+/// points (or the scene picks channels): `None` for one field at one time, which loads
+/// as a single volume.
 pub fn load_channels(scene: &Scene) -> Result<Option<Channels>, VolumeError> {
     let picked = scene.volume.channels.as_deref();
     let series = match &scene.volume.source {
@@ -21,7 +22,8 @@ pub fn load_channels(scene: &Scene) -> Result<Option<Channels>, VolumeError> {
         VolumeSource::Files { paths } => Series::open_channels(paths, picked)?,
         VolumeSource::File { path, raw: None } => {
             let series = Series::open(path, picked)?;
-            if picked.is_none() && series.info().channels.len() == 1 {
+            let info = series.info();
+            if picked.is_none() && info.channels.len() == 1 && info.times == 1 {
                 return Ok(None);
             }
             series

@@ -13,9 +13,12 @@ pub mod scene_gpu;
 pub mod scene_setup;
 mod submit;
 mod tf_upload;
+pub mod timeline;
 pub mod uploads;
 
-pub use inputs::{CameraMatrices, FrameInputs, FrameRequest, FrameResult, FEATURE_IMAGES};
+pub use inputs::{
+    CameraMatrices, FrameInputs, FrameRequest, FrameResult, SeriesTime, FEATURE_IMAGES,
+};
 pub use reference::{samples_per_dispatch, MAX_SAMPLES_PER_DISPATCH, PIXEL_SAMPLES_PER_DISPATCH};
 use submit::{add_readbacks, read_pixels, submit, Slot};
 
@@ -642,7 +645,8 @@ impl Renderer {
             Some(last) => Changes {
                 camera: reset || last.camera != inputs.camera,
                 lights: reset || last.lights != inputs.lights,
-                transfer_function: reset || last.lut != inputs.lut,
+                // A new time point changes the medium in place, as a TF edit does.
+                transfer_function: reset || last.lut != inputs.lut || last.time != inputs.time,
                 cut: reset || last.cut != inputs.cut,
             },
         }

@@ -4,8 +4,9 @@
 //! as GPU structs and the transfer function as LUTs, from a [`View`]. The CLI, the explorer and the tests
 //! all go through here.
 
+use super::timeline::Timeline;
 use super::uploads::{EnvironmentUpload, LutUpload, VolumeUpload};
-use super::{CameraMatrices, FrameInputs, Renderer, RendererConfig};
+use super::{CameraMatrices, FrameInputs, Renderer, RendererConfig, SeriesTime};
 use crate::error::{EngineError, Result as EngineResult};
 use crate::gpu::GpuContext;
 use crate::graph::Extent;
@@ -43,6 +44,8 @@ pub struct SceneSetup {
     pub config: RendererConfig,
     pub volume: Arc<VolumeUpload>,
     pub environment: Option<Arc<EnvironmentUpload>>,
+    /// The series' time points, when the volume has more than one.
+    pub timeline: Option<Arc<Timeline>>,
 }
 
 impl SceneSetup {
@@ -55,7 +58,7 @@ impl SceneSetup {
         volume_size: u32,
     ) -> Result<Self, SetupError> {
         if let Some(channels) = super::medium::load_channels(&scene)? {
-            return Self::with_channels(scene, &channels, size, spp);
+            return Self::with_channels(scene, channels, size, spp);
         }
         let upload = match on_demand(&scene, volume_size) {
             Some(v) => VolumeUpload::on_demand(v.name, v.blocks),
@@ -68,17 +71,31 @@ impl SceneSetup {
     /// channel's view from its section and the file (see [`super::medium`]).
     pub fn with_channels(
         mut scene: Scene,
-        channels: &super::medium::Channels,
+        channels: super::medium::Channels,
         size: Extent,
         spp: Option<u32>,
     ) -> Result<Self, SetupError> {
+        let times = channels.series.info().times;
+        for (i, k) in scene.animation.time.iter().enumerate() {
+            if k.time > (times - 1) as f64 {
+                return Err(SetupError::Invalid {
+                    scene: scene.name.clone(),
+                    problem: format!(
+                        "animation.time[{i}].time = {} is past the series' last time point {} ({times} in all)",
+                        k.time,
+                        times - 1
+                    ),
+                });
+            }
+        }
         let upload = VolumeUpload::from_channels(&channels.volumes).map_err(|problem| {
             SetupError::Invalid {
                 scene: scene.name.clone(),
                 problem,
             }
         })?;
-        let views = super::medium::channel_views(&scene, channels);
+        let views = super::medium::channel_views(&scene, &channels);
+        let one_channel_kept = views.len() == 1 && scene.channels.is_empty();
         if let Some(c0) = views.first() {
             // Channel 0's TF is the scene's `transfer.a`, over the channel's window
             // (in density now, so the data-unit mapping of `with_upload` keeps it).
@@ -87,8 +104,24 @@ impl SceneSetup {
                 .tf_b
                 .map(|b| crate::scene::channel::over_window(&b, c0.window, c0.data_window));
         }
-        scene.channel_views = views;
-        Self::with_upload(scene, upload, size, spp)
+        // One channel with no section of its own shows as a one-field volume does.
+        if !one_channel_kept {
+            scene.channel_views = views;
+        }
+        let mut setup = Self::with_upload(scene, upload, size, spp)?;
+        if times > 1 {
+            let first = setup.volume.clone();
+            setup.timeline = Some(Arc::new(Timeline::new(channels.series, first)));
+        }
+        Ok(setup)
+    }
+
+    /// A time point of the series (`None` for a volume of one time point).
+    pub fn series_time(&self, time: f64) -> Option<SeriesTime> {
+        self.timeline.as_ref().map(|timeline| SeriesTime {
+            timeline: timeline.clone(),
+            time,
+        })
     }
 
     /// [`SceneSetup::new`] with the volume already loaded (the explorer also draws its
@@ -124,6 +157,7 @@ impl SceneSetup {
             config,
             environment,
             scene,
+            timeline: None,
         })
     }
 
@@ -150,7 +184,10 @@ impl SceneSetup {
     /// takes too.
     pub fn frame_inputs(&self, f: u32) -> FrameInputs {
         let view = self.scene.view_at(f);
-        inputs_for_view(&view, self.config.size.aspect(), &view.lut())
+        FrameInputs {
+            time: self.series_time(view.time),
+            ..inputs_for_view(&view, self.config.size.aspect(), &view.lut())
+        }
     }
 }
 
@@ -172,6 +209,7 @@ pub fn inputs_for(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -
         lights: lights.iter().map(gpu_light).collect(),
         lut: LutUpload::from(lut),
         cut: Default::default(),
+        time: None,
     }
 }
 

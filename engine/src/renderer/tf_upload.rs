@@ -4,10 +4,12 @@
 
 use super::brick_pool::{self, VolumeResidency};
 use super::scene_gpu;
+use super::uploads::VolumeUpload;
 use super::FrameInputs;
 use super::Renderer;
 use crate::error::{EngineError, Result};
 use crate::graph::Frame;
+use std::sync::Arc;
 
 impl Renderer {
     /// Adds uploads of the TF LUTs and the majorant grid when the TF or the cut differs
@@ -23,6 +25,12 @@ impl Renderer {
         inputs: &FrameInputs,
         stream: bool,
     ) -> Result<f32> {
+        if let Some(t) = &inputs.time {
+            let volume = t.timeline.at(t.time)?;
+            if !Arc::ptr_eq(&volume, &self.volume) {
+                self.replace_volume(frame, slot, volume)?;
+            }
+        }
         let (lut, cut) = (&inputs.lut, &inputs.cut);
         let channels = self.volume.channels() as usize;
         let n = self.lut_size as usize;
@@ -98,6 +106,53 @@ impl Renderer {
             log::info!("{}", self.volume_residency());
         }
         Ok(self.majorant_max)
+    }
+
+    /// Uploads `volume` (another time point of the series on the device: one grid,
+    /// format and channel count) into the volume texture in `frame`, and has the
+    /// majorants made again from its brick ranges.
+    fn replace_volume(
+        &mut self,
+        frame: &mut Frame,
+        slot: usize,
+        volume: Arc<VolumeUpload>,
+    ) -> Result<()> {
+        let old = &self.volume;
+        if self.residency.is_some()
+            || volume.dims != old.dims
+            || volume.format != old.format
+            || volume.channels() != old.channels()
+        {
+            return Err(EngineError::Resource {
+                resource: format!("volume {:?}", volume.name),
+                problem: format!(
+                    "a time point of {:?} voxels, {:?} x {} channel(s) cannot replace {:?} x {:?} x {} held {}",
+                    volume.dims,
+                    volume.format,
+                    volume.channels(),
+                    old.dims,
+                    old.format,
+                    old.channels(),
+                    if self.residency.is_some() { "in the brick pool (a series is held dense)" } else { "dense" }
+                ),
+            });
+        }
+        let (ctx, graph) = (&self.ctx, &mut self.graph);
+        let image = self.scene.volume;
+        scene_gpu::add_frame_upload(
+            ctx,
+            graph,
+            frame,
+            "upload_volume",
+            slot,
+            image,
+            &volume.bytes,
+        )?;
+        self.bricks = volume.bricks.clone();
+        self.volume = volume;
+        // The majorants follow the new bricks' ranges.
+        self.current_lut = None;
+        Ok(())
     }
 
     /// On the pool path: uploads pending bricks into their slots (at most one frame's

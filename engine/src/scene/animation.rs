@@ -106,6 +106,17 @@ pub struct TfKey {
     pub interpolation: Interpolation,
 }
 
+/// `[[animation.time]]`: the time point a series shows at `frame` (fractional times
+/// interpolate the two time points around them; frame 0 shows time 0 unless a key says).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeKey {
+    pub frame: u32,
+    pub time: f64,
+    #[serde(default, skip_serializing_if = "Interpolation::is_linear")]
+    pub interpolation: Interpolation,
+}
+
 /// `[[animation.clip]]`: sets any of point, normal, enabled of plane `index` at `frame`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -197,6 +208,8 @@ pub struct Animation {
     pub clip: Vec<ClipKey>,
     /// `[[animation.crop]]`: keyframes of the crop box.
     pub crop: Vec<CropKey>,
+    /// `[[animation.time]]`: keyframes of a series' time point.
+    pub time: Vec<TimeKey>,
 }
 
 /// `[animation]` as written.
@@ -217,6 +230,8 @@ pub(crate) struct AnimationFile {
     clip: Vec<ClipKey>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     crop: Vec<CropKey>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    time: Vec<TimeKey>,
 }
 
 fn default_frames() -> u32 {
@@ -233,6 +248,7 @@ impl Default for AnimationFile {
             tf: Vec::new(),
             clip: Vec::new(),
             crop: Vec::new(),
+            time: Vec::new(),
         }
     }
 }
@@ -246,6 +262,7 @@ impl AnimationFile {
             tf: self.tf,
             clip: self.clip,
             crop: self.crop,
+            time: self.time,
         };
         (self.frames, a)
     }
@@ -258,6 +275,7 @@ impl AnimationFile {
             light: a.light.clone(),
             tf: a.tf.clone(),
             clip: a.clip.clone(),
+            time: a.time.clone(),
             crop: a.crop.clone(),
         }
     }
@@ -285,6 +303,7 @@ impl Animation {
         a.tf.iter_mut().for_each(|k| k.frame = f(k.frame));
         a.clip.iter_mut().for_each(|k| k.frame = f(k.frame));
         a.crop.iter_mut().for_each(|k| k.frame = f(k.frame));
+        a.time.iter_mut().for_each(|k| k.frame = f(k.frame));
         a
     }
 
@@ -324,6 +343,20 @@ impl Animation {
             };
             if let Some(i) = self.tf[..j].iter().position(same) {
                 return duplicate("tf", i, j, k.frame);
+            }
+        }
+        for (j, k) in self.time.iter().enumerate() {
+            if let Some(i) = self.time[..j].iter().position(|o| o.frame == k.frame) {
+                return duplicate("time", i, j, k.frame);
+            }
+            if !(k.time.is_finite() && k.time >= 0.0) {
+                return Err(ctx.invalid(
+                    format!("animation.time[{j}].time"),
+                    format!(
+                        "{} must be a time point >= 0 (fractional times interpolate)",
+                        k.time
+                    ),
+                ));
             }
         }
         for (j, k) in self.clip.iter().enumerate() {

@@ -39,6 +39,8 @@ pub struct FrameState {
     pub tf_blend: f32,
     /// How far that TF slides along the density axis (`TfLut::shifted`).
     pub tf_shift: f32,
+    /// The time point a series shows (fractional: between two); 0 without keys.
+    pub time: f64,
 }
 
 /// What differs between two frame states.
@@ -46,6 +48,7 @@ pub struct FrameState {
 pub struct Change {
     pub camera: bool,
     pub lights: bool,
+    /// The TF or the time point (the medium changes in place).
     pub tf: bool,
 }
 
@@ -62,7 +65,7 @@ pub fn changed(a: &FrameState, b: &FrameState) -> Change {
     Change {
         camera: a.camera != b.camera,
         lights: a.lights != b.lights,
-        tf: a.tf_blend != b.tf_blend || a.tf_shift != b.tf_shift,
+        tf: a.tf_blend != b.tf_blend || a.tf_shift != b.tf_shift || a.time != b.time,
     }
 }
 
@@ -119,7 +122,18 @@ impl Scene {
                 f,
             )
             .clamp(-1.0, 1.0) as f32,
+            time: self.time_at(f),
         }
+    }
+
+    /// The time point the scene shows at `frame` (its `[[animation.time]]` keys).
+    pub fn time_at(&self, frame: u32) -> f64 {
+        let keys = self
+            .animation
+            .time
+            .iter()
+            .map(|k| (k.frame, k.interpolation, k.time));
+        track(0.0, keys, self.clamp_frame(frame)).max(0.0)
     }
 
     /// The clip planes and crop box at `frame`, after their keyframes.

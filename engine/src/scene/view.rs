@@ -64,6 +64,8 @@ pub struct View {
     pub cut: Cut,
     /// Each channel of a multi-channel medium (empty for one field).
     pub channels: Vec<ChannelView>,
+    /// The time point of a series (fractional: the two around it interpolated).
+    pub time: f64,
 }
 
 impl View {
@@ -91,6 +93,7 @@ impl Scene {
             },
             cut: self.cut_at(frame),
             channels: self.channel_views.clone(),
+            time: self.time_at(frame),
         }
     }
 }

@@ -26,12 +26,14 @@ use crate::error::EngineError;
 use crate::gpu::GpuContext;
 use crate::graph::Extent;
 use crate::renderer::scene_setup::{inputs_for_view, load_environment, SceneSetup, SetupError};
-use crate::renderer::{FrameRequest, FrameResult, PresentTarget, Renderer, SettingsChange};
+use crate::renderer::{
+    FrameInputs, FrameRequest, FrameResult, PresentTarget, Renderer, SettingsChange,
+};
 use crate::scene::view::{check_camera_spec, check_cut, check_light_list, check_render};
 use crate::scene::{
     CameraSpec, Cut, EnvSource, Light, RenderSettings, Scene, SceneError, TfState, View,
 };
-use crate::transfer::TfLut;
+use crate::transfer::{TfLut, TransferFunction};
 use std::path::PathBuf;
 use std::sync::Arc;
 use thiserror::Error;
@@ -87,6 +89,22 @@ pub enum Edit {
     Denoisers(Vec<String>),
     /// Restart every history on the next frame (a cut).
     Restart,
+    /// The time point of a series (fractional: the two around it interpolated).
+    Time(f64),
+    /// One channel of a multi-channel medium: what is given changes (the renderer
+    /// re-traces ours' gradients under it, as for a TF edit).
+    Channel(ChannelEdit),
+}
+
+/// A change to channel `index`: its TF (over its window, or in data units), its window,
+/// colour or visibility.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ChannelEdit {
+    pub index: usize,
+    pub tf: Option<TransferFunction>,
+    pub window: Option<[f32; 2]>,
+    pub colour: Option<[f32; 3]>,
+    pub visible: Option<bool>,
 }
 
 /// A view of one volume, edited between frames; see the module docs.
@@ -232,6 +250,20 @@ impl Session {
                 return Ok(done);
             }
             Edit::Restart => self.restart = true,
+            Edit::Time(time) => {
+                let times = self.setup.timeline.as_ref().map_or(1, |t| t.times());
+                if !(time.is_finite() && time >= 0.0 && time <= (times - 1) as f64) {
+                    return Err(invalid_edit(
+                        "time",
+                        format!(
+                            "{time} is outside the time points 0 to {} ({times} in all)",
+                            times - 1
+                        ),
+                    ));
+                }
+                self.view.time = time;
+            }
+            Edit::Channel(edit) => self.edit_channel(edit)?,
         }
         Ok(Vec::new())
     }
@@ -243,6 +275,7 @@ impl Session {
         self.orbit.set_spec(&view.camera);
         self.view.camera = view.camera;
         self.view.cut = view.cut;
+        self.view.time = view.time;
         self.set_tf(view.tf);
         // The scene's lights were checked with the scene, every frame's values too.
         self.set_lights(view.lights)
@@ -265,7 +298,7 @@ impl Session {
         request: &FrameRequest,
         present: Option<&PresentTarget<'_>>,
     ) -> Result<Option<FrameResult>> {
-        let inputs = inputs_for_view(&self.view, self.view_size.aspect(), &self.lut);
+        let inputs = self.inputs();
         let mut request = request.clone();
         request.reset |= std::mem::take(&mut self.restart);
         let done = self
@@ -282,7 +315,7 @@ impl Session {
 
     /// A high-sample reference of the current view (see [`Renderer::reference`]).
     pub fn reference(&mut self, spp: u32, batch: u32) -> Result<Vec<[f32; 4]>> {
-        let inputs = inputs_for_view(&self.view, self.view_size.aspect(), &self.lut);
+        let inputs = self.inputs();
         Ok(self.renderer_mut()?.reference(&inputs, spp, batch)?)
     }
 
@@ -290,8 +323,19 @@ impl Session {
     /// leaving the current view as it is.
     pub fn reference_at(&mut self, frame: u32, spp: u32, batch: u32) -> Result<Vec<[f32; 4]>> {
         let view = self.setup.scene.view_at(frame);
-        let inputs = inputs_for_view(&view, self.view_size.aspect(), &view.lut());
+        let inputs = FrameInputs {
+            time: self.setup.series_time(view.time),
+            ..inputs_for_view(&view, self.view_size.aspect(), &view.lut())
+        };
         Ok(self.renderer_mut()?.reference(&inputs, spp, batch)?)
+    }
+
+    /// The renderer's inputs for the current view.
+    fn inputs(&self) -> FrameInputs {
+        FrameInputs {
+            time: self.setup.series_time(self.view.time),
+            ..inputs_for_view(&self.view, self.view_size.aspect(), &self.lut)
+        }
     }
 
     /// A camera move through the orbit camera; refused (and undone) when it would put
@@ -303,6 +347,61 @@ impl Session {
         check_camera_spec(&spec, EDIT_ORIGIN)?;
         self.orbit = moved;
         self.view.camera = spec;
+        Ok(())
+    }
+
+    fn edit_channel(&mut self, edit: ChannelEdit) -> Result<()> {
+        let count = self.view.channels.len();
+        let Some(mut c) = self.view.channels.get(edit.index).cloned() else {
+            return Err(invalid_edit(
+                "channel",
+                format!(
+                    "channel {} does not exist; the volume has {} channel(s) (0 to {})",
+                    edit.index,
+                    count.max(1),
+                    count.max(1) - 1
+                ),
+            ));
+        };
+        let field = |f: &str| format!("channel[{}].{f}", edit.index);
+        if let Some(tf) = edit.tf {
+            tf.validate().map_err(|e| tf_error(&field("tf"), e))?;
+            c.tf = tf;
+        }
+        if let Some([lo, hi]) = edit.window {
+            if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+                return Err(invalid_edit(
+                    &field("window"),
+                    format!("[{lo}, {hi}] must be finite, low < high"),
+                ));
+            }
+            c.window = [lo, hi];
+        }
+        if let Some(colour) = edit.colour {
+            if !colour
+                .iter()
+                .all(|x| x.is_finite() && (0.0..=1.0).contains(x))
+            {
+                return Err(invalid_edit(
+                    &field("colour"),
+                    format!("{colour:?} must be in [0, 1]"),
+                ));
+            }
+            c.colour = colour;
+        }
+        if let Some(v) = edit.visible {
+            c.visible = v;
+        }
+        let tf0 = (edit.index == 0).then(|| c.density_tf());
+        self.view.channels[edit.index] = c;
+        match tf0 {
+            // Channel 0's TF is the view's TF.
+            Some(tf) => {
+                self.view.tf = TfState::single(tf);
+                self.lut = self.view.lut();
+            }
+            None => self.lut = self.view.lut(),
+        }
         Ok(())
     }
 
@@ -427,4 +526,12 @@ fn tf_error(field: &str, source: crate::transfer::TransferError) -> SessionError
 
 fn no_renderer() -> SessionError {
     SessionError::NoRenderer("an earlier settings change left none".into())
+}
+
+fn invalid_edit(field: &str, message: String) -> SessionError {
+    SessionError::Invalid(SceneError::Invalid {
+        origin: EDIT_ORIGIN.into(),
+        field: field.into(),
+        message,
+    })
 }

@@ -266,7 +266,7 @@ fn resample(path: &Path, v: Volume, t: PatientTransform) -> Result<Volume, Volum
                     lo[1] + f64::from(j) * vox[1],
                     lo[2] + f64::from(k) * vox[2],
                 ];
-                out.push(trilinear(&v, inverse(p)));
+                out.push(trilinear(&v, inverse(p)).unwrap_or(0.0));
             }
         }
     }
@@ -297,17 +297,24 @@ fn resample(path: &Path, v: Volume, t: PatientTransform) -> Result<Volume, Volum
 
 /// `v` resampled (trilinear, in patient space) onto the grid of `dims` voxels placed by
 /// `onto`: how a channel from another file lands on a series' first file's grid (a 3 mm
-/// statistical map on a 1 mm T1). Points outside `v`'s voxel centres are empty (0); the
-/// samples keep `v`'s type and window.
+/// statistical map on a 1 mm T1). Points outside `v`'s voxel centres hold the data value
+/// 0 (nilearn's `resample_to_img` fill: a z map's "no effect", not its most negative
+/// value), as far as the window reaches it; the samples keep `v`'s type and window.
 pub(crate) fn resample_onto(v: &Volume, dims: [u32; 3], onto: &PatientTransform) -> Volume {
     let inverse = invert(v.to_patient);
+    let [lo, hi] = v.window;
+    let fill = if hi > lo {
+        (-lo / (hi - lo)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let n = crate::voxel_count(dims) as usize;
     let mut out = Vec::with_capacity(n);
     for k in 0..dims[2] {
         for j in 0..dims[1] {
             for i in 0..dims[0] {
                 let p = onto.apply([f64::from(i), f64::from(j), f64::from(k)]);
-                out.push(trilinear(v, inverse(p)));
+                out.push(trilinear(v, inverse(p)).unwrap_or(fill));
             }
         }
     }
@@ -351,12 +358,12 @@ fn invert(t: PatientTransform) -> impl Fn([f64; 3]) -> [f64; 3] {
     }
 }
 
-/// Trilinear density at a fractional index; 0 outside the voxel centres' box.
-fn trilinear(v: &Volume, p: [f64; 3]) -> f32 {
+/// Trilinear density at a fractional index; `None` outside the voxel centres' box.
+fn trilinear(v: &Volume, p: [f64; 3]) -> Option<f32> {
     let d = v.dims.map(|x| x as f64);
     let eps = 1e-6;
     if (0..3).any(|a| p[a] < -eps || p[a] > d[a] - 1.0 + eps) {
-        return 0.0;
+        return None;
     }
     let base = [0, 1, 2].map(|a| (p[a].max(0.0).floor() as u32).min(v.dims[a] - 1));
     let frac = [0, 1, 2].map(|a| (p[a] - f64::from(base[a])).clamp(0.0, 1.0));
@@ -377,7 +384,7 @@ fn trilinear(v: &Volume, p: [f64; 3]) -> f32 {
             acc += w * f64::from(v.value(idx[0], idx[1], idx[2]).unwrap_or(0.0));
         }
     }
-    acc as f32
+    Some(acc as f32)
 }
 
 #[cfg(test)]
