@@ -6,6 +6,7 @@ import warnings
 import numpy as np
 
 from . import _native
+from .channels import Channel
 from .live import CameraView, ClipsView, CropView, LightsView, SettingsView, _as_dict, _plain
 from .scene import Scene, TransferFunction
 
@@ -169,6 +170,28 @@ class Renderer:
     @tf.setter
     def tf(self, tf):
         self._r.set_tf(TransferFunction.coerce(tf).to_dict())
+
+    @property
+    def time(self) -> float:
+        """The time point of a series shown (fractional: the two around it interpolated,
+        so playback can be smooth and slow); 0 for a volume of one time point. Assigning
+        it is an edit the next render follows (``ValueError`` names the range)."""
+        return self._r.time()[0]
+
+    @time.setter
+    def time(self, t):
+        self._r.set_time(float(t))
+
+    @property
+    def times(self) -> int:
+        """How many time points the volume has."""
+        return self._r.time()[1]
+
+    @property
+    def channels(self) -> list:
+        """The channels of a multi-channel medium (empty for one field), each a live
+        :class:`~dvr.channels.Channel`: ``r.channels[1].visible = False``."""
+        return [Channel(self._r, i) for i in range(len(self._r.channels()))]
 
     @property
     def denoisers(self) -> tuple:

@@ -12,10 +12,11 @@ use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::gpu::{ContextOptions, GpuContext};
 use dvr_engine::graph::Extent;
 use dvr_engine::passes::aux_features::{ALBEDO, NORMAL};
+use dvr_engine::renderer::medium::load_channels;
 use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup, DEFAULT_VOLUME_SIZE};
 use dvr_engine::renderer::{FrameRequest, FrameResult, FEATURE_IMAGES};
 use dvr_engine::scene::{parse_memory_size, TfState, ViewSections};
-use dvr_engine::session::{Edit, Session, SessionError};
+use dvr_engine::session::{ChannelEdit, Edit, Session, SessionError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, PoisonError};
@@ -153,26 +154,39 @@ impl Renderer {
         );
         let given = volume.as_ref().map(|v| OnThisThread(&v.inner));
         let inner = py.detach(move || -> PyResult<_> {
-            let loaded;
-            let volume = match given {
-                Some(v) => v.0,
+            let extent = Extent {
+                width: w,
+                height: h,
+            };
+            // A file of several channels or time points loads as a series.
+            let channels = match given {
+                Some(_) => None,
+                None => load_channels(&scene).map_err(value_error)?,
+            };
+            let (mut setup, histogram, custom) = match channels {
+                Some(channels) => {
+                    let histogram = channels.volumes[0].histogram(HISTOGRAM_BINS);
+                    let setup = SceneSetup::with_channels(scene, channels, extent, spp)
+                        .map_err(value_error)?;
+                    (setup, histogram, true)
+                }
                 None => {
-                    loaded = load_volume(&scene, DEFAULT_VOLUME_SIZE).map_err(value_error)?;
-                    &loaded
+                    let loaded;
+                    let volume = match given {
+                        Some(v) => v.0,
+                        None => {
+                            loaded =
+                                load_volume(&scene, DEFAULT_VOLUME_SIZE).map_err(value_error)?;
+                            &loaded
+                        }
+                    };
+                    let custom = given_is_custom(&scene, volume);
+                    let histogram = volume.histogram(HISTOGRAM_BINS);
+                    let setup =
+                        SceneSetup::with_volume(scene, volume, extent, spp).map_err(value_error)?;
+                    (setup, histogram, custom)
                 }
             };
-            let custom = given_is_custom(&scene, volume);
-            let histogram = volume.histogram(HISTOGRAM_BINS);
-            let mut setup = SceneSetup::with_volume(
-                scene,
-                volume,
-                Extent {
-                    width: w,
-                    height: h,
-                },
-                spp,
-            )
-            .map_err(value_error)?;
             setup.config.motion_source = motion;
             if custom {
                 // The trained RAE networks are per dataset; an array is none of them.
@@ -308,6 +322,62 @@ impl Renderer {
             }
             Ok(())
         })
+    }
+
+    /// The time point shown (fractional: two interpolated) and the series' count.
+    fn time(&self, py: Python<'_>) -> PyResult<(f64, usize)> {
+        self.locked(py, |me| {
+            let s = &me.session;
+            let times = s.setup().timeline.as_ref().map_or(1, |t| t.times());
+            Ok((s.view().time, times))
+        })
+    }
+
+    /// Shows time point `time` (fractional: the two around it interpolated); raises
+    /// `ValueError` naming the range.
+    fn set_time(&self, py: Python<'_>, time: f64) -> PyResult<()> {
+        self.edit(py, Edit::Time(time))
+    }
+
+    /// Each channel of a multi-channel medium: `{"name", "tf" (a TF file's dict),
+    /// "window", "data_window", "colour", "visible"}`; empty for one field.
+    fn channels<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let views = self.locked(py, |me| Ok(me.session.view().channels.clone()))?;
+        views
+            .iter()
+            .map(|c| {
+                let d = PyDict::new(py);
+                d.set_item("name", &c.name)?;
+                d.set_item("tf", toml_dict(py, &c.tf.to_toml())?)?;
+                d.set_item("window", c.window.to_vec())?;
+                d.set_item("data_window", c.data_window.to_vec())?;
+                d.set_item("colour", c.colour.to_vec())?;
+                d.set_item("visible", c.visible)?;
+                Ok(d)
+            })
+            .collect()
+    }
+
+    /// Edits channel `index`: what is given changes. Raises `ValueError` naming the
+    /// field.
+    #[pyo3(signature = (index, tf = None, window = None, colour = None, visible = None))]
+    fn edit_channel(
+        &self,
+        py: Python<'_>,
+        index: usize,
+        tf: Option<&Bound<'_, PyDict>>,
+        window: Option<(f32, f32)>,
+        colour: Option<(f32, f32, f32)>,
+        visible: Option<bool>,
+    ) -> PyResult<()> {
+        let edit = ChannelEdit {
+            index,
+            tf: tf.map(tf_from_dict).transpose()?,
+            window: window.map(|(a, b)| [a, b]),
+            colour: colour.map(|(r, g, b)| [r, g, b]),
+            visible,
+        };
+        self.edit(py, Edit::Channel(edit))
     }
 
     /// The transfer function in effect: `{"a": tf, "b": tf or None, "blend": x,
@@ -551,6 +621,7 @@ pub fn denoiser_names() -> Vec<(String, String)> {
 fn given_is_custom(scene: &dvr_engine::scene::Scene, volume: &dvr_engine::volume::Volume) -> bool {
     match &scene.volume.source {
         dvr_engine::scene::VolumeSource::Builtin { dataset, .. } => dataset.name() != volume.name,
-        dvr_engine::scene::VolumeSource::File { .. } => true,
+        dvr_engine::scene::VolumeSource::File { .. }
+        | dvr_engine::scene::VolumeSource::Files { .. } => true,
     }
 }
