@@ -141,6 +141,20 @@ impl SceneSetup {
         size: Extent,
         spp: Option<u32>,
     ) -> Result<Self, SetupError> {
+        let count = scene.channel_views.len();
+        if let Some((i, k)) = scene.animation.channel.iter().enumerate().find(|(_, k)| k.index >= count) {
+            return Err(SetupError::Invalid {
+                scene: scene.name.clone(),
+                problem: format!(
+                    "animation.channel[{i}].index = {} names no channel: the volume has {}",
+                    k.index,
+                    match count {
+                        0 => "one field (give its channels with [volume] files or a file of several)".to_string(),
+                        n => format!("{n} channels (0 to {})", n - 1),
+                    }
+                ),
+            });
+        }
         // TFs written in data units (Hounsfield…) meet the volume here, once: everything
         // after this works in normalised density.
         scene.tf_a = scene.tf_a.in_density(volume.window);

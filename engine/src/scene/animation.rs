@@ -117,6 +117,21 @@ pub struct TimeKey {
     pub interpolation: Interpolation,
 }
 
+/// `[[animation.channel]]`: sets the visibility and/or colour of channel `index` at
+/// `frame` (visibility holds until the next key; colours interpolate).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelKey {
+    pub index: usize,
+    pub frame: u32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub visible: Option<bool>,
+    #[serde(default, alias = "color", skip_serializing_if = "Option::is_none")]
+    pub colour: Option<DVec3>,
+    #[serde(default, skip_serializing_if = "Interpolation::is_linear")]
+    pub interpolation: Interpolation,
+}
+
 /// `[[animation.clip]]`: sets any of point, normal, enabled of plane `index` at `frame`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -210,6 +225,8 @@ pub struct Animation {
     pub crop: Vec<CropKey>,
     /// `[[animation.time]]`: keyframes of a series' time point.
     pub time: Vec<TimeKey>,
+    /// `[[animation.channel]]`: keyframes of the channels' visibility and colour.
+    pub channel: Vec<ChannelKey>,
 }
 
 /// `[animation]` as written.
@@ -232,6 +249,8 @@ pub(crate) struct AnimationFile {
     crop: Vec<CropKey>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     time: Vec<TimeKey>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    channel: Vec<ChannelKey>,
 }
 
 fn default_frames() -> u32 {
@@ -249,6 +268,7 @@ impl Default for AnimationFile {
             clip: Vec::new(),
             crop: Vec::new(),
             time: Vec::new(),
+            channel: Vec::new(),
         }
     }
 }
@@ -263,6 +283,7 @@ impl AnimationFile {
             clip: self.clip,
             crop: self.crop,
             time: self.time,
+            channel: self.channel,
         };
         (self.frames, a)
     }
@@ -276,6 +297,7 @@ impl AnimationFile {
             tf: a.tf.clone(),
             clip: a.clip.clone(),
             time: a.time.clone(),
+            channel: a.channel.clone(),
             crop: a.crop.clone(),
         }
     }
@@ -304,6 +326,7 @@ impl Animation {
         a.clip.iter_mut().for_each(|k| k.frame = f(k.frame));
         a.crop.iter_mut().for_each(|k| k.frame = f(k.frame));
         a.time.iter_mut().for_each(|k| k.frame = f(k.frame));
+        a.channel.iter_mut().for_each(|k| k.frame = f(k.frame));
         a
     }
 
@@ -357,6 +380,21 @@ impl Animation {
                         k.time
                     ),
                 ));
+            }
+        }
+        for (j, k) in self.channel.iter().enumerate() {
+            let same = |o: &ChannelKey| o.frame == k.frame && o.index == k.index;
+            if let Some(i) = self.channel[..j].iter().position(same) {
+                return duplicate("channel", i, j, k.frame);
+            }
+            if k.index >= super::channel::MAX_CHANNELS {
+                return Err(ctx.invalid(
+                    format!("animation.channel[{j}].index"),
+                    format!("{} is past the last channel a medium holds (0 to {})", k.index, super::channel::MAX_CHANNELS - 1),
+                ));
+            }
+            if let Some(c) = k.colour {
+                ctx.colour(&format!("animation.channel[{j}].colour"), c)?;
             }
         }
         for (j, k) in self.clip.iter().enumerate() {

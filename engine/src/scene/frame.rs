@@ -126,6 +126,28 @@ impl Scene {
         }
     }
 
+    /// The channels' views at `frame`: visibility and colour after their
+    /// `[[animation.channel]]` keys.
+    pub fn channels_at(&self, frame: u32) -> Vec<super::ChannelView> {
+        let f = self.clamp_frame(frame);
+        let mut views = self.channel_views.clone();
+        for (i, c) in views.iter_mut().enumerate() {
+            let keys = || self.animation.channel.iter().filter(move |k| k.index == i);
+            c.visible = track(
+                c.visible,
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.visible?))),
+                f,
+            );
+            let colour = track(
+                glam::Vec3::from(c.colour).as_dvec3(),
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.colour?))),
+                f,
+            );
+            c.colour = colour.as_vec3().to_array();
+        }
+        views
+    }
+
     /// The time point the scene shows at `frame` (its `[[animation.time]]` keys).
     pub fn time_at(&self, frame: u32) -> f64 {
         let keys = self

@@ -56,7 +56,7 @@ use std::path::Path;
 
 pub use crate::bytes::parse_memory_size;
 pub use animation::{
-    Animation, CameraKey, ClipKey, CropKey, Interpolation, LightKey, Orbit, TfKey, TimeKey,
+    Animation, CameraKey, ChannelKey, ClipKey, CropKey, Interpolation, LightKey, Orbit, TfKey, TimeKey,
     DEFAULT_FRAMES,
 };
 pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR, MAX_CAMERA_DISTANCE};

@@ -92,7 +92,7 @@ impl Scene {
                 shift: state.tf_shift,
             },
             cut: self.cut_at(frame),
-            channels: self.channel_views.clone(),
+            channels: self.channels_at(frame),
             time: self.time_at(frame),
         }
     }

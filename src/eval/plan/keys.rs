@@ -10,7 +10,9 @@
 
 use super::settings::EvalArgs;
 use anyhow::{Context, Result};
+use dvr_engine::renderer::medium::load_channels;
 use dvr_engine::renderer::scene_setup::{load_environment, load_volume, on_demand};
+use dvr_engine::volume::Volume;
 use dvr_engine::scene::Scene;
 use serde::{Deserialize, Serialize};
 
@@ -74,11 +76,7 @@ fn content_hash(scene: &Scene, volume_size: u32) -> Result<String> {
     }
     // A volume made on demand is named by its generator and size (its voxels are made
     // brick by brick and never held whole).
-    if let Some(v) = on_demand(scene, volume_size) {
-        h.write(v.identity.as_bytes());
-    } else {
-        let volume = load_volume(scene, volume_size)
-            .with_context(|| format!("loading the volume of {}", scene.name))?;
+    let mut write_volume = |volume: &Volume| {
         for d in volume.dims {
             h.write(&d.to_le_bytes());
         }
@@ -86,6 +84,22 @@ fn content_hash(scene: &Scene, volume_size: u32) -> Result<String> {
             h.write(&x.to_le_bytes());
         }
         h.write(volume.data.as_bytes());
+    };
+    let loading = || format!("loading the volume of {}", scene.name);
+    if let Some(v) = on_demand(scene, volume_size) {
+        h.write(v.identity.as_bytes());
+    } else if let Some(channels) = load_channels(scene).with_context(loading)? {
+        // A medium of channels and time points: every channel at every time point.
+        for c in &channels.volumes {
+            write_volume(c);
+        }
+        for t in 1..channels.series.info().times {
+            for c in channels.series.read(t).with_context(loading)? {
+                write_volume(&c);
+            }
+        }
+    } else {
+        write_volume(&load_volume(scene, volume_size).with_context(loading)?);
     }
     let environment = load_environment(&scene.lights)
         .with_context(|| format!("loading the environment map of {}", scene.name))?;
