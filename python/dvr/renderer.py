@@ -23,7 +23,7 @@ def denoisers() -> dict:
 
 
 class Renderer:
-    """Renders ``scene`` (a :class:`Scene`, a :class:`Volume` or a 3-D numpy array, both
+    """Renders ``scene`` (a :class:`Scene`, a :class:`Volume` or a numpy array, both
     with :class:`Scene`'s defaults, a built-in scene name or a scene file) at ``size`` = (width, height) with ``spp`` samples per pixel per
     frame (default: the scene's) and runs each of ``denoisers`` on the same noisy
     frames. ``motion`` is what the temporal denoisers reproject with (``"features"`` or
@@ -59,11 +59,11 @@ class Renderer:
         if isinstance(scene, str):
             scene = Scene.builtin(scene) if scene in _native.builtin_scene_names() else Scene.load(scene)
         elif isinstance(scene, (np.ndarray, _native.Volume)):
-            # A volume alone is a scene with the defaults (Scene checks an array is 3-D).
+            # A volume alone is a scene with the defaults (Volume checks the array).
             scene = Scene(scene)
         elif not isinstance(scene, Scene):
             raise TypeError(
-                f"Renderer: expected a Scene, a Volume, a 3-D numpy array, a built-in scene name or a scene "
+                f"Renderer: expected a Scene, a Volume, a numpy array, a built-in scene name or a scene "
                 f"file, got {type(scene).__name__}"
             )
         if isinstance(denoisers, str):

@@ -277,8 +277,9 @@ class Scene:
     """A volume, a transfer function, a camera, lights, render settings and an
     animation: what a scene file holds.
 
-    ``volume`` is a :class:`Volume`, a 3-D numpy array indexed ``[z, y, x]`` (as
-    :class:`Volume` takes it, 1 mm voxels), a built-in dataset name or a volume file.
+    ``volume`` is a :class:`Volume`, a numpy array indexed ``[z, y, x]``, ``[c, z, y,
+    x]`` (channels) or ``[t, c, z, y, x]`` (time points of channels) (as :class:`Volume`
+    takes it, 1 mm voxels), a built-in dataset name or a volume file.
     ``Scene(volume)`` gives sensible defaults (a camera framing the volume, a key light
     and a soft environment, the ``phantom-opaque`` TF when none is given, one frame).
     ``Scene.builtin("phantom/orbit")`` and ``Scene.load("my.toml")`` open the CLI's
@@ -290,7 +291,7 @@ class Scene:
         from ._native import Volume
 
         if isinstance(volume, np.ndarray):
-            # Volume checks the array (3-D, a volume dtype) and says what is wrong.
+            # Volume checks the array (3-D to 5-D, a volume dtype) and says what is wrong.
             volume = Volume(volume)
         self.volume = None
         if isinstance(volume, Volume):

@@ -12,7 +12,7 @@ use dvr_engine::gpu::timestamps::PassTiming;
 use dvr_engine::gpu::{ContextOptions, GpuContext};
 use dvr_engine::graph::Extent;
 use dvr_engine::passes::aux_features::{ALBEDO, NORMAL};
-use dvr_engine::renderer::medium::load_channels;
+use dvr_engine::renderer::medium::{load_channels, Channels};
 use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup, DEFAULT_VOLUME_SIZE};
 use dvr_engine::renderer::{FrameRequest, FrameResult, FEATURE_IMAGES};
 use dvr_engine::scene::{parse_memory_size, TfState, ViewSections};
@@ -152,15 +152,20 @@ impl Renderer {
                 .map(String::as_str)
                 .filter(|n| *n != NOISY_METHOD),
         );
-        let given = volume.as_ref().map(|v| OnThisThread(&v.inner));
+        let given = volume
+            .as_ref()
+            .map(|v| OnThisThread((&v.inner, v.series.clone())));
         let inner = py.detach(move || -> PyResult<_> {
             let extent = Extent {
                 width: w,
                 height: h,
             };
-            // A file of several channels or time points loads as a series.
-            let channels = match given {
-                Some(_) => None,
+            // A file or an array of several channels or time points is a series.
+            let channels = match &given {
+                Some(v) => match &v.0 .1 {
+                    Some(series) => Some(Channels::of(series.clone()).map_err(value_error)?),
+                    None => None,
+                },
                 None => load_channels(&scene).map_err(value_error)?,
             };
             let (mut setup, histogram, custom) = match channels {
@@ -173,7 +178,7 @@ impl Renderer {
                 None => {
                     let loaded;
                     let volume = match given {
-                        Some(v) => v.0,
+                        Some(v) => v.0 .0,
                         None => {
                             loaded =
                                 load_volume(&scene, DEFAULT_VOLUME_SIZE).map_err(value_error)?;

@@ -7,17 +7,21 @@ use crate::convert::value_error;
 use crate::warnings;
 use dvr_engine::renderer::scene_setup::DEFAULT_VOLUME_SIZE;
 use dvr_engine::scene::parse_gpu_memory;
-use dvr_engine::volume::{SampleKind, Volume as EngineVolume, VolumeData, Voxels};
+use dvr_engine::volume::{SampleKind, Series, Volume as EngineVolume, VolumeData, Voxels};
 use numpy::{
     PyArray2, PyArray3, PyArrayDescrMethods, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 use pyo3::types::IntoPyDict;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// The attributes a volume has (named when a mistyped one is asked for).
 const FIELDS: &[&str] = &[
     "name",
+    "channels",
+    "times",
+    "channel_names",
     "shape",
     "spacing",
     "window",
@@ -31,7 +35,104 @@ const FIELDS: &[&str] = &[
 /// dataset, held in RAS order (see `to_patient`) with its data window and stored type.
 #[pyclass(module = "dvr._native", frozen)]
 pub struct Volume {
+    /// Channel 0 at time point 0 (all of a plain volume).
     pub inner: EngineVolume,
+    /// The channels and time points of a volume of more than one.
+    pub series: Option<Arc<Series>>,
+}
+
+/// A 3-D array's voxels (x fastest) of a volume dtype, `dtype` named by `name` in errors.
+fn voxels_any(
+    py: Python<'_>,
+    a: &Bound<'_, PyUntypedArray>,
+    name: &str,
+) -> PyResult<(Voxels, bool)> {
+    let dtype = a.dtype();
+    let voxels = if dtype.is_equiv_to(&numpy::dtype::<u8>(py)) {
+        Voxels::U8(voxels_of::<u8>(a)?)
+    } else if dtype.is_equiv_to(&numpy::dtype::<u16>(py)) {
+        Voxels::U16(voxels_of::<u16>(a)?)
+    } else if dtype.is_equiv_to(&numpy::dtype::<i16>(py)) {
+        Voxels::I16(voxels_of::<i16>(a)?)
+    } else if dtype.is_equiv_to(&numpy::dtype::<f32>(py)) {
+        Voxels::F32(voxels_of::<f32>(a)?)
+    } else if dtype.is_equiv_to(&numpy::dtype::<f64>(py)) {
+        // The GPU holds float32 at most; float64 is what numpy computes in, so it is
+        // common input and narrowing it is what a user would do by hand.
+        let wide = voxels_of::<f64>(a)?;
+        Voxels::F32(wide.into_iter().map(|x| x as f32).collect())
+    } else {
+        return Err(value_error(format!(
+            "{name}: dtype {dtype} is not a volume type (uint8, uint16, int16, float32 or \
+             float64; convert with .astype(numpy.float32))"
+        )));
+    };
+    Ok((voxels, dtype.is_equiv_to(&numpy::dtype::<f64>(py))))
+}
+
+/// A volume of several channels or time points: `a` is `(C, Z, Y, X)` or
+/// `(T, C, Z, Y, X)`; each channel is normalised through the window of its first time
+/// point, as a file's series is.
+fn from_series_array(
+    py: Python<'_>,
+    a: &Bound<'_, PyUntypedArray>,
+    spacing: (f64, f64, f64),
+    name: &str,
+    channels: Option<Vec<usize>>,
+) -> PyResult<Volume> {
+    let shape = a.shape().to_vec();
+    let (times, count) = if shape.len() == 4 {
+        (1, shape[0])
+    } else {
+        (shape[0], shape[1])
+    };
+    let lead = shape.len() - 3;
+    let (z, y, x) = (shape[lead], shape[lead + 1], shape[lead + 2]);
+    if shape.contains(&0) {
+        return Err(value_error(format!(
+            "{name}: the array is empty (shape {shape:?})"
+        )));
+    }
+    let too_big = |n: usize| {
+        u32::try_from(n).map_err(|_| value_error(format!("{name}: shape {shape:?} is too large")))
+    };
+    let dims = [too_big(x)?, too_big(y)?, too_big(z)?];
+    let flat = a.call_method1("reshape", ((times * count, z, y, x),))?;
+    let mut blocks = Vec::with_capacity(times);
+    let mut wide = false;
+    for t in 0..times {
+        let mut row = Vec::with_capacity(count);
+        for c in 0..count {
+            let block = flat.get_item(t * count + c)?;
+            let block = block.cast::<PyUntypedArray>()?;
+            let (v, w) = voxels_any(py, block, name)?;
+            wide |= w;
+            row.push(v);
+        }
+        blocks.push(row);
+    }
+    let spacing = [spacing.2 as f32, spacing.1 as f32, spacing.0 as f32];
+    let series = py
+        .detach(|| Series::from_arrays(name, dims, spacing, blocks, channels.as_deref()))
+        .map_err(value_error)?;
+    Volume::of_series(py, series, wide)
+}
+
+impl Volume {
+    /// A volume of a series: channel 0 at time 0 as `inner`, the series beside it.
+    fn of_series(py: Python<'_>, series: Series, wide: bool) -> PyResult<Self> {
+        let mut first = py.detach(|| series.read(0)).map_err(value_error)?;
+        let mut inner = first.swap_remove(0);
+        if wide {
+            inner.sample_kind = SampleKind::F64;
+        }
+        let info = series.info();
+        let one = info.channels.len() == 1 && info.times == 1;
+        Ok(Self {
+            inner,
+            series: (!one).then(|| Arc::new(series)),
+        })
+    }
 }
 
 /// `array`'s elements in C order (non-contiguous views are copied).
@@ -48,12 +149,13 @@ impl Volume {
     /// by the rule the file loaders follow: float32 in [0, 1] is density as it is,
     /// anything else is windowed to its range.
     #[new]
-    #[pyo3(signature = (array, spacing = (1.0, 1.0, 1.0), name = "array"))]
+    #[pyo3(signature = (array, spacing = (1.0, 1.0, 1.0), name = "array", channels = None))]
     fn new(
         py: Python<'_>,
         array: &Bound<'_, PyAny>,
         spacing: (f64, f64, f64),
         name: &str,
+        channels: Option<Vec<usize>>,
     ) -> PyResult<Self> {
         let a = array.cast::<PyUntypedArray>().map_err(|_| {
             value_error(format!(
@@ -65,11 +167,20 @@ impl Volume {
                     .unwrap_or_default()
             ))
         })?;
+        if a.ndim() == 4 || a.ndim() == 5 {
+            return from_series_array(py, a, spacing, name, channels);
+        }
         if a.ndim() != 3 {
             return Err(value_error(format!(
-                "{name}: expected a 3-D array indexed [z, y, x], got {} dimension(s) (shape {:?})",
+                "{name}: expected an array indexed [z, y, x], [c, z, y, x] (channels) or \
+                 [t, c, z, y, x] (time points of channels), got {} dimension(s) (shape {:?})",
                 a.ndim(),
                 a.shape()
+            )));
+        }
+        if channels.is_some() {
+            return Err(value_error(format!(
+                "{name}: channels= picks channels of a [c, z, y, x] or [t, c, z, y, x] array; this one is 3-D"
             )));
         }
         let shape = a.shape();
@@ -83,27 +194,7 @@ impl Volume {
                 .map_err(|_| value_error(format!("{name}: shape {shape:?} is too large")))
         };
         let dims = [too_big(shape[2])?, too_big(shape[1])?, too_big(shape[0])?];
-        let dtype = a.dtype();
-        let voxels = if dtype.is_equiv_to(&numpy::dtype::<u8>(py)) {
-            Voxels::U8(voxels_of::<u8>(a)?)
-        } else if dtype.is_equiv_to(&numpy::dtype::<u16>(py)) {
-            Voxels::U16(voxels_of::<u16>(a)?)
-        } else if dtype.is_equiv_to(&numpy::dtype::<i16>(py)) {
-            Voxels::I16(voxels_of::<i16>(a)?)
-        } else if dtype.is_equiv_to(&numpy::dtype::<f32>(py)) {
-            Voxels::F32(voxels_of::<f32>(a)?)
-        } else if dtype.is_equiv_to(&numpy::dtype::<f64>(py)) {
-            // The GPU holds float32 at most; float64 is what numpy computes in, so it is
-            // common input and narrowing it is what a user would do by hand.
-            let wide = voxels_of::<f64>(a)?;
-            Voxels::F32(wide.into_iter().map(|x| x as f32).collect())
-        } else {
-            return Err(value_error(format!(
-                "{name}: dtype {dtype} is not a volume type (uint8, uint16, int16, float32 or \
-                 float64; convert with .astype(numpy.float32))"
-            )));
-        };
-        let wide = dtype.is_equiv_to(&numpy::dtype::<f64>(py));
+        let (voxels, wide) = voxels_any(py, a, name)?;
         let spacing = [spacing.2 as f32, spacing.1 as f32, spacing.0 as f32];
         let mut inner = py
             .detach(|| EngineVolume::from_voxels(name, dims, spacing, voxels))
@@ -112,7 +203,10 @@ impl Volume {
             // `dtype` reports what the user handed over, not the narrowed copy.
             inner.sample_kind = SampleKind::F64;
         }
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            series: None,
+        })
     }
 
     /// Loads a volume file: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), DICOM (a folder or
@@ -148,6 +242,7 @@ impl Volume {
                 &array,
                 (1.0, 1.0, 1.0),
                 stem.as_deref().unwrap_or("npy"),
+                None,
             );
         }
         let budget = gpu_memory
@@ -159,7 +254,10 @@ impl Volume {
             py.detach(|| warnings::capture(|| EngineVolume::load_within(&path, None, budget)));
         let inner = loaded.map_err(value_error)?;
         warnings::issue(py, &dropped, _stacklevel)?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            series: None,
+        })
     }
 
     /// A built-in dataset: `phantom` (CT-like head), `cloud` (a homogeneous medium),
@@ -172,7 +270,10 @@ impl Volume {
         let inner = py
             .detach(|| EngineVolume::builtin(&name, size))
             .map_err(value_error)?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            series: None,
+        })
     }
 
     /// The name errors and pages use (file stem, built-in name, or as given).
@@ -233,6 +334,92 @@ impl Volume {
     #[getter]
     fn data<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f32>> {
         self.to_numpy(py)
+    }
+
+    /// Opens a volume of several channels or time points: one file (its channel and
+    /// time axes), a list of files (one channel each, resampled onto the first file's
+    /// grid; with `times=True`, one time point each) or a glob (`scan_*.nii.gz`, time
+    /// points sorted by name). `channels` picks some, in that order.
+    #[staticmethod]
+    #[pyo3(signature = (paths, channels = None, times = false))]
+    fn load_series(
+        py: Python<'_>,
+        paths: &Bound<'_, PyAny>,
+        channels: Option<Vec<usize>>,
+        times: bool,
+    ) -> PyResult<Self> {
+        let picked = channels.as_deref();
+        let series = if let Ok(one) = paths.extract::<PathBuf>() {
+            let glob = one.to_string_lossy().contains(['*', '?']);
+            py.detach(|| {
+                if glob {
+                    Series::open_glob(&one, picked)
+                } else {
+                    Series::open(&one, picked)
+                }
+            })
+        } else {
+            let list: Vec<PathBuf> = paths.extract()?;
+            py.detach(|| {
+                if times {
+                    Series::open_times(&list, picked)
+                } else {
+                    Series::open_channels(&list, picked)
+                }
+            })
+        }
+        .map_err(value_error)?;
+        Self::of_series(py, series, false)
+    }
+
+    /// How many channels the volume has.
+    #[getter]
+    fn channels(&self) -> usize {
+        self.series.as_ref().map_or(1, |s| s.info().channels.len())
+    }
+
+    /// How many time points the volume has.
+    #[getter]
+    fn times(&self) -> usize {
+        self.series.as_ref().map_or(1, |s| s.info().times)
+    }
+
+    /// The names of the channels (the file's labels, file stems, or `channel <i>`).
+    #[getter]
+    fn channel_names(&self) -> Vec<String> {
+        match &self.series {
+            Some(s) => s.info().channels.iter().map(|c| c.name.clone()).collect(),
+            None => vec![self.inner.name.clone()],
+        }
+    }
+
+    /// Channel `index` at time point `time` as a volume of its own (on the series' grid,
+    /// with its own window).
+    #[pyo3(signature = (index, time = 0))]
+    fn channel(&self, py: Python<'_>, index: usize, time: usize) -> PyResult<Self> {
+        let Some(series) = &self.series else {
+            if index == 0 && time == 0 {
+                return Ok(Self {
+                    inner: self.inner.clone(),
+                    series: None,
+                });
+            }
+            return Err(value_error(format!(
+                "channel {index} at time {time}: the volume has one channel and one time point"
+            )));
+        };
+        let count = series.info().channels.len();
+        if index >= count {
+            return Err(value_error(format!(
+                "channel {index} does not exist: the volume has {count} (0 to {})",
+                count - 1
+            )));
+        }
+        let mut all = py.detach(|| series.read(time)).map_err(value_error)?;
+        Ok(Self {
+            inner: all.swap_remove(index),
+            series: None,
+        })
     }
 
     /// A mistyped attribute names the ones that exist (as cameras, lights and scenes do).

@@ -5,11 +5,20 @@
 
 use crate::scene::{ChannelView, Scene, VolumeSource};
 use crate::volume::{Series, Volume, VolumeError};
+use std::sync::Arc;
 
 /// The loaded channels of a multi-channel medium, with what the file says of each.
 pub struct Channels {
     pub volumes: Vec<Volume>,
-    pub series: Series,
+    pub series: Arc<Series>,
+}
+
+impl Channels {
+    /// A series' channels at time point 0.
+    pub fn of(series: Arc<Series>) -> Result<Self, VolumeError> {
+        let volumes = series.read(0)?;
+        Ok(Self { volumes, series })
+    }
 }
 
 /// The scene's channels at time point 0 when its volume has several channels or time
@@ -29,8 +38,7 @@ pub fn load_channels(scene: &Scene) -> Result<Option<Channels>, VolumeError> {
             series
         }
     };
-    let volumes = series.read(0)?;
-    Ok(Some(Channels { volumes, series }))
+    Channels::of(Arc::new(series)).map(Some)
 }
 
 /// Each channel's view as the scene starts: its `[[channel]]` TF (else `[transfer] a`)

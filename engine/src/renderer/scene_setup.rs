@@ -142,14 +142,22 @@ impl SceneSetup {
         spp: Option<u32>,
     ) -> Result<Self, SetupError> {
         let count = scene.channel_views.len();
-        if let Some((i, k)) = scene.animation.channel.iter().enumerate().find(|(_, k)| k.index >= count) {
+        if let Some((i, k)) = scene
+            .animation
+            .channel
+            .iter()
+            .enumerate()
+            .find(|(_, k)| k.index >= count)
+        {
             return Err(SetupError::Invalid {
                 scene: scene.name.clone(),
                 problem: format!(
                     "animation.channel[{i}].index = {} names no channel: the volume has {}",
                     k.index,
                     match count {
-                        0 => "one field (give its channels with [volume] files or a file of several)".to_string(),
+                        0 =>
+                            "one field (give its channels with [volume] files or a file of several)"
+                                .to_string(),
                         n => format!("{n} channels (0 to {})", n - 1),
                     }
                 ),

@@ -36,10 +36,10 @@ impl std::fmt::Debug for Timeline {
 
 impl Timeline {
     /// A timeline over `series`, whose time point 0 is `first` (already read and packed).
-    pub fn new(series: Series, first: Arc<VolumeUpload>) -> Self {
+    pub fn new(series: Arc<Series>, first: Arc<VolumeUpload>) -> Self {
         let times = series.info().times;
         Self {
-            series: Arc::new(series),
+            series,
             times,
             resident: Mutex::new(VecDeque::from([(0, first)])),
             last: Mutex::new(None),

@@ -390,7 +390,11 @@ impl Animation {
             if k.index >= super::channel::MAX_CHANNELS {
                 return Err(ctx.invalid(
                     format!("animation.channel[{j}].index"),
-                    format!("{} is past the last channel a medium holds (0 to {})", k.index, super::channel::MAX_CHANNELS - 1),
+                    format!(
+                        "{} is past the last channel a medium holds (0 to {})",
+                        k.index,
+                        super::channel::MAX_CHANNELS - 1
+                    ),
                 ));
             }
             if let Some(c) = k.colour {

@@ -56,8 +56,8 @@ use std::path::Path;
 
 pub use crate::bytes::parse_memory_size;
 pub use animation::{
-    Animation, CameraKey, ChannelKey, ClipKey, CropKey, Interpolation, LightKey, Orbit, TfKey, TimeKey,
-    DEFAULT_FRAMES,
+    Animation, CameraKey, ChannelKey, ClipKey, CropKey, Interpolation, LightKey, Orbit, TfKey,
+    TimeKey, DEFAULT_FRAMES,
 };
 pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR, MAX_CAMERA_DISTANCE};
 pub use channel::{ChannelFile, ChannelSpec, ChannelView, MAX_CHANNELS};

@@ -46,6 +46,7 @@
 //! has the first file's shape, when the two are taken as aligned. The time points of one
 //! series must share one grid; files that do not are an error naming both shapes.
 
+mod arrays;
 mod glob;
 
 use std::path::{Path, PathBuf};

@@ -12,8 +12,8 @@ use super::settings::EvalArgs;
 use anyhow::{Context, Result};
 use dvr_engine::renderer::medium::load_channels;
 use dvr_engine::renderer::scene_setup::{load_environment, load_volume, on_demand};
-use dvr_engine::volume::Volume;
 use dvr_engine::scene::Scene;
+use dvr_engine::volume::Volume;
 use serde::{Deserialize, Serialize};
 
 /// What a reference frame depends on. Written before the first frame is rendered, so
