@@ -167,12 +167,16 @@ fn mean_abs_diff(a: &Shot, b: &Shot, w: u32, h: u32) -> f64 {
 const SIZE: u32 = 256;
 
 fn explore_shot(x: &Xvfb, dir: &Path, name: &str, extra: &[&str]) -> Shot {
+    explore_scene_shot(x, dir, name, "phantom/orbit", extra)
+}
+
+fn explore_scene_shot(x: &Xvfb, dir: &Path, name: &str, scene: &str, extra: &[&str]) -> Shot {
     let shot = dir.join(name);
     let size = format!("{SIZE}x{SIZE}");
     let mut args = vec![
         "explore",
         "--scene",
-        "phantom/orbit",
+        scene,
         "--size",
         &size,
         "--frames",
@@ -490,5 +494,47 @@ fn the_view_shows_orientation_letters_and_a_scale_bar_that_follow_the_camera() {
     assert!(
         differ > 0 && letters_differ > 5,
         "the left edge's letter is the same from the front and the side"
+    );
+}
+
+#[test]
+fn a_channel_switches_off_takes_a_tf_and_the_time_slider_scrubs_a_series() {
+    let Some(x) = xvfb() else { return };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scenes = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/development/");
+    let head = format!("{scenes}mri-statmap-light.toml");
+    let shot = |name: &str, scene: &str, script: &str| {
+        let extra: Vec<&str> = if script.is_empty() {
+            vec![]
+        } else {
+            vec!["--script", script]
+        };
+        explore_scene_shot(&x, dir.path(), name, scene, &extra)
+    };
+    let both = shot("both.png", &head, "");
+    // The statistical map's clusters switched off: only they change.
+    let off = shot("off.png", &head, "channel:1:off@3");
+    let d_off = mean_abs_diff(&both, &off, SIZE, SIZE);
+    // The T1 (channel 0) given the opaque cortex TF: the whole head changes.
+    let tf = shot("tf.png", &head, "channel:0:select@2;tf:mri-opaque@3");
+    let d_tf = mean_abs_diff(&both, &tf, SIZE, SIZE);
+    // A quarter beat later the shell is at its largest (times 0 and 12 are both at its
+    // mean size).
+    let shell = format!("{scenes}shell-beat-still.toml");
+    let t0 = shot("t0.png", &shell, "");
+    let t6 = shot("t6.png", &shell, "time:6@3");
+    let d_time = mean_abs_diff(&t0, &t6, SIZE, SIZE);
+    eprintln!("mean |Δ|: channel off {d_off:.2}, channel TF {d_tf:.2}, time 0 -> 6 {d_time:.2}");
+    assert!(
+        d_off > 0.3,
+        "switching the map off barely changed the view ({d_off:.2})"
+    );
+    assert!(
+        d_tf > 3.0,
+        "the channel's TF barely changed the view ({d_tf:.2})"
+    );
+    assert!(
+        d_time > 0.5,
+        "scrubbing the time barely changed the view ({d_time:.2})"
     );
 }

@@ -33,6 +33,7 @@ impl Explorer {
                 self.resized = false;
             }
         }
+        self.ui.playback.tick(&mut self.model.time);
         let due: Vec<Command> = self.script.at(self.frame).cloned().collect();
         for c in &due {
             self.command(c);

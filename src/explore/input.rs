@@ -122,6 +122,21 @@ pub enum Command {
     Clip(ClipCommand),
     /// Resize the window so the view is (width, height) pixels.
     Resize(u32, u32),
+    /// A change to channel `i` (the channels panel).
+    Channel(usize, ChannelCommand),
+    /// The time slider set to a time point.
+    Time(f64),
+    /// Playback on or off.
+    Play(bool),
+}
+
+/// What a `channel:` script command does (the channels panel's controls).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ChannelCommand {
+    Visible(bool),
+    /// The TF editor edits this channel from now on (`tf:` commands too).
+    Select,
+    Colour([f32; 3]),
 }
 
 /// What a `clip:`/`crop:` script command does (the panel's buttons and sliders).
@@ -292,6 +307,42 @@ impl Script {
                         "script command {part:?}: crop:on, crop:off, crop:min:X,Y,Z or crop:max:X,Y,Z"
                     ),
                 }),
+                "channel" => {
+                    let usage = || {
+                        format!("script command {part:?}: channel:I:on, channel:I:off, channel:I:select or channel:I:colour:R,G,B")
+                    };
+                    let (i, what) = args.trim().split_once(':').with_context(usage)?;
+                    let i: usize = i.trim().parse().ok().with_context(usage)?;
+                    let change = match what.trim().split_once(':') {
+                        None if what.trim() == "on" => ChannelCommand::Visible(true),
+                        None if what.trim() == "off" => ChannelCommand::Visible(false),
+                        None if what.trim() == "select" => ChannelCommand::Select,
+                        Some(("colour" | "color", rgb)) => {
+                            let v: Vec<f32> = rgb
+                                .split(',')
+                                .map(|c| c.trim().parse::<f32>())
+                                .collect::<Result<_, _>>()
+                                .ok()
+                                .filter(|v: &Vec<f32>| v.len() == 3 && v.iter().all(|c| (0.0..=1.0).contains(c)))
+                                .with_context(usage)?;
+                            ChannelCommand::Colour([v[0], v[1], v[2]])
+                        }
+                        _ => bail!(usage()),
+                    };
+                    Command::Channel(i, change)
+                }
+                "time" => Command::Time(
+                    args.trim()
+                        .parse()
+                        .ok()
+                        .filter(|t: &f64| t.is_finite() && *t >= 0.0)
+                        .with_context(|| format!("script command {part:?}: time:T, a time point >= 0"))?,
+                ),
+                "play" => match args.trim() {
+                    "on" => Command::Play(true),
+                    "off" => Command::Play(false),
+                    _ => bail!("script command {part:?}: play:on or play:off"),
+                },
                 "denoiser" => Command::Denoiser(args.trim().to_string()),
                 "split" => match args.trim() {
                     "off" | "" => Command::Split(None),
@@ -310,7 +361,7 @@ impl Script {
                 }
                 other => bail!(
                     "script command {part:?}: unknown action {other:?} \
-                     (orbit, pan, zoom, key, denoiser, split, tf, size, clip, crop)"
+                     (orbit, pan, zoom, key, denoiser, split, tf, size, clip, crop, channel, time, play)"
                 ),
             };
             events.push((frame, command));

@@ -23,6 +23,7 @@
 //! what happens to its results; `moving.rs` the rendered size while the view moves;
 //! `ui.rs` the panel that edits the model.
 
+mod channel_panel;
 mod cut_panel;
 mod frame;
 mod input;
@@ -42,6 +43,7 @@ use dvr_engine::gpu::{ContextOptions, GpuContext, Swapchain};
 use dvr_engine::graph::Extent;
 use dvr_engine::image_io::{to_rgb, write_exr, write_png, PNG_EXPOSURE};
 use dvr_engine::passes::present::PresentLayout;
+use dvr_engine::renderer::medium::load_channels;
 use dvr_engine::renderer::scene_setup::{load_volume, on_demand, SceneSetup};
 use dvr_engine::renderer::{FrameRequest, FrameResult, PresentTarget, Screenshot};
 use dvr_engine::scene::{Scene, TfState, View, VolumeSource};
@@ -153,9 +155,20 @@ pub fn run(args: ExploreArgs) -> Result<()> {
     };
     // A volume made on demand has no dense array to count: the TF editor shows no
     // histogram for it.
+    let mut channel_histograms = Vec::new();
     let (mut setup, histogram) = if on_demand(&scene, args.render.volume_size).is_some() {
         let setup = SceneSetup::new(scene, size, args.render.spp, args.render.volume_size)?;
         (setup, vec![0u32; HISTOGRAM_BINS])
+    } else if let Some(channels) = load_channels(&scene)? {
+        // Channels and time points: each channel's histogram at time point 0.
+        channel_histograms = channels
+            .volumes
+            .iter()
+            .map(|v| v.histogram(HISTOGRAM_BINS))
+            .collect();
+        let first = channel_histograms[0].clone();
+        let setup = SceneSetup::with_channels(scene, channels, size, args.render.spp)?;
+        (setup, first)
     } else {
         let volume = load_volume(&scene, args.render.volume_size)?;
         let histogram = volume.histogram(HISTOGRAM_BINS);
@@ -168,6 +181,10 @@ pub fn run(args: ExploreArgs) -> Result<()> {
     let event_loop = EventLoop::new().map_err(|e| anyhow::anyhow!("{NO_DISPLAY} ({e})"))?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut app = Explorer::new(args, setup, &histogram, script, &names)?;
+    app.ui.channel_histograms = channel_histograms
+        .iter()
+        .map(|h| ui::log_histogram(h))
+        .collect();
     event_loop
         .run_app(&mut app)
         .context("the window's event loop failed")?;
@@ -244,8 +261,12 @@ impl Explorer {
             left: names[0].clone(),
             right: names.get(1).cloned(),
             split: 0.5,
+            channels: view.channels,
+            time: view.time,
         };
         let mut ui = UiState::new(histogram, setup.volume.window);
+        ui.playback =
+            channel_panel::Playback::new(setup.timeline.as_ref().map_or(1, |t| t.times()));
         let recorder = match &args.record {
             Some(dir) => {
                 ui.recording = true;

@@ -1,7 +1,9 @@
 //! Model application: what the UI and the script edit reaches the session as edits
 //! (denoisers, render settings, TF, lights) and the swapchain.
 
+use super::input::ChannelCommand;
 use super::*;
+use dvr_engine::session::ChannelEdit;
 
 impl Explorer {
     /// The renderer's denoisers: the shown one, and the right-hand one when split.
@@ -50,6 +52,29 @@ impl Explorer {
             if let Err(e) = session.edit(Edit::Tf(tf)) {
                 self.ui.set_status(e.to_string());
                 self.model.tf = session.view().tf.a.clone();
+            }
+        }
+        for i in 0..self.model.channels.len().min(self.applied.channels.len()) {
+            let (c, was) = (&self.model.channels[i], &self.applied.channels[i]);
+            if c == was {
+                continue;
+            }
+            let edit = ChannelEdit {
+                index: i,
+                tf: (c.tf != was.tf).then(|| c.tf.clone()),
+                window: (c.window != was.window).then_some(c.window),
+                colour: (c.colour != was.colour).then_some(c.colour),
+                visible: (c.visible != was.visible).then_some(c.visible),
+            };
+            if let Err(e) = session.edit(Edit::Channel(edit)) {
+                self.ui.set_status(e.to_string());
+                self.model.channels[i] = session.view().channels[i].clone();
+            }
+        }
+        if self.model.time != self.applied.time {
+            if let Err(e) = session.edit(Edit::Time(self.model.time)) {
+                self.ui.set_status(e.to_string());
+                self.model.time = session.view().time;
             }
         }
         if self.model.cut != self.applied.cut {
@@ -118,10 +143,28 @@ impl Explorer {
             },
             Command::Split(right) => self.model.right = right.clone(),
             Command::Tf(tf) => {
-                self.model.tf = (**tf).clone();
+                // With channels, the TF editor's channel takes it.
+                let i = self.ui.channel;
+                match self.model.channels.get_mut(i) {
+                    Some(c) => c.tf = (**tf).clone(),
+                    None => self.model.tf = (**tf).clone(),
+                }
                 self.ui.tf_editor.selected = None;
                 self.ui.tf_editor.dragging = None;
             }
+            Command::Channel(i, change) => match self.model.channels.get_mut(*i) {
+                Some(c) => match change {
+                    ChannelCommand::Visible(v) => c.visible = *v,
+                    ChannelCommand::Select => self.ui.channel = *i,
+                    ChannelCommand::Colour(rgb) => c.colour = *rgb,
+                },
+                None => self.ui.set_status(format!(
+                    "channel {i} does not exist: the volume has {} channel(s)",
+                    self.model.channels.len().max(1)
+                )),
+            },
+            Command::Time(t) => self.model.time = *t,
+            Command::Play(on) => self.ui.playback.playing = *on,
             Command::Key(Key::Cut) => self.toggle_cuts(),
             Command::Resize(w, h) => {
                 if let Some(window) = &self.window {

@@ -4,6 +4,7 @@
 //! The UI edits a [`Model`]; the frame loop compares it with last frame's copy and turns
 //! differences into renderer inputs (see `mod.rs`). Nothing here touches the GPU.
 
+use super::channel_panel;
 use super::cut_panel;
 use super::input::SHORTCUTS;
 use super::orientation;
@@ -41,6 +42,10 @@ pub struct Model {
     pub right: Option<String>,
     /// Split position as a fraction of the width.
     pub split: f32,
+    /// The channels of a multi-channel medium (empty for one field).
+    pub channels: Vec<scene::ChannelView>,
+    /// The time point of a series.
+    pub time: f64,
 }
 
 /// Frame statistics the panel shows.
@@ -107,6 +112,11 @@ pub struct UiState {
     pub max_spp: u32,
     /// The shown view's camera and rectangle this frame (the cut's outline and "align").
     pub view: Option<cut_panel::ViewGeometry>,
+    /// The channel the TF editor edits, and each channel's histogram (log-scaled).
+    pub channel: usize,
+    pub channel_histograms: Vec<Vec<f32>>,
+    /// A series' playback (one time point: not shown).
+    pub playback: channel_panel::Playback,
 }
 
 /// What the UI asks the frame loop to do besides editing the model.
@@ -128,6 +138,9 @@ impl UiState {
             recording: false,
             max_spp: 1,
             view: None,
+            channel: 0,
+            channel_histograms: Vec::new(),
+            playback: channel_panel::Playback::new(1),
         }
     }
 
@@ -222,17 +235,30 @@ fn panel(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model, requests: &m
         .small(),
     );
     ui.label(RichText::new(&state.stats.volume).small());
-    egui::CollapsingHeader::new("Transfer function")
-        .default_open(true)
-        .show(ui, |ui| {
-            tf_editor::show(
-                ui,
-                &mut state.tf_editor,
-                &mut model.tf,
-                &state.histogram,
-                state.window,
-            );
-        });
+    if model.channels.is_empty() {
+        egui::CollapsingHeader::new("Transfer function")
+            .default_open(true)
+            .show(ui, |ui| {
+                tf_editor::show(
+                    ui,
+                    &mut state.tf_editor,
+                    &mut model.tf,
+                    &state.histogram,
+                    state.window,
+                );
+            });
+    } else {
+        egui::CollapsingHeader::new("Channels")
+            .default_open(true)
+            .show(ui, |ui| channel_panel::channels(ui, state, model));
+    }
+    if state.playback.times > 1 {
+        egui::CollapsingHeader::new("Time")
+            .default_open(true)
+            .show(ui, |ui| {
+                channel_panel::time(ui, &mut state.playback, &mut model.time)
+            });
+    }
     egui::CollapsingHeader::new("Denoiser")
         .default_open(true)
         .show(ui, |ui| denoiser_controls(ui, model));
