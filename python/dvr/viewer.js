@@ -49,7 +49,9 @@ function tickLabel(v, span) {
 // over a checkerboard). Drag a point, double-click to add one, shift-click a point to
 // remove it. It always shows the kernel's `tf_points` (the renderer's TF, whoever set
 // it); every field of a point (specular, emissive, roughness too) is kept in edits.
-function tfEditor(model, uid) {
+// With channels it shows and edits channel `tf_channel`'s TF (density 0..1 over that
+// channel's window), and an edit goes to the kernel as a message naming that channel.
+function tfEditor(model, uid, send) {
   const W = 210, H = 100, L = 30, T = 6, BAR = 8;
   const VW = L + W + 6, VH = T + H + 4 + 2 * BAR + 26;
   const svg = svgEl("svg", { class: "dvr-tf", viewBox: `0 0 ${VW} ${VH}` });
@@ -63,9 +65,9 @@ function tfEditor(model, uid) {
     const q = p.matrixTransform(svg.getScreenCTM().inverse());
     return [clamp01((q.x - L) / W), clamp01((T + H - q.y) / H)];
   };
+  const channel = () => (model.get("channels") || [])[model.get("tf_channel")];
   function axes() {
-    const vol = model.get("volume") || {};
-    const win = vol.window;
+    const win = channel() ? channel().window : (model.get("volume") || {}).window;
     // Data units only where they differ from density: a [0, 1] window is density.
     const data = win && !(win[0] === 0 && win[1] === 1);
     const g = svgEl("g", { class: "dvr-axes" });
@@ -109,12 +111,26 @@ function tfEditor(model, uid) {
     g.append(svgEl("rect", { x: L, y: y + BAR, width: W, height: BAR, fill: `url(#${uid}-a)`, class: "dvr-opacity-bar" }));
     return g;
   }
+  // The histogram's bins span density 0..1 of the volume's window. With channels the
+  // renderer has one histogram, channel 0's (over its data window, at the first time
+  // point): it is drawn under channel 0's TF only, placed by that channel's window.
+  function histogram() {
+    const hist = model.get("histogram") || [];
+    const c = channel();
+    if (!c) return [hist, 0, 1];
+    if (model.get("tf_channel") !== 0) return [[], 0, 1];
+    const at = (v) => (v - c.window[0]) / (c.window[1] - c.window[0]);
+    return [hist, at(c.data_window[0]), at(c.data_window[1])];
+  }
   function draw() {
     svg.replaceChildren();
-    const hist = model.get("histogram") || [];
-    const bw = W / Math.max(1, hist.length);
+    const [hist, lo, hi] = histogram();
+    const bw = ((hi - lo) * W) / Math.max(1, hist.length);
     svg.append(svgEl("rect", { x: L, y: T, width: W, height: H, class: "dvr-plot" }));
-    hist.forEach((h, i) => svg.append(svgEl("rect", { x: L + i * bw, y: T + H - h * H, width: bw + 0.2, height: h * H, class: "dvr-hist" })));
+    hist.forEach((h, i) => {
+      const x0 = Math.max(L, L + lo * W + i * bw), x1 = Math.min(L + W, L + lo * W + (i + 1) * bw + 0.2);
+      if (x1 > x0) svg.append(svgEl("rect", { x: x0, y: T + H - h * H, width: x1 - x0, height: h * H, class: "dvr-hist" }));
+    });
     svg.append(axes());
     if (points.length) svg.append(colourBar());
     svg.append(svgEl("polyline", { points: points.map((p) => `${toX(p.density)},${toY(p.opacity)}`).join(" "), class: "dvr-curve" }));
@@ -135,8 +151,12 @@ function tfEditor(model, uid) {
   }
   function commit() {
     points.sort((a, b) => a.density - b.density);
-    model.set("tf_points", points.map((p) => ({ ...p })));
-    model.save_changes();
+    const edited = points.map((p) => ({ ...p }));
+    if (channel()) send({ type: "channel", index: model.get("tf_channel"), tf: edited });
+    else {
+      model.set("tf_points", edited);
+      model.save_changes();
+    }
     draw();
   }
   svg.addEventListener("pointermove", (ev) => {
@@ -177,6 +197,8 @@ function tfEditor(model, uid) {
   model.on("change:tf_points", load);
   model.on("change:histogram", draw);
   model.on("change:volume", draw);
+  model.on("change:tf_channel", draw);
+  model.on("change:channels", draw);
   load();
   return svg;
 }
@@ -282,6 +304,99 @@ function cutsPanel(model) {
     ...cropRows);
 }
 
+const hex = (c) => "#" + c.map((v) => Math.round(255 * clamp01(v)).toString(16).padStart(2, "0")).join("");
+const fromHex = (h) => [1, 3, 5].map((i) => parseInt(h.slice(i, i + 2), 16) / 255);
+
+// The channels panel (a medium of several channels; hidden otherwise): per channel its
+// colour (a colour picker), whether it is shown, its name, and whether the TF editor
+// edits its TF. Edits go to the kernel as messages; the rows show the kernel's
+// `channels` (the renderer's), whoever changed them, except a colour being picked.
+function channelsPanel(model, send, uid) {
+  const rows = el("div", { class: "dvr-channel-rows" });
+  const box = el("div", { class: "dvr-channels" }, el("div", { class: "dvr-hint" }, "channels: colour · shown · name · TF in the editor"), rows);
+  let inputs = [];
+  function build(n) {
+    inputs = Array.from({ length: n }, (_, i) => {
+      const colour = el("input", { type: "color", class: "dvr-channel-colour", title: "colour" });
+      colour.addEventListener("input", () => {
+        colour.dataset.picking = "1";
+        send({ type: "channel", index: i, colour: fromHex(colour.value) });
+      });
+      colour.addEventListener("change", () => delete colour.dataset.picking);
+      const on = el("input", { type: "checkbox", class: "dvr-channel-visible", title: "shown" });
+      on.addEventListener("change", () => send({ type: "channel", index: i, visible: on.checked }));
+      const tf = el("input", { type: "radio", name: `${uid}-channel`, class: "dvr-channel-tf", title: "the TF editor edits this channel's TF" });
+      tf.addEventListener("change", () => {
+        if (!tf.checked) return;
+        model.set("channel", i);
+        model.save_changes();
+      });
+      const name = el("span", { class: "dvr-channel-name" });
+      rows.append(el("div", { class: "dvr-channel", "data-index": i }, colour, on, name, tf));
+      return { colour, on, name, tf };
+    });
+  }
+  function update() {
+    const channels = model.get("channels") || [];
+    box.hidden = !channels.length;
+    if (channels.length !== inputs.length) {
+      rows.replaceChildren();
+      build(channels.length);
+    }
+    channels.forEach((c, i) => {
+      const r = inputs[i];
+      if (!r.colour.dataset.picking) r.colour.value = hex(c.colour);
+      r.on.checked = c.visible;
+      r.name.textContent = c.name;
+      r.tf.checked = i === model.get("channel");
+    });
+  }
+  model.on("change:channels", update);
+  model.on("change:channel", update);
+  update();
+  return box;
+}
+
+// The time slider (a series of time points; hidden otherwise): 0 to times - 1 in
+// fractional steps (the renderer mixes the two time points around a fraction), play and
+// pause, and the speed in time points per second. Playback runs in the kernel's render
+// thread; the slider follows the time of each frame shown, except while it is held or
+// until the frames show the page's last time.
+function timeRow(model, send) {
+  const times = model.get("times") || 1;
+  const value = el("span", { class: "dvr-time-value" });
+  const show = (t) => (value.textContent = `${t.toFixed(2)} / ${times - 1}`);
+  let held = false, asked = 0;
+  const range = slider("0", String(Math.max(1, times - 1)), "0.05", 0, (t) => {
+    asked = send({ type: "time", time: t });
+    show(t);
+  }, "dvr-time");
+  range.addEventListener("pointerdown", () => (held = true));
+  for (const ev of ["pointerup", "pointercancel", "change", "blur"]) range.addEventListener(ev, () => (held = false));
+  const play = button("play", "dvr-play", () => send({ type: "play", playing: !model.get("playing") }));
+  const speed = el("input", { type: "number", min: "0.1", max: "100", step: "0.5", class: "dvr-speed", title: "time points per second" });
+  speed.addEventListener("change", () => send({ type: "play", speed: parseFloat(speed.value) }));
+  const drawPlay = () => {
+    play.textContent = model.get("playing") ? "pause" : "play";
+    speed.value = model.get("speed");
+  };
+  model.on("change:playing", drawPlay);
+  model.on("change:speed", drawPlay);
+  drawPlay();
+  show(0);
+  const row = el("div", { class: "dvr-time-row" },
+    el("div", { class: "dvr-row" }, "time ", range, value),
+    el("div", { class: "dvr-row" }, play, "speed ", speed, " /s"));
+  row.hidden = times < 2;
+  // A frame's time point (with the newest page message it follows, `seq`).
+  row.follow = (t, seq) => {
+    if (held || seq < asked || t === null || t === undefined) return;
+    range.value = t;
+    show(t);
+  };
+  return row;
+}
+
 function render({ model, el: root }) {
   root.classList.add("dvr-viewer");
   const uid = `dvr${Math.random().toString(36).slice(2, 10)}`;
@@ -316,6 +431,10 @@ function render({ model, el: root }) {
   const preset = () =>
     select(model.get("presets"), model.get("preset"), (v) => {
       if (!v) return;
+      if ((model.get("channels") || []).length) {
+        send({ type: "channel", index: model.get("tf_channel"), preset: v });
+        return;
+      }
       model.set("preset", v);
       model.save_changes();
     }, [["", "(edited)"]]);
@@ -352,7 +471,9 @@ function render({ model, el: root }) {
     seq += 1;
     sentAt.set(seq, performance.now());
     model.send({ ...msg, seq });
+    return seq;
   };
+  const time = timeRow(model, send);
   const cameraRow = el("div", { class: "dvr-row dvr-camera-buttons" },
     button("reset", "dvr-reset", () => send({ type: "reset" })),
     button("fit", "dvr-fit", () => send({ type: "fit" })));
@@ -372,8 +493,10 @@ function render({ model, el: root }) {
     el("label", {}, "spp ", spp, sppRange),
     cameraRow,
     sidesRow,
+    time,
+    channelsPanel(model, send, uid),
     el("label", {}, "TF preset ", presetSel),
-    tfEditor(model, uid),
+    tfEditor(model, uid, send),
     el("div", { class: "dvr-hint" }, "drag a point · double-click adds · shift-click removes"),
     cutsPanel(model),
     captureRow,
@@ -483,6 +606,7 @@ function render({ model, el: root }) {
         sentAt.delete(s);
       }
     }
+    time.follow(msg.time, msg.seq);
     labels.replaceChildren(...msg.names.map((n) => el("span", {}, n)));
     labels.classList.toggle("dvr-split-labels", msg.names.length > 1);
     if (msg.orientation) drawOrientation(msg.orientation);

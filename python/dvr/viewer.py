@@ -5,14 +5,16 @@ A thread renders the view for as long as the viewer is open: a still view keeps
 refining. Each frame is tone-mapped and encoded (JPEG by default) and sent to the
 browser only when the browser has shown the one before, so a lagging browser drops
 frames instead of queueing them. Mouse drags, the wheel and the panel (TF editor,
-denoiser switch, split view, spp) come back as messages; the thread applies the newest
-of them before its next frame (drags are summed, never queued), as edits of the live
-:class:`dvr.Renderer`, which the temporal denoisers reproject. The same renderer can be
-edited from other cells (``v.renderer.lights[0].intensity = 30``) while the viewer runs.
+denoiser switch, split view, spp, channels, time) come back as messages; the thread
+applies the newest of them before its next frame (drags are summed, never queued), as
+edits of the live :class:`dvr.Renderer`, which the temporal denoisers reproject. The
+same renderer can be edited from other cells (``v.renderer.lights[0].intensity = 30``)
+while the viewer runs.
 
 The panel always shows the renderer's current state: the render thread compares the
-renderer's TF, clip planes, crop box and spp with what the panel shows after each frame
-and sends any change, whichever road it came by (the page, another cell, a preset).
+renderer's TF, clip planes, crop box, spp and channels with what the panel shows after
+each frame and sends any change, whichever road it came by (the page, another cell, a
+preset); each frame carries the time point it shows, which the time slider follows.
 
 The render thread stops when the viewer is closed (:meth:`Viewer.close`, or the
 frontend closing its comm) or the kernel is interrupted while idle. A closed viewer
@@ -39,6 +41,7 @@ except ImportError as e:  # pragma: no cover - the notebook extra is missing
 
 from . import _native
 from . import viewer_capture as capture
+from . import viewer_channels as series
 from . import viewer_panel as panel
 from .renderer import Renderer
 from .scene import Scene, TransferFunction
@@ -83,7 +86,10 @@ class Viewer(anywidget.AnyWidget):
     limit), resets, fits, and views from a patient side; adds clip planes and a crop
     box; takes a screenshot or an orbit movie; and shows the frame counter, frames per
     second, the latency of the last drag, the GPU ms per pass, the patient's sides at
-    the view's edges and a scale bar in mm.
+    the view's edges and a scale bar in mm. A medium of several channels gets a
+    channels panel (each channel's colour, whether it is shown, and which channel's TF
+    the editor edits); a series of time points a time slider, with playback at
+    ``speed`` time points per second (``playing``) moved on by the render thread.
     """
 
     _esm = (_HERE / "viewer.js").read_text(encoding="utf-8")
@@ -101,7 +107,17 @@ class Viewer(anywidget.AnyWidget):
     crop_box = traitlets.Dict().tag(sync=True)
     status = traitlets.Unicode("").tag(sync=True)
     captures = traitlets.List().tag(sync=True)
+    # The channels panel: each channel's name, colour, visible and windows (the
+    # renderer's); which channel's TF the editor edits (the page's choice), and which
+    # channel's TF its points are (-1: the renderer's one TF), set with them.
+    channels = traitlets.List().tag(sync=True)
+    channel = traitlets.Int(0).tag(sync=True)
+    tf_channel = traitlets.Int(-1).tag(sync=True)
+    # Playback of a series: the render thread moves the time on while `playing`.
+    playing = traitlets.Bool(False).tag(sync=True)
+    speed = traitlets.Float(4.0).tag(sync=True)
     # Fixed for the viewer's life.
+    times = traitlets.Int(1).tag(sync=True)
     methods = traitlets.List().tag(sync=True)
     presets = traitlets.List().tag(sync=True)
     sides = traitlets.List().tag(sync=True)
@@ -134,6 +150,7 @@ class Viewer(anywidget.AnyWidget):
             counts = renderer.histogram().astype(np.float64)
             info = panel.volume_info(renderer)
             limit = panel.spp_limit(renderer)
+            n_channels, times = len(renderer._r.channels()), renderer.times
         except BaseException:
             if self._owns:
                 renderer.close()  # made here: its device memory goes now, not at GC
@@ -150,6 +167,7 @@ class Viewer(anywidget.AnyWidget):
             volume=info or {},
             width=renderer.size[0],
             height=renderer.size[1],
+            times=times,
         )
         self.renderer = renderer
         self._format, self._quality = format, quality
@@ -161,7 +179,8 @@ class Viewer(anywidget.AnyWidget):
         # to send back (a thread-local flag: the page's changes come on another thread).
         self._local = threading.local()
         self._shown = {}  # what the panel shows of the renderer's state, as last synced
-        self._sync(renderer._r.view(), renderer._r.tf())
+        self._n_channels = n_channels
+        self._sync(renderer._r.view(), renderer._r.tf(), series.read(renderer, n_channels, times))
         if limit is None:
             self.status = "the engine did not say its spp limit: the box keeps the renderer's spp"
         self._stop = threading.Event()
@@ -176,7 +195,7 @@ class Viewer(anywidget.AnyWidget):
         self.on_msg(self._on_message)
         if self.comm is not None:
             self.comm.on_close(lambda _msg: self.close())
-        self.observe(self._on_state, names=["denoiser", "split", "spp", "preset", "tf_points", "clip_planes", "crop_box"])
+        self.observe(self._on_state, names=["denoiser", "split", "spp", "preset", "tf_points", "clip_planes", "crop_box", "channel"])
         self._thread = threading.Thread(
             target=_render_loop, args=(weakref.ref(self), renderer, self._pending, self._stop, self._acked),
             name="dvr-viewer", daemon=True,
@@ -335,6 +354,8 @@ class Viewer(anywidget.AnyWidget):
                 self.status = f"refused a view from the page: side {msg.get('side')!r} is not one of {', '.join(_SIDES)}"
                 return
             self._pending.set("view", msg["side"], _seq(msg))
+        elif kind in ("channel", "time", "play"):
+            series.on_message(self, kind, msg, _seq(msg))
         elif kind in ("screenshot", "movie"):
             # Off the kernel's message thread: a movie takes seconds to minutes.
             threading.Thread(target=self._capture_from_page, args=(kind,), name=f"dvr-{kind}", daemon=True).start()
@@ -358,10 +379,23 @@ class Viewer(anywidget.AnyWidget):
                 self.status = "refused a transfer function from the page (not a list of control points)"
                 self._shown.pop("tf", None)  # the panel shows the renderer's again
                 return
-            self._pending.set("tf", points)
+            if self._n_channels:  # the points shown are tf_channel's
+                self._pending.merge("channels", self.tf_channel, {"tf": ("points", points)})
+            else:
+                self._pending.set("tf", points)
         elif name == "preset":
-            if value in self.presets:
+            if value in self.presets and self._n_channels:
+                self._pending.merge("channels", self.tf_channel, {"tf": ("preset", value)})
+            elif value in self.presets:
                 self._pending.set("preset", value)
+        elif name == "channel":
+            if not 0 <= value < max(1, self._n_channels):
+                self.status = f"channel {value!r} refused: the volume has {self._n_channels} channel(s)"
+                self._local.syncing = True
+                try:
+                    self.channel = change["old"]
+                finally:
+                    self._local.syncing = False
         elif name in ("denoiser", "split"):
             if value and value not in self.methods:
                 self.status = f"unknown denoiser {value!r}"
@@ -390,16 +424,22 @@ class Viewer(anywidget.AnyWidget):
 
     # Kernel to browser.
 
-    def _sync(self, view, tf):
-        """Shows the renderer's TF, clip planes, crop box and spp in the panel where
-        they differ from what it shows (whoever changed them)."""
+    def _sync(self, view, tf, extra):
+        """Shows the renderer's TF (or the chosen channel's), clip planes, crop box, spp
+        and channels in the panel where they differ from what it shows (whoever changed
+        them). `extra` is :func:`viewer_channels.read`'s."""
         a = tf["a"]
         state = {
-            "tf": (a["point"], a.get("name", "")),
+            "tf": (-1, a["point"], a.get("name", "")),
             "clip": [{"point": c["point"], "normal": c["normal"], "enabled": c.get("enabled", True)} for c in view.get("clip", [])],
             "crop": view.get("crop") or {},
             "spp": view.get("render", {}).get("spp", self.spp),
         }
+        if "channels" in extra:
+            # With channels, the renderer's one TF is not drawn: each channel has its own.
+            index = min(max(self.channel, 0), len(extra["channels"]) - 1)
+            state["channels"] = series.rows(extra["channels"])
+            state["tf"] = (index, *series.editor_tf(extra["channels"][index]))
         changed = {k: v for k, v in state.items() if self._shown.get(k) != v}
         if not changed:
             return
@@ -408,9 +448,12 @@ class Viewer(anywidget.AnyWidget):
         self._local.syncing = True
         try:
             if "tf" in changed:
-                points, name = changed["tf"]
-                self.tf_points = [dict(p) for p in points]
+                index, points, name = changed["tf"]
+                self.tf_channel = index
+                self._show("tf_points", [dict(p) for p in points])
                 self.preset = name if name in self.presets else ""
+            if "channels" in changed:
+                self._show("channels", changed["channels"])
             if "clip" in changed:
                 self.clip_planes = changed["clip"]
             if "crop" in changed:
@@ -426,6 +469,15 @@ class Viewer(anywidget.AnyWidget):
         finally:
             self._local.syncing = False
         self._shown.update(changed)
+
+    def _show(self, name, value):
+        """Sets a trait the panel shows; one already holding `value` is sent again, since
+        the page may show its own refused edit (a channel edit comes as a message, which
+        leaves the kernel's trait as it was)."""
+        if getattr(self, name) == value:
+            self.send_state(name)
+        else:
+            setattr(self, name, value)
 
 
 class _Pending:
@@ -450,6 +502,14 @@ class _Pending:
             if seq is not None:
                 self.seq = max(self.seq, seq)
 
+    def merge(self, kind, key, fields, seq=None):
+        """Edits of one item of `kind` (a channel, by index), field by field: each field
+        keeps its newest value."""
+        with self._lock:
+            self._edits.setdefault(kind, {}).setdefault(key, {}).update(fields)
+            if seq is not None:
+                self.seq = max(self.seq, seq)
+
     def take(self):
         with self._lock:
             edits, self._edits = self._edits, {}
@@ -462,6 +522,7 @@ def _render_loop(viewer_ref, renderer, pending, stop, acked):
     only weakly."""
     frames, started = 0, time.perf_counter()
     shown_at = []
+    playback = series.Playback()
     while not stop.is_set():
         viewer = viewer_ref()
         if viewer is None:
@@ -472,8 +533,10 @@ def _render_loop(viewer_ref, renderer, pending, stop, acked):
             edits, seq = pending.take()
             status = _apply(renderer, edits)
             try:
+                playback.step(renderer, viewer.times, viewer.playing, viewer.speed)
                 out = renderer.render()
                 view, tf = renderer._r.view(), renderer._r.tf()
+                extra = series.read(renderer, viewer._n_channels, viewer.times)
             except Exception as e:  # noqa: BLE001 - shown in the panel, then the loop ends
                 viewer.status = f"render failed: {e}"
                 return
@@ -486,11 +549,11 @@ def _render_loop(viewer_ref, renderer, pending, stop, acked):
             # A refused edit leaves the panel showing it: show the renderer's again.
             viewer._shown.clear()
         try:
-            viewer._sync(view, tf)
+            viewer._sync(view, tf, extra)
             image, names = _compose(out, viewer.denoiser, viewer.split, viewer.split_position)
             viewer._last = (renderer.frames_rendered, image)
             if acked.is_set() or now - viewer._sent_at > _ACK_TIMEOUT_S:
-                _send_frame(viewer, renderer, image, names, view["camera"], seq, shown_at, now - started)
+                _send_frame(viewer, renderer, image, names, view["camera"], extra.get("time"), seq, shown_at, now - started)
                 acked.clear()
                 viewer._sent_at = now
         except Exception as e:  # noqa: BLE001 - a frame lost is said, the loop goes on
@@ -498,7 +561,7 @@ def _render_loop(viewer_ref, renderer, pending, stop, acked):
         del viewer
 
 
-def _send_frame(viewer, renderer, image, names, camera, seq, shown_at, seconds):
+def _send_frame(viewer, renderer, image, names, camera, time_point, seq, shown_at, seconds):
     data = _native.encode_image(image, viewer._format, viewer._quality)
     fps = (len(shown_at) - 1) / (shown_at[-1] - shown_at[0]) if len(shown_at) > 1 else 0.0
     physical = viewer.volume.get("physical")
@@ -518,6 +581,8 @@ def _send_frame(viewer, renderer, image, names, camera, seq, shown_at, seconds):
             "orientation": panel.orientation(camera),
             # No bar where the volume's physical size is unknown (never a wrong one).
             "scale": panel.scale_bar(camera, image.shape[0], image.shape[1], physical) if physical else None,
+            # The time point shown (a series; None otherwise): the time slider follows it.
+            "time": time_point,
         },
         buffers=[data],
     )
@@ -559,6 +624,8 @@ def _apply(renderer, edits):
             renderer.pan(*edits["pan"])
         if "zoom" in edits:
             renderer.zoom(edits["zoom"][0])
+        # Last: a refused channel edit loses no camera move of the same frame.
+        series.apply(renderer, edits)
     except (ValueError, TypeError, RuntimeError) as e:
         return str(e)
     return ""

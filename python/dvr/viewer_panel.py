@@ -7,6 +7,7 @@ orientation letters, the scale bar)."""
 import math
 import os
 import re
+import warnings
 
 import numpy as np
 
@@ -144,12 +145,17 @@ def volume_info(renderer):
             # A raw file: its layout is in the scene; its values are not needed.
             dims, spacing = source["dims"], source.get("spacing", [1.0, 1.0, 1.0])
             return _info(tuple(dims), tuple(spacing), None)
-        elif "file" in source:
-            path = source["file"]
+        elif "file" in source or "files" in source:
+            # A series (channels in one file or one per file, time points): its first
+            # channel at its first time point has the grid the others share.
+            path = source["file"] if "file" in source else source["files"][0]
             try:
                 if os.path.getsize(path) > _MAX_RELOAD_BYTES:
                     return None
-                volume = _native.Volume.load(path)
+                with warnings.catch_warnings():
+                    # That the read keeps one of them is no news here: the renderer has all.
+                    warnings.simplefilter("ignore", _native.DataDroppedWarning)
+                    volume = _native.Volume.load(path)
             except (OSError, ValueError):
                 return None
         else:

@@ -1,10 +1,12 @@
-"""Shared fixtures: the repository's paths and the CLI binary the package is compared
-with (``DVR_BIN``, else the workspace's debug or release build)."""
+"""Shared fixtures: the repository's paths, the CLI binary the package is compared with
+(``DVR_BIN``, else the workspace's debug or release build), a small series of channels
+and time points, and the notebook tests' JupyterLab and browser."""
 
 import os
 import pathlib
 import shutil
 
+import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -21,6 +23,23 @@ def dvr_bin():
         if candidate and pathlib.Path(candidate).is_file():
             return str(candidate)
     pytest.fail("no dvr binary: build it (cargo build) or set DVR_BIN")
+
+
+@pytest.fixture(scope="session")
+def series_file(tmp_path_factory):
+    """A small series as an OME-TIFF written by tifffile: 2 channels ("core", a ball;
+    "shell", a shell around it that grows) × 4 time points, 16³ voxels."""
+    tifffile = pytest.importorskip("tifffile")
+    n = 16
+    z, y, x = np.mgrid[:n, :n, :n] / (n - 1) - 0.5
+    r = np.sqrt(x**2 + y**2 + z**2)
+    data = np.zeros((4, 2, n, n, n), np.uint16)
+    for t in range(4):
+        data[t, 0] = (r < 0.2) * 1000
+        data[t, 1] = (np.abs(r - (0.25 + 0.05 * t)) < 0.05) * 1000
+    path = tmp_path_factory.mktemp("series") / "series.ome.tif"
+    tifffile.imwrite(path, data, ome=True, metadata={"axes": "TCZYX", "Channel": {"Name": ["core", "shell"]}})
+    return path
 
 
 @pytest.fixture(autouse=True)

@@ -4,7 +4,8 @@ from another cell and a preset picked in the page, a point added to a preset rea
 kernel with the preset's points intact, the raw input shows in the split view, a clip
 plane is added from the cuts panel, a screenshot and a movie are written, an interrupted
 kernel stops the render loop, and a closed viewer leaves no thread and no renderer and
-its last frame in the saved notebook. The example notebooks run through nbclient."""
+its last frame in the saved notebook; a series' channels panel and time slider edit
+the view. The example notebooks run through nbclient."""
 
 import base64
 import json
@@ -183,6 +184,98 @@ def test_the_viewer_streams_takes_edits_and_stops(lab, browser):
 
     image = wait_for("the last frame in the saved notebook", saved_image)
     assert decode_png(base64.b64decode(image))[:2] == (48, 48)
+    page.close()
+
+
+def test_the_channels_panel_and_the_time_slider(lab, browser, series_file):
+    """A series of 2 channels × 4 time points: a channel switched off, a channel's
+    colour and TF edited and the time scrubbed and played from the page, each changing
+    the view; edits from another cell shown in the panel; no error in the page or the
+    status line. (The same server as the test above: one JupyterLab per session.)"""
+    write_notebook(
+        lab.root / "channels.ipynb",
+        [
+            "import dvr, json\n"
+            f"v = dvr.Viewer(dvr.Scene({str(series_file)!r}, tf='phantom-opaque'), size=(48, 48), denoisers=['ours'])\n"
+            "v",
+            "r = v.renderer\n"
+            "print('state', json.dumps({'visible': [c.visible for c in r.channels], 'colour': [c.colour for c in r.channels],"
+            " 'tf': [c.tf.name for c in r.channels], 'time': r.time, 'playing': v.playing, 'status': v.status}))",
+            "v.renderer.channels[0].colour = (1.0, 0.2, 0.2)\nv.renderer.time = 2.0",
+            "v.close()",
+        ],
+    )
+    page = browser.new_page(viewport={"width": 1400, "height": 1200})
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    nb = Notebook(page, lab, "channels.ipynb")
+    nb.run(0)
+
+    def state():
+        return json.loads(nb.run(1).split("state ", 1)[1])
+
+    def frame():
+        return int(page.locator(".dvr-frame-counter").inner_text())
+
+    first = wait_for("the first frame", lambda: image_stats(page, ".dvr-frame"))
+    rows = page.locator(".dvr-channel")
+    assert page.locator(".dvr-channel-name").all_inner_texts() == ["core", "shell"]
+    assert page.locator(".dvr-time").get_attribute("max") == "3"
+    page.locator(".dvr-channels").scroll_into_view_if_needed()
+
+    # The shell switched off: the ball inside shows, and the view changes.
+    before = shown_after(page, max(first[0], frame()))
+    rows.nth(1).locator(".dvr-channel-visible").uncheck()
+    wait_for("the shell hidden in the kernel", lambda: state()["visible"] == [True, False])
+    hidden = shown_after(page, frame() + 1)
+    assert difference(before, hidden) > 5.0, difference(before, hidden)
+
+    # The ball's colour picked: red in the kernel and in the view.
+    rows.nth(0).locator(".dvr-channel-colour").fill("#ff0000")
+    wait_for("the colour in the kernel", lambda: state()["colour"][0] == [1.0, 0.0, 0.0])
+    red = shown_after(page, frame() + 1)
+    assert (red[1] - red[3]) - (hidden[1] - hidden[3]) > 5.0, (hidden[:4], red[:4])  # redder than blue
+
+    # The editor edits the ball's TF: a preset picked for it reaches channel 0 only.
+    assert rows.nth(0).locator(".dvr-channel-tf").is_checked()
+    page.select_option(".dvr-preset", "phantom-vessels")
+    wait_for("the ball's new TF", lambda: state()["tf"] == ["phantom-vessels", "phantom-opaque"])
+    assert page.locator(".dvr-tf .dvr-point").count() == len(dvr_tf("phantom-vessels"))
+    # Channel 1 picked in the panel: the editor shows its TF.
+    rows.nth(1).locator(".dvr-channel-tf").check()
+    wait_for("channel 1's TF in the editor", lambda: page.locator(".dvr-preset").input_value() == "phantom-opaque")
+    assert page.locator(".dvr-tf .dvr-point").count() == len(dvr_tf("phantom-opaque"))
+
+    # The time slider scrubbed (a click at 80% of it): the kernel's time and the view.
+    rows.nth(1).locator(".dvr-channel-visible").check()
+    wait_for("the shell back", lambda: state()["visible"] == [True, True])
+    still = shown_after(page, frame() + 1)
+    page.locator(".dvr-time").scroll_into_view_if_needed()
+    box = page.locator(".dvr-time").bounding_box()
+    page.mouse.click(box["x"] + 0.8 * box["width"], box["y"] + box["height"] / 2)
+    t = wait_for("the scrubbed time in the kernel", lambda: (t := state()["time"]) > 1.5 and t)
+    assert 2.0 < t < 2.9, t
+    later = shown_after(page, frame() + 1)
+    assert difference(still, later) > 2.0, difference(still, later)
+    # Played: the slider moves with the frames; paused, it stays.
+    page.click(".dvr-play")
+    wait_for("playing", lambda: state()["playing"])
+    shown_time = lambda: float(page.locator(".dvr-time").input_value())  # noqa: E731
+    start = shown_time()
+    wait_for("the slider following playback", lambda: shown_time() != start)
+    page.click(".dvr-play")
+    wait_for("paused", lambda: not state()["playing"])
+
+    # Edits from another cell: the panel shows them.
+    nb.run(2)
+    wait_for("the cell's colour in the panel", lambda: rows.nth(0).locator(".dvr-channel-colour").input_value() == "#ff3333")
+    wait_for("the cell's time on the slider", lambda: shown_time() == 2.0)
+    assert page.locator(".dvr-time-value").inner_text().startswith("2.00")
+
+    # No error anywhere.
+    assert state()["status"] == "" and page.locator(".dvr-status").inner_text() == "", page.locator(".dvr-status").inner_text()
+    assert errors == []
+    nb.run(3)
     page.close()
 
 

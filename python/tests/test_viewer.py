@@ -447,3 +447,166 @@ def test_a_closed_viewer_leaves_its_last_frame_in_the_output(monkeypatch):
     assert kw2["display_id"] == kw["display_id"] and kw2["raw"]
     assert decode_png(base64.b64decode(out["image/png"]))[:2] == (12, 10)
     assert "closed" in out["text/plain"]
+
+
+# Channels and time points: the channels panel and the time slider.
+
+
+@pytest.fixture
+def series_viewer(monkeypatch, series_file):
+    sent, resent = Recorder(), []
+    monkeypatch.setattr(dvr.Viewer, "send", lambda self, content, buffers=None: sent(content, buffers))
+    monkeypatch.setattr(dvr.Viewer, "send_state", lambda self, key=None: resent.append(key))
+    v = dvr.Viewer(dvr.Scene(str(series_file), tf="phantom-opaque"), size=(16, 16), denoisers=["ours"])
+    yield v, sent, resent
+    v.close()
+
+
+def test_channel_and_time_messages_are_checked_then_applied_by_the_render_thread(series_viewer):
+    v, sent, _ = series_viewer
+    r = v.renderer
+    assert [c["name"] for c in v.channels] == ["core", "shell"] and v.times == 4 and v.tf_channel == 0
+    assert frames_after(sent, v, 0)[0]["time"] == 0.0
+    # Refused with a reason, and nothing reaches the renderer: indices out of range or
+    # not whole numbers, colours outside [0, 1] or not three numbers, visible not a bool,
+    # unknown fields, times outside the series, speeds of none or too many.
+    for msg, reason in [
+        ({"type": "channel", "index": 2, "visible": False}, "not a channel"),
+        ({"type": "channel", "index": -1, "visible": False}, "not a channel"),
+        ({"type": "channel", "index": True, "visible": False}, "not a channel"),
+        ({"type": "channel", "index": "0", "visible": False}, "not a channel"),
+        ({"type": "channel", "index": 0, "colour": [1, 0, 1.5]}, "colour"),
+        ({"type": "channel", "index": 0, "colour": [-0.1, 0, 0]}, "colour"),
+        ({"type": "channel", "index": 0, "colour": [float("nan"), 0, 0]}, "colour"),
+        ({"type": "channel", "index": 0, "colour": [1, 0]}, "colour"),
+        ({"type": "channel", "index": 0, "colour": "#ff0000"}, "colour"),
+        ({"type": "channel", "index": 0, "visible": 0}, "visible"),
+        ({"type": "channel", "index": 0, "visible": "false"}, "visible"),
+        ({"type": "channel", "index": 0, "window": [0, 1]}, "unknown field"),
+        ({"type": "channel", "index": 0}, "nothing to edit"),
+        ({"type": "channel", "index": 0, "preset": "no-such"}, "preset"),
+        ({"type": "channel", "index": 0, "tf": "no"}, "tf"),
+        ({"type": "time", "time": 3.5}, "from 0 to 3"),
+        ({"type": "time", "time": -0.01}, "from 0 to 3"),
+        ({"type": "time", "time": float("nan")}, "from 0 to 3"),
+        ({"type": "time", "time": "1"}, "from 0 to 3"),
+        ({"type": "play", "speed": 0}, "speed"),
+        ({"type": "play", "speed": 1e6}, "speed"),
+        ({"type": "play", "playing": 1}, "playing"),
+    ]:
+        v._on_message(v, msg, [])
+        assert reason in v.status, (msg, v.status)
+    time.sleep(0.3)
+    assert [(c.visible, c.colour) for c in r.channels] == [(True, (1.0, 1.0, 1.0))] * 2
+    assert r.time == 0.0 and not v.playing and v.speed == 4.0 and v.running
+    # A flood of colours for one channel is one pending edit, its newest colour.
+    for i in range(1000):
+        v._on_message(v, {"type": "channel", "index": 0, "colour": [i / 999, 0.5, 0.25], "seq": 1}, [])
+    assert len(v._pending._edits.get("channels", {})) <= 1
+    before = v._last[1].copy()
+    v._on_message(v, {"type": "channel", "index": 1, "visible": False}, [])
+    v._on_message(v, {"type": "time", "time": 2.5, "seq": 2}, [])
+    wait_for("the edits in the renderer", lambda: r.time == 2.5 and not r.channels[1].visible)
+    assert r.channels[0].colour == pytest.approx((1.0, 0.5, 0.25))
+    # The panel shows them, the frames carry the time, and the view changed.
+    wait_for("the rows", lambda: [(c["visible"], c["colour"]) for c in v.channels] == [(True, pytest.approx([1.0, 0.5, 0.25])), (False, [1.0, 1.0, 1.0])])
+    content, _ = frames_after(sent, v, len(sent.frames))
+    assert content["time"] == 2.5 and content["seq"] >= 2
+    assert np.abs(v._last[1] - before).mean() > 1e-3
+    # A TF preset for the second channel from the page.
+    v._on_message(v, {"type": "channel", "index": 1, "preset": "phantom-vessels"}, [])
+    wait_for("the preset on channel 1", lambda: r.channels[1].tf.name == "phantom-vessels")
+    assert r.channels[0].tf.name == "phantom-opaque"
+
+
+def test_playback_moves_the_time_on_from_the_render_thread_and_loops(series_viewer):
+    v, sent, _ = series_viewer
+    r = v.renderer
+    v._on_message(v, {"type": "play", "playing": True, "speed": 2.0}, [])
+    assert v.playing and v.speed == 2.0
+    # Sampled as it plays: it moves on by the wall clock (2 time points a second), a
+    # little each frame, and loops after the last time point (3).
+    seen, start = [r.time], time.monotonic()
+    while time.monotonic() - start < 20 and not (len(seen) > 1 and seen[-1] < seen[-2]):
+        seen.append(r.time)
+        time.sleep(0.01)
+    elapsed = time.monotonic() - start
+    steps = np.diff(seen)
+    assert (steps[:-1] > 0).sum() > 5 and (steps[:-1] >= 0).all(), "small steps forward, one per frame"
+    assert (steps[:-1] <= 2.0 * 0.25 + 1e-6).all() and steps[-1] < -2.0, "then a loop back to the start"
+    # About 2 time points a second of wall clock: less where a frame was slower than
+    # the step's cap of a quarter second; more by up to one step, the first, which
+    # counts from the frame before playback began (before the sampling did).
+    moved = steps.sum() + 3.0
+    assert 0.5 * 2.0 * elapsed < moved <= 2.0 * (elapsed + 0.25), (moved, elapsed)
+    # A time from the page while playing: playback goes on from there.
+    v.speed = 0.5
+    v._on_message(v, {"type": "time", "time": 0.5}, [])
+    wait_for("the page's time", lambda: 0.5 <= r.time < 1.0)
+    # Paused: the time stays.
+    v._on_message(v, {"type": "play", "playing": False}, [])
+    n = r.frames_rendered
+    wait_for("frames", lambda: r.frames_rendered > n + 2)
+    paused = r.time
+    wait_for("more frames", lambda: r.frames_rendered > n + 6)
+    assert r.time == paused
+    # A speed set from Python that the page could not ask for plays nothing (the render
+    # thread goes on).
+    v.speed, v.playing = float("nan"), True
+    n = r.frames_rendered
+    wait_for("frames", lambda: r.frames_rendered > n + 4)
+    assert r.time == paused and v.running
+
+
+def test_the_channels_panel_and_tf_editor_follow_the_renderer(series_viewer):
+    v, sent, resent = series_viewer
+    r = v.renderer
+    # Edits from another cell show in the panel, and the time in the frames.
+    r.channels[1].visible = False
+    r.channels[0].colour = (0.2, 0.4, 0.6)
+    r.time = 1.25
+    wait_for("the cell's edits in the rows", lambda: [c["visible"] for c in v.channels] == [True, False] and v.channels[0]["colour"] == pytest.approx([0.2, 0.4, 0.6]))
+    wait_for("the cell's time in a frame", lambda: frames_after(sent, v, len(sent.frames))[0]["time"] == 1.25)
+    # A TF in data units on channel 0: the editor shows it over the channel's window
+    # (0 to 1000 here), and says which channel it edits.
+    r.channels[0].tf = "stat-zscore"
+    zscore = [p["density"] for p in dvr.TransferFunction.preset("stat-zscore").points]
+    lo, hi = r.channels[0].window
+    wait_for("channel 0's TF in the editor", lambda: v.preset == "stat-zscore")
+    assert v.tf_channel == 0 and [p["density"] for p in v.tf_points] == pytest.approx([(d - lo) / (hi - lo) for d in zscore])
+    # Edited in the page (an opacity): it stays in data units, its densities as they
+    # were, and the editor shows the same numbers again.
+    shown = [dict(p) for p in v.tf_points]
+    shown[0]["opacity"] = 0.5
+    v._on_message(v, {"type": "channel", "index": 0, "tf": shown}, [])
+    wait_for("the edit in the renderer", lambda: r.channels[0].tf.name == "edited")
+    tf = r.channels[0].tf
+    assert tf.units == "data" and [p["density"] for p in tf.points] == pytest.approx(zscore, abs=1e-3)
+    assert tf.points[0]["opacity"] == pytest.approx(0.5)
+    wait_for("the edited TF in the editor", lambda: v.preset == "" and v.tf_points[0]["opacity"] == pytest.approx(0.5))
+    assert [p["density"] for p in v.tf_points] == [p["density"] for p in shown]
+    # A TF the engine refuses: said, and the editor's points sent to the page again
+    # (the page shows its refused edit; the kernel's trait never changed).
+    resent.clear()
+    v._on_message(v, {"type": "channel", "index": 0, "tf": [dict(shown[0], opacity=7.0), shown[-1]]}, [])
+    wait_for("the refusal", lambda: "opacity" in v.status)
+    wait_for("the editor's points sent again", lambda: "tf_points" in resent)
+    # The page picks channel 1: the editor shows its TF; Python's tf_points and
+    # preset go to the channel shown.
+    v.channel = 1
+    wait_for("channel 1's TF in the editor", lambda: v.tf_channel == 1 and v.preset == "phantom-opaque")
+    v.preset = "phantom-vessels"
+    wait_for("the preset on channel 1", lambda: r.channels[1].tf.name == "phantom-vessels")
+    assert r.channels[0].tf.name == "edited"
+    v.channel = 2
+    assert "channel 2 refused" in v.status and v.channel == 1
+
+
+def test_a_volume_of_one_field_shows_neither_panel(viewer):
+    v, sent = viewer
+    content, _ = frames_after(sent, v, 0)
+    assert v.channels == [] and v.times == 1 and v.tf_channel == -1 and content["time"] is None
+    v._on_message(v, {"type": "time", "time": 0.0}, [])
+    assert "one time point" in v.status
+    v._on_message(v, {"type": "channel", "index": 0, "visible": False}, [])
+    assert "not a channel" in v.status and v.running
