@@ -70,6 +70,25 @@ fn voxels_any(
     Ok((voxels, dtype.is_equiv_to(&numpy::dtype::<f64>(py))))
 }
 
+/// The grid (x, y, z voxels) of an array whose last three axes are z, y, x: an error
+/// names an empty array or one too large.
+fn grid_of(shape: &[usize], name: &str) -> PyResult<[u32; 3]> {
+    if shape.contains(&0) {
+        return Err(value_error(format!(
+            "{name}: the array is empty (shape {shape:?})"
+        )));
+    }
+    let too_big = |n: usize| {
+        u32::try_from(n).map_err(|_| value_error(format!("{name}: shape {shape:?} is too large")))
+    };
+    let n = shape.len();
+    Ok([
+        too_big(shape[n - 1])?,
+        too_big(shape[n - 2])?,
+        too_big(shape[n - 3])?,
+    ])
+}
+
 /// A volume of several channels or time points: `a` is `(C, Z, Y, X)` or
 /// `(T, C, Z, Y, X)`; each channel is normalised through the window of its first time
 /// point, as a file's series is.
@@ -88,15 +107,7 @@ fn from_series_array(
     };
     let lead = shape.len() - 3;
     let (z, y, x) = (shape[lead], shape[lead + 1], shape[lead + 2]);
-    if shape.contains(&0) {
-        return Err(value_error(format!(
-            "{name}: the array is empty (shape {shape:?})"
-        )));
-    }
-    let too_big = |n: usize| {
-        u32::try_from(n).map_err(|_| value_error(format!("{name}: shape {shape:?} is too large")))
-    };
-    let dims = [too_big(x)?, too_big(y)?, too_big(z)?];
+    let dims = grid_of(&shape, name)?;
     let flat = a.call_method1("reshape", ((times * count, z, y, x),))?;
     let mut blocks = Vec::with_capacity(times);
     let mut wide = false;
@@ -183,17 +194,7 @@ impl Volume {
                 "{name}: channels= picks channels of a [c, z, y, x] or [t, c, z, y, x] array; this one is 3-D"
             )));
         }
-        let shape = a.shape();
-        if shape.contains(&0) {
-            return Err(value_error(format!(
-                "{name}: the array is empty (shape {shape:?})"
-            )));
-        }
-        let too_big = |n: usize| {
-            u32::try_from(n)
-                .map_err(|_| value_error(format!("{name}: shape {shape:?} is too large")))
-        };
-        let dims = [too_big(shape[2])?, too_big(shape[1])?, too_big(shape[0])?];
+        let dims = grid_of(a.shape(), name)?;
         let (voxels, wide) = voxels_any(py, a, name)?;
         let spacing = [spacing.2 as f32, spacing.1 as f32, spacing.0 as f32];
         let mut inner = py
