@@ -170,3 +170,34 @@ fn mean_square(img: &[[f32; 4]]) -> f64 {
         .sum::<f64>()
         / (img.len() * 3) as f64
 }
+
+#[test]
+fn a_played_scene_follows_its_channel_keys() {
+    // The microscopy scene switches channel 1 off at frame 24: capture and eval play
+    // scenes through the session, which must take the key as the references do.
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/assets/scenes/development/microscopy-orbit.toml"
+    );
+    let scene = dvr_engine::scene::Scene::load(path).expect("scene");
+    let size = dvr_engine::graph::Extent {
+        width: 16,
+        height: 16,
+    };
+    let setup = dvr_engine::renderer::scene_setup::SceneSetup::new(scene, size, Some(1), 32)
+        .expect("setup");
+    assert!(setup.frame_inputs(23).lut != setup.frame_inputs(24).lut);
+    let mut s =
+        dvr_engine::session::Session::new(setup.clone(), context(), &["none"]).expect("session");
+    for (f, shown) in [(23, true), (24, false), (30, false)] {
+        s.play(f).expect("play");
+        assert_eq!(s.view().channels[1].visible, shown, "frame {f}");
+        let live = s.view().lut();
+        assert_eq!(
+            dvr_engine::renderer::uploads::LutUpload::from(&live),
+            setup.frame_inputs(f).lut,
+            "frame {f}: the session's LUT is the scene's"
+        );
+    }
+    assert_validation_clean();
+}

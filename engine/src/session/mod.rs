@@ -269,14 +269,20 @@ impl Session {
     }
 
     /// Sets the view the scene's animation has at `frame` (camera, lights, TF blend and
-    /// shift): a scripted animation is these edits, one frame after another.
+    /// shift, time point, channels): a scripted animation is these edits, one frame
+    /// after another.
     pub fn play(&mut self, frame: u32) -> Result<Vec<FrameResult>> {
         let view = self.setup.scene.view_at(frame);
         self.orbit.set_spec(&view.camera);
         self.view.camera = view.camera;
         self.view.cut = view.cut;
         self.view.time = view.time;
+        let channels = view.channels != self.view.channels;
+        self.view.channels = view.channels;
         self.set_tf(view.tf);
+        if channels {
+            self.lut = self.view.lut();
+        }
         // The scene's lights were checked with the scene, every frame's values too.
         self.set_lights(view.lights)
     }
