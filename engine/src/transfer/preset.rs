@@ -74,6 +74,8 @@ mod tests {
 
     /// A 12-bit CT's Hounsfield range: where the data-unit presets are looked at.
     const CT_WINDOW: [f32; 2] = [-1024.0, 3071.0];
+    /// A z map's range: where the statistical-map presets are looked at.
+    const Z_WINDOW: [f32; 2] = [-10.0, 10.0];
 
     #[test]
     fn all_presets_load_and_are_valid() {
@@ -88,6 +90,14 @@ mod tests {
             let tf = TransferFunction::preset(name).unwrap_or_else(|e| panic!("{e}"));
             assert_eq!(&tf.name, name, "preset name must match its file");
             tf.validate().unwrap_or_else(|e| panic!("{e}"));
+            if tf.units == crate::transfer::TfUnits::Data && !name.starts_with("ct-") {
+                // A statistical map's preset: z = 0 (no effect) is clear, and it shows
+                // something over a z range.
+                let lut = tf.in_density(Z_WINDOW).lut();
+                assert!(lut.max_opacity() > 0.0, "{name} is invisible");
+                assert_eq!(tf.sample(0.0).opacity, 0.0, "{name}: z = 0 must be clear");
+                continue;
+            }
             let lut = tf.in_density(CT_WINDOW).lut();
             assert_eq!(lut.len(), LUT_SIZE);
             assert!(lut.max_opacity() > 0.0, "{name} is invisible");
