@@ -72,10 +72,13 @@ def test_any_array_is_a_volume_or_a_named_refusal(a, spacing):
     except (ValueError, TypeError) as e:
         refused(e, "array", "spacing", "dtype", "shape", "voxels")
         return
-    # Accepted: a 3-D array of a volume type, densities in [0, 1] and finite.
-    assert a.ndim == 3 and a.dtype in (np.uint8, np.uint16, np.int16, np.float32)
+    # Accepted: a 3-D array (or [c, z, y, x] channels, at most 4) of a volume type,
+    # densities in [0, 1] and finite.
+    assert a.ndim in (3, 4) and a.dtype in (np.uint8, np.uint16, np.int16, np.float32)
+    if a.ndim == 4:
+        assert v.channels == a.shape[0] <= 4 and v.times == 1
     d = v.to_numpy()
-    assert d.shape == a.shape and np.isfinite(d).all() and d.min() >= 0 and d.max() <= 1
+    assert d.shape == a.shape[-3:] and np.isfinite(d).all() and d.min() >= 0 and d.max() <= 1
     assert all(math.isfinite(s) and s > 0 for s in v.spacing)
 
 
