@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use dvr_engine::scene::Scene;
 use dvr_engine::transfer::TransferFunction;
+use dvr_engine::volume::labels::LabelTable;
 use dvr_engine::volume::{
     RawFormat, RawParams, Series, Volume, VolumeError, MAX_ANISOTROPY, MAX_DIM, MAX_SPACING_MM,
     MAX_VOXELS, MIN_SPACING_MM,
@@ -19,7 +20,7 @@ use dvr_engine::volume::{
 pub type Entry = fn(&[u8], &Path);
 
 /// Every target: its name (the folder under `fuzz/corpus/`) and its entry point.
-pub const TARGETS: [(&str, Entry); 9] = [
+pub const TARGETS: [(&str, Entry); 10] = [
     ("volume_nifti", volume_nifti),
     ("volume_nrrd", volume_nrrd),
     ("volume_nhdr", volume_nhdr),
@@ -29,6 +30,7 @@ pub const TARGETS: [(&str, Entry); 9] = [
     ("volume_ome_tiff", volume_ome_tiff),
     ("scene_toml", scene_toml),
     ("tf_toml", tf_toml),
+    ("label_table", label_table),
 ];
 
 /// Separates slice files in a `volume_dicom` input.
@@ -331,6 +333,19 @@ pub fn tf_toml(bytes: &[u8], _scratch: &Path) {
         if let Ok(tf) = TransferFunction::from_toml_str(text, "fuzz.toml") {
             let _ = tf.lut();
             let _ = TransferFunction::from_toml_str(&tf.to_toml(), "round-trip.toml");
+        }
+    }
+}
+
+/// A label table in both formats (ITK-SNAP's label description, Slicer's `.ctbl`), and
+/// completed with the values its own labels and a few more name.
+pub fn label_table(bytes: &[u8], _scratch: &Path) {
+    if let Ok(text) = std::str::from_utf8(bytes) {
+        for parse in [LabelTable::parse_itksnap, LabelTable::parse_slicer] {
+            if let Ok(mut t) = parse(text, Path::new("fuzz.label")) {
+                let values: Vec<u16> = t.labels.iter().map(|l| l.value.wrapping_add(1)).collect();
+                let _ = t.complete(&values);
+            }
         }
     }
 }

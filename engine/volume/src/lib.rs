@@ -59,6 +59,7 @@ mod error;
 pub mod files;
 mod formats;
 mod io;
+pub mod labels;
 mod majorant;
 mod nifti;
 mod normalise;

@@ -339,7 +339,7 @@ pub(crate) fn resample_onto(v: &Volume, dims: [u32; 3], onto: &PatientTransform)
 }
 
 /// Patient mm to (fractional) index.
-fn invert(t: PatientTransform) -> impl Fn([f64; 3]) -> [f64; 3] {
+pub(crate) fn invert(t: PatientTransform) -> impl Fn([f64; 3]) -> [f64; 3] {
     let m = t.axes; // columns
     let det = det3(m);
     // Rows of the inverse of the matrix whose columns are m[0], m[1], m[2].

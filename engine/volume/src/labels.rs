@@ -1,0 +1,121 @@
+//! Label maps: an integer volume (a segmentation: organs, a tumour, a parcellation) beside
+//! a density volume, read by the volume loaders (NIfTI, NRRD, OME-Zarr, raw) and put on
+//! the volume's grid by nearest neighbour through the patient transforms (interpolating
+//! label values makes labels that are not there). Its label table is `labels/table.rs`.
+
+mod table;
+
+pub use table::{Label, LabelTable, PALETTE};
+
+use crate::orientation::invert;
+use crate::{PatientTransform, SampleKind, Volume, VolumeError};
+use std::path::{Path, PathBuf};
+
+/// Largest label value: labels are held as u16.
+pub const MAX_LABEL: u32 = u16::MAX as u32;
+
+/// A label map on a grid: one label value per voxel, x fastest (RAS order, as volumes).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelMap {
+    pub name: String,
+    /// The file it was read from (errors name it).
+    pub path: PathBuf,
+    pub dims: [u32; 3],
+    pub to_patient: PatientTransform,
+    pub values: Vec<u16>,
+}
+
+impl LabelMap {
+    /// Reads an integer volume file as a label map. A float file, negative values or
+    /// values past [`MAX_LABEL`] are errors naming the file.
+    pub fn load(path: &Path) -> Result<Self, VolumeError> {
+        let v = Volume::load(path, None)?;
+        Self::from_volume(path, &v)
+    }
+
+    /// The label values of a loaded integer volume: its densities brought back through
+    /// its window (exact for integer samples: a window spans at most 65535 steps of the
+    /// 16-bit density, or the 8-bit values themselves).
+    pub fn from_volume(path: &Path, v: &Volume) -> Result<Self, VolumeError> {
+        let bad = |problem: String| VolumeError::MalformedHeader {
+            path: path.to_path_buf(),
+            field: "label values".into(),
+            problem,
+        };
+        if matches!(v.sample_kind, SampleKind::F32 | SampleKind::F64) {
+            return Err(bad(format!(
+                "{:?} samples: a label map holds integers (uint8, uint16, int16)",
+                v.sample_kind
+            )));
+        }
+        let [lo, hi] = v.window.map(f64::from);
+        let mut values = Vec::with_capacity(v.data.len());
+        for i in 0..v.data.len() {
+            let d = f64::from(v.data.get(i).unwrap_or(0.0));
+            let label = (lo + d * (hi - lo)).round();
+            if !(0.0..=f64::from(MAX_LABEL)).contains(&label) {
+                return Err(bad(format!(
+                    "voxel {i} holds {label}; labels are 0 to {MAX_LABEL} (0 is no label)"
+                )));
+            }
+            values.push(label as u16);
+        }
+        Ok(Self {
+            name: v.name.clone(),
+            path: path.to_path_buf(),
+            dims: v.dims,
+            to_patient: v.to_patient,
+            values,
+        })
+    }
+
+    /// The label at voxel (x, y, z); 0 outside.
+    pub fn at(&self, x: i64, y: i64, z: i64) -> u16 {
+        let [nx, ny, nz] = self.dims.map(i64::from);
+        if x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz {
+            return 0;
+        }
+        self.values[((z * ny + y) * nx + x) as usize]
+    }
+
+    /// The label map on the grid of `dims` voxels placed by `onto`, by nearest
+    /// neighbour: each voxel takes the label of the voxel its centre falls in (0 outside).
+    /// The same grid is returned as it is.
+    pub fn onto(&self, dims: [u32; 3], onto: &PatientTransform) -> Self {
+        if dims == self.dims && *onto == self.to_patient {
+            return self.clone();
+        }
+        let inverse = invert(self.to_patient);
+        let mut values = Vec::with_capacity(crate::voxel_count(dims) as usize);
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let p = onto.apply([f64::from(i), f64::from(j), f64::from(k)]);
+                    let q = inverse(p).map(|c| c.round() as i64);
+                    values.push(self.at(q[0], q[1], q[2]));
+                }
+            }
+        }
+        Self {
+            values,
+            dims,
+            to_patient: *onto,
+            ..self.clone()
+        }
+    }
+
+    /// The label values present (0, no label, left out), ascending.
+    pub fn present(&self) -> Vec<u16> {
+        let mut seen = vec![false; MAX_LABEL as usize + 1];
+        for &v in &self.values {
+            seen[usize::from(v)] = true;
+        }
+        (1..=MAX_LABEL as usize)
+            .filter(|&v| seen[v])
+            .map(|v| v as u16)
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests;

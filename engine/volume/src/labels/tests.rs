@@ -1,0 +1,125 @@
+use super::*;
+use crate::write::{self, NiftiData};
+
+fn dir() -> tempfile::TempDir {
+    tempfile::tempdir().expect("tempdir")
+}
+
+#[test]
+fn integer_label_maps_keep_their_values_in_every_type() {
+    let d = dir();
+    let dims = [5, 4, 3];
+    let n = 60;
+    let wide: Vec<u16> = (0..n).map(|i| [0, 1, 7, 300, 40000][i % 5]).collect();
+    let cases = [
+        ("u8.nii", NiftiData::U8((0..n).map(|i| (i % 6) as u8).collect()), (0..n).map(|i| (i % 6) as u16).collect::<Vec<_>>()),
+        ("i16.nii", NiftiData::I16((0..n).map(|i| (i % 3) as i16 * 1000).collect()), (0..n).map(|i| (i % 3) as u16 * 1000).collect()),
+        ("u16.nii.gz", NiftiData::U16(wide.clone()), wide),
+    ];
+    for (name, data, want) in cases {
+        let path = d.path().join(name);
+        write::nifti(&path, dims, [1.0; 3], &data, None);
+        let map = LabelMap::load(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(map.dims, dims);
+        assert_eq!(map.values, want, "{name}");
+    }
+}
+
+#[test]
+fn float_and_negative_label_maps_are_refused_naming_the_file() {
+    let d = dir();
+    let f = d.path().join("prob.nii");
+    write::nifti(&f, [2, 2, 2], [1.0; 3], &NiftiData::F32(vec![0.5; 8]), None);
+    let msg = LabelMap::load(&f).unwrap_err().to_string();
+    assert!(msg.contains("prob.nii") && msg.contains("integers"), "{msg}");
+    let neg = d.path().join("neg.nii");
+    write::nifti(&neg, [2, 2, 2], [1.0; 3], &NiftiData::I16(vec![-3, 0, 1, 2, 0, 0, 0, 1]), None);
+    let msg = LabelMap::load(&neg).unwrap_err().to_string();
+    assert!(msg.contains("neg.nii") && msg.contains("-3"), "{msg}");
+}
+
+#[test]
+fn nearest_neighbour_puts_labels_on_a_finer_grid_without_new_values() {
+    // 2 mm labels onto a 1 mm grid over the same box: every fine voxel takes the label of
+    // the coarse voxel its centre falls in, and no value appears that was not there.
+    let coarse = LabelMap {
+        name: "seg".into(),
+        path: "seg.nii".into(),
+        dims: [2, 2, 2],
+        to_patient: PatientTransform::aligned([2.0; 3]),
+        values: vec![0, 1, 2, 3, 4, 5, 6, 7],
+    };
+    let fine = PatientTransform {
+        origin: [-0.5; 3],
+        ..PatientTransform::aligned([1.0; 3])
+    };
+    let m = coarse.onto([4, 4, 4], &fine);
+    assert_eq!(m.present(), vec![1, 2, 3, 4, 5, 6, 7]);
+    // Fine voxel (i, j, k) lies at i - 0.5 mm: coarse index (i - 0.5) / 2, rounded.
+    for (i, j, k) in [(0, 0, 0), (3, 0, 0), (0, 3, 3), (2, 2, 2), (1, 1, 1)] {
+        let c = |x: i64| ((x as f64 - 0.5) / 2.0).round() as i64;
+        assert_eq!(m.at(i, j, k), coarse.at(c(i), c(j), c(k)), "({i}, {j}, {k})");
+    }
+    // Outside the labelled box: no label.
+    let far = PatientTransform {
+        origin: [100.0; 3],
+        ..PatientTransform::aligned([1.0; 3])
+    };
+    assert!(coarse.onto([2, 2, 2], &far).values.iter().all(|&v| v == 0));
+}
+
+#[test]
+fn itksnap_and_slicer_tables_read_as_their_tools_write_them() {
+    let itk = r#"################################################
+# ITK-SnAP Label Description File
+# Columns = IDX -R- -G- -B- -A-- VIS MSH LABEL
+################################################
+    0     0    0    0        0  0  0    "Clear Label"
+    1   255    0    0        1  1  1    "White Matter"
+    2     0  255    0      0.5  0  1    "Grey matter, cortical"
+"#;
+    let t = LabelTable::parse_itksnap(itk, Path::new("seg.label")).expect("itk-snap");
+    assert_eq!(t.labels.len(), 3);
+    let wm = t.get(1).expect("label 1");
+    assert_eq!((wm.name.as_str(), wm.colour, wm.opacity, wm.visible), ("White Matter", [1.0, 0.0, 0.0], 1.0, true));
+    let gm = t.get(2).expect("label 2");
+    assert_eq!((gm.name.as_str(), gm.opacity, gm.visible), ("Grey matter, cortical", 0.5, false));
+
+    let ctbl = "# Color table file seg.ctbl\n# 2 values\n0 Background 0 0 0 0\n5 liver 221 130 101 255\n17 kidney 185 102 83 128\n";
+    let t = LabelTable::parse_slicer(ctbl, Path::new("seg.ctbl")).expect("slicer");
+    assert_eq!(t.labels.iter().map(|l| l.value).collect::<Vec<_>>(), vec![0, 5, 17]);
+    let k = t.get(17).expect("kidney");
+    assert_eq!(k.name, "kidney");
+    assert!((k.opacity - 128.0 / 255.0).abs() < 1e-6 && (k.colour[0] - 185.0 / 255.0).abs() < 1e-6);
+}
+
+#[test]
+fn table_mistakes_name_the_file_and_line() {
+    let cases = [
+        ("a.label", "# c\n 1 255 0 0 1 1 1 \"ok\"\n 2 256 0 0 1 1 1 \"bad\"\n", "line 3", "R \"256\""),
+        ("b.label", " 1 255 0 0 1.5 1 1 \"x\"\n", "line 1", "opacity"),
+        ("c.label", " 1 255 0 0 1 1 \"x\"\n", "line 1", "6 numbers"),
+        ("d.label", " 1 255 0 0 1 1 1 x\n", "line 1", "LABEL"),
+        ("e.ctbl", "1 liver 1 2 3\n", "line 1", "5 fields"),
+        ("f.ctbl", "x liver 1 2 3 4\n", "line 1", "label value"),
+        ("g.ctbl", "1 a 1 2 3 4\n1 b 1 2 3 4\n", "label table", "given twice"),
+    ];
+    let d = dir();
+    for (name, text, at, what) in cases {
+        let path = d.path().join(name);
+        write::text(&path, text);
+        let msg = LabelTable::load(&path).unwrap_err().to_string();
+        assert!(msg.contains(name) && msg.contains(at) && msg.contains(what), "{name}: {msg}");
+    }
+}
+
+#[test]
+fn labels_a_table_lacks_take_palette_colours_and_are_listed() {
+    let mut t = LabelTable::parse_slicer("3 skull 200 200 180 255\n", Path::new("t.ctbl")).expect("table");
+    let added = t.complete(&[0, 2, 3, 14]);
+    assert_eq!(added, vec![2, 14]);
+    assert_eq!(t.get(2).map(|l| l.colour), Some(PALETTE[2]));
+    assert_eq!(t.get(14).map(|l| l.name.as_str()), Some("label 14"));
+    assert_eq!(t.get(3).map(|l| l.name.as_str()), Some("skull"));
+    assert!(t.get(0).is_none(), "0 is no label");
+}
