@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Soaks of live sessions with random edits (python/tests/soak.py): a Python renderer for
-10,000 renders, the explorer under Xvfb for 10,000 frames, the notebook viewer left
+10,000 renders, a 4D series played for 10,000 frames, the explorer under Xvfb for 10,000 frames, the notebook viewer left
 refining for 30 minutes. Prints each session's figures and writes them, with the
 command, commit and machine, to the CSV given; exits 1 if one fails (resident memory
 more than 5 % above the warm-up's, device memory grown, or a validation message).
@@ -32,14 +32,17 @@ def main():
     ap.add_argument("--renders", type=int, default=10_000)
     ap.add_argument("--frames", type=int, default=10_000)
     ap.add_argument("--minutes", type=float, default=30.0)
-    ap.add_argument("--only", choices=["python", "explorer", "notebook"], action="append")
+    ap.add_argument("--only", choices=["python", "series", "explorer", "notebook"], action="append")
     ap.add_argument("--out", type=pathlib.Path, required=True)
     args = ap.parse_args()
-    only = set(args.only or ["python", "explorer", "notebook"])
+    only = set(args.only or ["python", "series", "explorer", "notebook"])
     dvr_bin = os.environ.get("DVR_BIN", str(ROOT / "target/debug/dvr"))
     rows = []
     if "python" in only:
         rows.append(soak.python_session(args.renders))
+        print(rows[-1], flush=True)
+    if "series" in only:
+        rows.append(soak.series_session(args.renders))
         print(rows[-1], flush=True)
     if "explorer" in only:
         rows.append(soak.explorer_session(dvr_bin, args.frames))

@@ -120,6 +120,37 @@ def python_session(renders, seed=0, size=(32, 32)):
     )
 
 
+def series_session(renders, seed=0, size=(32, 32)):
+    """A 4D series (the beating shell, 24 time points) played for `renders` frames at a
+    fractional time that moves on each frame (two time points interpolated, the next read
+    ahead), with a random jump now and then; the warm-up plays one whole beat."""
+    rng = random.Random(seed)
+    messages = dvr._native.validation_messages()
+    scene = dvr.Scene.load(str(pathlib.Path(__file__).resolve().parents[2] / "assets/scenes/development/shell-beat-still.toml"))
+    r = dvr.Renderer(scene, size=size, denoisers=["ours"])
+    last = r.times - 1
+    started = time.perf_counter()
+    t = 0.0
+
+    def step():
+        nonlocal t
+        t = rng.uniform(0, last) if rng.random() < 0.02 else (t + 0.37) % last
+        r.time = t
+        r.render()
+
+    for _ in range(int(last / 0.37) + 1):
+        step()
+    rss_warm, gpu_warm = rss_mib(), r.gpu_memory()["allocated"] / 2**20
+    for _ in range(renders):
+        step()
+    rss_end, gpu_end = rss_mib(), r.gpu_memory()["allocated"] / 2**20
+    r.close()
+    return _row(
+        "4D series played", renders, time.perf_counter() - started, (rss_warm, rss_end),
+        (gpu_warm, gpu_end), dvr._native.validation_messages() - messages,
+    )
+
+
 def explorer_script(frames, seed=0, size=64):
     """A --script of random edits over `frames` frames: the first 60 frames make every
     kind once (the warm-up), the last 20 return to the first size and denoiser."""

@@ -1,5 +1,5 @@
-"""Short soaks of live sessions (soak.py): a Python renderer, the explorer under Xvfb
-and the notebook viewer, each with random edits, hold resident memory within 5 % after
+"""Short soaks of live sessions (soak.py): a Python renderer, a 4D series played, the
+explorer under Xvfb and the notebook viewer, each with random edits, hold resident memory within 5 % after
 the warm-up and device memory flat, with no validation message. `tools/soak.py` runs
 the long ones (10,000 frames, 30 minutes) and records them."""
 
@@ -13,6 +13,10 @@ def check(row):
 
 def test_a_python_renderer_soaks():
     check(soak.python_session(renders=300))
+
+
+def test_a_series_plays_for_long():
+    check(soak.series_session(renders=300))
 
 
 def test_the_explorer_soaks(dvr_bin):
