@@ -2,13 +2,15 @@
 """The datasets that multi-channel and time-series rendering are tested and shown on,
 written the way people's files are written (nibabel, tifffile, ome-zarr-py).
 
-    tools/datasets.py {statmap,microscopy,beating-shell,all} [--out DIR]
+    tools/datasets.py {statmap,microscopy,beating-shell,mni-labels,all} [--out DIR]
 
 `statmap` copies nilearn's sample statistical map (MNI space, 3 mm) out of the installed
 nilearn wheel, byte for byte. `microscopy` is a synthetic 3-channel fluorescence stack
 (nuclei, membranes, a sparse marker) with photon noise, as OME-Zarr and OME-TIFF.
 `beating-shell` is a 4D NIfTI of a heart-like shell beating once over 24 time points,
-with vessels on its wall that move with it.
+with vessels on its wall that move with it. `mni-labels` segments the MNI152 template
+into white and grey matter from its own tissue probability maps (in nilearn's wheel), as
+a NIfTI label map with an ITK-SNAP label file.
 
 Everything is made from fixed seeds and closed-form shapes, so a run writes the same
 voxels as the files committed under `assets/volumes/` (the tests regenerate and compare).
@@ -248,6 +250,40 @@ def beating_shell_frame(t: int) -> np.ndarray:
     return density
 
 
+# The MNI152 segmentation: (value, name, ITK-SNAP RGB) of each label, made from the
+# template's own tissue probability maps in nilearn's wheel.
+TISSUES = [(1, "White matter", (245, 240, 225)), (2, "Grey matter", (205, 110, 95))]
+
+
+def write_mni_labels(out: pathlib.Path) -> list:
+    """White matter where its probability passes one half, grey matter where its does
+    (and white matter's does not), on the T1's grid; with an ITK-SNAP label file."""
+    import nibabel as nib
+
+    base = statmap_source().parent
+    prob = {n: nib.load(base / f"mni_icbm152_{n}_tal_nlin_sym_09a_converted.nii.gz") for n in ("wm", "gm")}
+    wm = prob["wm"].get_fdata() > 127.5
+    gm = (prob["gm"].get_fdata() > 127.5) & ~wm
+    labels = np.where(wm, 1, np.where(gm, 2, 0)).astype(np.uint8)
+    img = nib.Nifti1Image(labels, prob["wm"].affine)
+    img.header.set_xyzt_units("mm")
+    img.header.set_qform(prob["wm"].affine, code=1)
+    img.header.set_sform(prob["wm"].affine, code=1)
+    path = out / "mni152_labels.nii.gz"
+    nib.save(img, path)
+    table = out / "mni152_labels.label"
+    lines = [
+        "################################################",
+        "# ITK-SnAP Label Description File",
+        "# Columns = IDX -R- -G- -B- -A-- VIS MSH LABEL",
+        "################################################",
+        '    0     0    0    0        0  0  0    "Clear Label"',
+    ]
+    lines += [f'{v:5d} {r:5d}{g:5d}{b:5d}        1  1  1    "{name}"' for v, name, (r, g, b) in TISSUES]
+    table.write_text("\n".join(lines) + "\n")
+    return [path, table]
+
+
 def write_beating_shell(out: pathlib.Path) -> list:
     import nibabel as nib
 
@@ -265,7 +301,12 @@ def write_beating_shell(out: pathlib.Path) -> list:
     return [path]
 
 
-WRITERS = {"statmap": write_statmap, "microscopy": write_microscopy, "beating-shell": write_beating_shell}
+WRITERS = {
+    "statmap": write_statmap,
+    "microscopy": write_microscopy,
+    "beating-shell": write_beating_shell,
+    "mni-labels": write_mni_labels,
+}
 
 
 def main(argv=None):

@@ -166,3 +166,23 @@ def test_the_vessels_ride_on_the_wall():
     vessel_r = [r[data[..., t] >= 220].mean() for t in (6, 18)]
     assert vessel_r[0] / vessel_r[1] == pytest.approx(1.15 / 0.85, rel=0.05)
     assert all(np.count_nonzero(data[..., t] >= 220) > 500 for t in range(24))
+
+
+def test_the_committed_mni_labels_are_what_the_tool_writes(tmp_path):
+    out = write("mni-labels", tmp_path)
+    for name in ("mni152_labels.nii.gz",):
+        ours, theirs = nib.load(VOLUMES / name), nib.load(out / name)
+        assert np.array_equal(ours.get_fdata(), theirs.get_fdata()) and np.allclose(ours.affine, theirs.affine)
+    assert (VOLUMES / "mni152_labels.label").read_text() == (out / "mni152_labels.label").read_text()
+
+
+def test_the_mni_labels_lie_on_the_t1_grid_and_follow_the_tissue_maps():
+    labels = nib.load(VOLUMES / "mni152_labels.nii.gz")
+    t1 = nib.load(VOLUMES / "mni152_t1.nii.gz")
+    assert labels.shape == t1.shape and np.allclose(labels.affine, t1.affine)
+    a = np.asarray(labels.dataobj)
+    assert a.dtype == np.uint8 and set(np.unique(a)) == {0, 1, 2}
+    # White matter is brighter than grey matter in a T1: the labels agree with the image.
+    t = t1.get_fdata()
+    assert t[a == 1].mean() > t[a == 2].mean() + 20
+    assert 0.05 < (a == 1).mean() < 0.2 and 0.05 < (a == 2).mean() < 0.2

@@ -45,13 +45,14 @@ impl LabelTable {
     /// Reads a table file: `.ctbl` is a Slicer colour table, anything else an ITK-SNAP
     /// label description file.
     pub fn load(path: &Path) -> Result<Self, VolumeError> {
-        let text = crate::files::read_text(path, crate::files::MAX_TEXT_FILE_BYTES).map_err(|e| {
-            VolumeError::MalformedHeader {
-                path: path.to_path_buf(),
-                field: "label table".into(),
-                problem: e.to_string(),
-            }
-        })?;
+        let text =
+            crate::files::read_text(path, crate::files::MAX_TEXT_FILE_BYTES).map_err(|e| {
+                VolumeError::MalformedHeader {
+                    path: path.to_path_buf(),
+                    field: "label table".into(),
+                    problem: e.to_string(),
+                }
+            })?;
         let slicer = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("ctbl"));
@@ -70,7 +71,9 @@ impl LabelTable {
             let (numbers, name) = match line.find('"') {
                 Some(q) => {
                     let rest = &line[q + 1..];
-                    let end = rest.rfind('"').ok_or_else(|| err("the label's name has no closing quote".into()))?;
+                    let end = rest
+                        .rfind('"')
+                        .ok_or_else(|| err("the label's name has no closing quote".into()))?;
                     (&line[..q], rest[..end].to_string())
                 }
                 None => return Err(err("expected IDX R G B A VIS MSH \"LABEL\"".into())),
@@ -90,7 +93,13 @@ impl LabelTable {
                 "1" => true,
                 v => return Err(err(format!("VIS {v:?} must be 0 or 1"))),
             };
-            labels.push(Label { value, name, colour, opacity, visible });
+            labels.push(Label {
+                value,
+                name,
+                colour,
+                opacity,
+                visible,
+            });
         }
         Self::checked(labels, origin)
     }
@@ -102,7 +111,10 @@ impl LabelTable {
             let err = |problem: String| line_error(origin, n, problem);
             let f: Vec<&str> = line.split_whitespace().collect();
             if f.len() != 6 {
-                return Err(err(format!("{} fields; expected 6 (value name R G B A)", f.len())));
+                return Err(err(format!(
+                    "{} fields; expected 6 (value name R G B A)",
+                    f.len()
+                )));
             }
             let value = parse_value(f[0]).map_err(err)?;
             let colour = rgb255(&f[2..5]).map_err(err)?;

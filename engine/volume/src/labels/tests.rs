@@ -12,8 +12,16 @@ fn integer_label_maps_keep_their_values_in_every_type() {
     let n = 60;
     let wide: Vec<u16> = (0..n).map(|i| [0, 1, 7, 300, 40000][i % 5]).collect();
     let cases = [
-        ("u8.nii", NiftiData::U8((0..n).map(|i| (i % 6) as u8).collect()), (0..n).map(|i| (i % 6) as u16).collect::<Vec<_>>()),
-        ("i16.nii", NiftiData::I16((0..n).map(|i| (i % 3) as i16 * 1000).collect()), (0..n).map(|i| (i % 3) as u16 * 1000).collect()),
+        (
+            "u8.nii",
+            NiftiData::U8((0..n).map(|i| (i % 6) as u8).collect()),
+            (0..n).map(|i| (i % 6) as u16).collect::<Vec<_>>(),
+        ),
+        (
+            "i16.nii",
+            NiftiData::I16((0..n).map(|i| (i % 3) as i16 * 1000).collect()),
+            (0..n).map(|i| (i % 3) as u16 * 1000).collect(),
+        ),
         ("u16.nii.gz", NiftiData::U16(wide.clone()), wide),
     ];
     for (name, data, want) in cases {
@@ -31,9 +39,18 @@ fn float_and_negative_label_maps_are_refused_naming_the_file() {
     let f = d.path().join("prob.nii");
     write::nifti(&f, [2, 2, 2], [1.0; 3], &NiftiData::F32(vec![0.5; 8]), None);
     let msg = LabelMap::load(&f).unwrap_err().to_string();
-    assert!(msg.contains("prob.nii") && msg.contains("integers"), "{msg}");
+    assert!(
+        msg.contains("prob.nii") && msg.contains("integers"),
+        "{msg}"
+    );
     let neg = d.path().join("neg.nii");
-    write::nifti(&neg, [2, 2, 2], [1.0; 3], &NiftiData::I16(vec![-3, 0, 1, 2, 0, 0, 0, 1]), None);
+    write::nifti(
+        &neg,
+        [2, 2, 2],
+        [1.0; 3],
+        &NiftiData::I16(vec![-3, 0, 1, 2, 0, 0, 0, 1]),
+        None,
+    );
     let msg = LabelMap::load(&neg).unwrap_err().to_string();
     assert!(msg.contains("neg.nii") && msg.contains("-3"), "{msg}");
 }
@@ -58,7 +75,11 @@ fn nearest_neighbour_puts_labels_on_a_finer_grid_without_new_values() {
     // Fine voxel (i, j, k) lies at i - 0.5 mm: coarse index (i - 0.5) / 2, rounded.
     for (i, j, k) in [(0, 0, 0), (3, 0, 0), (0, 3, 3), (2, 2, 2), (1, 1, 1)] {
         let c = |x: i64| ((x as f64 - 0.5) / 2.0).round() as i64;
-        assert_eq!(m.at(i, j, k), coarse.at(c(i), c(j), c(k)), "({i}, {j}, {k})");
+        assert_eq!(
+            m.at(i, j, k),
+            coarse.at(c(i), c(j), c(k)),
+            "({i}, {j}, {k})"
+        );
     }
     // Outside the labelled box: no label.
     let far = PatientTransform {
@@ -81,13 +102,22 @@ fn itksnap_and_slicer_tables_read_as_their_tools_write_them() {
     let t = LabelTable::parse_itksnap(itk, Path::new("seg.label")).expect("itk-snap");
     assert_eq!(t.labels.len(), 3);
     let wm = t.get(1).expect("label 1");
-    assert_eq!((wm.name.as_str(), wm.colour, wm.opacity, wm.visible), ("White Matter", [1.0, 0.0, 0.0], 1.0, true));
+    assert_eq!(
+        (wm.name.as_str(), wm.colour, wm.opacity, wm.visible),
+        ("White Matter", [1.0, 0.0, 0.0], 1.0, true)
+    );
     let gm = t.get(2).expect("label 2");
-    assert_eq!((gm.name.as_str(), gm.opacity, gm.visible), ("Grey matter, cortical", 0.5, false));
+    assert_eq!(
+        (gm.name.as_str(), gm.opacity, gm.visible),
+        ("Grey matter, cortical", 0.5, false)
+    );
 
     let ctbl = "# Color table file seg.ctbl\n# 2 values\n0 Background 0 0 0 0\n5 liver 221 130 101 255\n17 kidney 185 102 83 128\n";
     let t = LabelTable::parse_slicer(ctbl, Path::new("seg.ctbl")).expect("slicer");
-    assert_eq!(t.labels.iter().map(|l| l.value).collect::<Vec<_>>(), vec![0, 5, 17]);
+    assert_eq!(
+        t.labels.iter().map(|l| l.value).collect::<Vec<_>>(),
+        vec![0, 5, 17]
+    );
     let k = t.get(17).expect("kidney");
     assert_eq!(k.name, "kidney");
     assert!((k.opacity - 128.0 / 255.0).abs() < 1e-6 && (k.colour[0] - 185.0 / 255.0).abs() < 1e-6);
@@ -96,30 +126,78 @@ fn itksnap_and_slicer_tables_read_as_their_tools_write_them() {
 #[test]
 fn table_mistakes_name_the_file_and_line() {
     let cases = [
-        ("a.label", "# c\n 1 255 0 0 1 1 1 \"ok\"\n 2 256 0 0 1 1 1 \"bad\"\n", "line 3", "R \"256\""),
+        (
+            "a.label",
+            "# c\n 1 255 0 0 1 1 1 \"ok\"\n 2 256 0 0 1 1 1 \"bad\"\n",
+            "line 3",
+            "R \"256\"",
+        ),
         ("b.label", " 1 255 0 0 1.5 1 1 \"x\"\n", "line 1", "opacity"),
         ("c.label", " 1 255 0 0 1 1 \"x\"\n", "line 1", "6 numbers"),
         ("d.label", " 1 255 0 0 1 1 1 x\n", "line 1", "LABEL"),
         ("e.ctbl", "1 liver 1 2 3\n", "line 1", "5 fields"),
         ("f.ctbl", "x liver 1 2 3 4\n", "line 1", "label value"),
-        ("g.ctbl", "1 a 1 2 3 4\n1 b 1 2 3 4\n", "label table", "given twice"),
+        (
+            "g.ctbl",
+            "1 a 1 2 3 4\n1 b 1 2 3 4\n",
+            "label table",
+            "given twice",
+        ),
     ];
     let d = dir();
     for (name, text, at, what) in cases {
         let path = d.path().join(name);
         write::text(&path, text);
         let msg = LabelTable::load(&path).unwrap_err().to_string();
-        assert!(msg.contains(name) && msg.contains(at) && msg.contains(what), "{name}: {msg}");
+        assert!(
+            msg.contains(name) && msg.contains(at) && msg.contains(what),
+            "{name}: {msg}"
+        );
     }
 }
 
 #[test]
 fn labels_a_table_lacks_take_palette_colours_and_are_listed() {
-    let mut t = LabelTable::parse_slicer("3 skull 200 200 180 255\n", Path::new("t.ctbl")).expect("table");
+    let mut t =
+        LabelTable::parse_slicer("3 skull 200 200 180 255\n", Path::new("t.ctbl")).expect("table");
     let added = t.complete(&[0, 2, 3, 14]);
     assert_eq!(added, vec![2, 14]);
     assert_eq!(t.get(2).map(|l| l.colour), Some(PALETTE[2]));
     assert_eq!(t.get(14).map(|l| l.name.as_str()), Some("label 14"));
     assert_eq!(t.get(3).map(|l| l.name.as_str()), Some("skull"));
     assert!(t.get(0).is_none(), "0 is no label");
+}
+
+#[test]
+fn the_mni_segmentation_and_its_itksnap_table_load_on_the_t1_grid() {
+    let volumes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/volumes");
+    let map = LabelMap::load(&volumes.join("mni152_labels.nii.gz")).expect("label map");
+    let t1 = Volume::load(&volumes.join("mni152_t1.nii.gz"), None).expect("t1");
+    assert_eq!((map.dims, map.to_patient), (t1.dims, t1.to_patient));
+    assert_eq!(map.present(), vec![1, 2]);
+    let mut table = LabelTable::load(&volumes.join("mni152_labels.label")).expect("table");
+    assert!(
+        table.complete(&map.present()).is_empty(),
+        "the table names every label"
+    );
+    let names: Vec<&str> = table.labels.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(names, vec!["Clear Label", "White matter", "Grey matter"]);
+    // White matter is brighter than grey matter in the T1 it was made from.
+    let mean = |label: u16| {
+        let (sum, n) = map
+            .values
+            .iter()
+            .zip(0..)
+            .filter(|(&v, _)| v == label)
+            .fold((0.0, 0u32), |(s, n), (_, i)| {
+                (s + f64::from(t1.data.get(i).unwrap_or(0.0)), n + 1)
+            });
+        sum / f64::from(n.max(1))
+    };
+    assert!(
+        mean(1) > mean(2) + 0.05,
+        "white {} grey {}",
+        mean(1),
+        mean(2)
+    );
 }
