@@ -556,9 +556,12 @@ def cut_frames(metrics):
     return {sc: worst_margin(frames, ["svgf", "taa"]) for sc, frames in frames_by_scene(metrics).items()}
 
 
-def b_cuts():
-    rows = read_csv("cuts", "summary.csv")
-    metrics = read_csv("cuts", "metrics.csv")
+def set_table(folder):
+    """Mean PSNR per scene of an eval set run at 128×128 over 48 frames with 256-spp
+    references, with ours' closest frame after frame 4 to the better of svgf and taa, and
+    ours against oidn-aux on the mean; its source line."""
+    rows = read_csv(folder, "summary.csv")
+    metrics = read_csv(folder, "metrics.csv")
     methods = present(rows, ["none", "taa", "svgf", "oidn", "oidn-aux", "ours"])
     worst = cut_frames(metrics)
     body = []
@@ -579,10 +582,18 @@ def b_cuts():
         "",
         table(header, body),
         "",
-        source("cuts", ["summary.csv", "metrics.csv"]),
-        "",
-        newer_runs_note(scenes_of(rows)),
+        source(folder, ["summary.csv", "metrics.csv"]),
     ])
+
+
+def b_cuts():
+    rows = read_csv("cuts", "summary.csv")
+    return "\n".join([set_table("cuts"), "", newer_runs_note(scenes_of(rows))])
+
+
+def b_media():
+    """The channel and time scenes: several fields in one medium, 4D series played."""
+    return set_table("media")
 
 
 def newer_runs_note(scenes):
@@ -599,24 +610,33 @@ def newer_runs_note(scenes):
             f"(commit {cuts['commit']}).")
 
 
-def b_cuts_line():
-    """README's sentence on the cut scenes: ours against oidn-aux per scene, and its
-    closest frame to the better of svgf and taa after frame 4."""
-    rows = read_csv("cuts", "summary.csv")
-    worst = cut_frames(read_csv("cuts", "metrics.csv"))
+def set_line(folder, what):
+    """README's sentence on an eval set: ours against oidn-aux per scene, and its closest
+    frame to the better of svgf and taa after frame 4."""
+    rows = read_csv(folder, "summary.csv")
+    worst = cut_frames(read_csv(folder, "metrics.csv"))
     psnr = {(r["scene"], r["method"]): num(r["psnr"]) for r in rows}
     scenes = scenes_of(rows)
     pairs = ", ".join(f"`{sc}` {fmt(psnr[(sc, 'ours')], 2)} / {fmt(psnr.get((sc, 'oidn-aux')), 2)}"
                       for sc in scenes)
     closest = min((w for w in worst.values() if w), key=lambda w: w[0])
-    meta = read_json("cuts", "meta.json")
+    meta = read_json(folder, "meta.json")
+    versus = (f"is above the better of `svgf` and `taa` on every frame (closest {closest[0]:+.2f} dB)"
+              if closest[0] >= 0 else
+              f"falls below the better of `svgf` and `taa` (at worst {closest[0]:+.2f} dB, frame {closest[1]})")
     return (
-        f"Mean PSNR (dB) of `ours` / `oidn-aux` on the cut scenes, 128×128, 48 frames, 256-spp "
-        f"references: {pairs}. After frame 4, `ours` is above the better of `svgf` and `taa` on "
-        f"every frame (closest {closest[0]:+.2f} dB). Commit {meta['commit']} (the validation "
-        "scene's later run is in the results' validation table); source: "
-        "`assets/results/cuts/`."
+        f"Mean PSNR (dB) of `ours` / `oidn-aux` on {what}, 128×128, 48 frames, 256-spp "
+        f"references: {pairs}. After frame 4, `ours` {versus}. Commit {meta['commit']}"
     )
+
+
+def b_cuts_line():
+    return (set_line("cuts", "the cut scenes") + " (the validation scene's later run is in the "
+            "results' validation table); source: `assets/results/cuts/`.")
+
+
+def b_media_line():
+    return set_line("media", "the channel and time scenes") + "; source: `assets/results/media/`."
 
 
 def b_cut_cost():
@@ -729,6 +749,8 @@ BLOCKS = {
     "viewer-line": (b_viewer_line, ["viewer/viewer.csv"]),
     "soak": (b_soak, ["soak/soak.csv"]),
     "cuts": (b_cuts, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json", "validation/meta.json"]),
+    "media": (b_media, ["media/summary.csv", "media/metrics.csv", "media/meta.json"]),
+    "media-line": (b_media_line, ["media/summary.csv", "media/metrics.csv", "media/meta.json"]),
     "cuts-line": (b_cuts_line, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json"]),
     "cut-cost": (b_cut_cost, ["cut-cost/profile.csv"]),
     "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv",
