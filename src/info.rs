@@ -1,11 +1,13 @@
 //! `dvr info`: what a volume file (or a list of files) holds as a series: its grid,
 //! spacing, orientation, channels and time points, read as the renderer would read them
 //! (`dvr_engine::volume::Series`). Reads the headers and time point 0 of each selected
-//! channel (which fixes the channels' windows); no GPU.
+//! channel (which fixes the channels' windows); no GPU. With `--labels`, the labels a
+//! label map holds, named by its table.
 
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
+use dvr_engine::volume::labels::{Label, LabelMap, LabelTable, MAX_LABEL};
 use dvr_engine::volume::{Series, SeriesInfo};
 
 /// What `dvr info` was asked.
@@ -26,9 +28,20 @@ pub struct InfoArgs {
     /// Print JSON (for scripts) instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Read the file as a label map (a segmentation): list the labels it holds, with
+    /// their voxel counts and, from `--label-table`, names and colours.
+    #[arg(long)]
+    pub labels: bool,
+    /// The label map's table: an ITK-SNAP label description file, or a Slicer colour
+    /// table (`.ctbl`). Labels it lacks take palette colours.
+    #[arg(long, requires = "labels")]
+    pub label_table: Option<PathBuf>,
 }
 
 pub fn run(args: &InfoArgs) -> Result<()> {
+    if args.labels {
+        return labels(args);
+    }
     let sel = args.channels.as_deref();
     let glob = args.paths.iter().any(|p| {
         p.file_name()
@@ -134,4 +147,63 @@ fn to_text(info: &SeriesInfo) -> String {
         );
     }
     s
+}
+
+/// `--labels`: the labels a label map holds, each with its voxel count and its table
+/// entry (name, colour, opacity, shown).
+fn labels(args: &InfoArgs) -> Result<()> {
+    let path = &args.paths[0];
+    let map = LabelMap::load(path).with_context(|| format!("reading {}", path.display()))?;
+    let mut table = match &args.label_table {
+        Some(t) => LabelTable::load(t).with_context(|| format!("reading {}", t.display()))?,
+        None => LabelTable::default(),
+    };
+    let present = map.present();
+    let unnamed = table.complete(&present);
+    if args.label_table.is_some() && !unnamed.is_empty() {
+        log::warn!(
+            "{}: label(s) {unnamed:?} are not in the table; they take palette colours",
+            path.display()
+        );
+    }
+    let mut counts = vec![0u64; MAX_LABEL as usize + 1];
+    for &v in &map.values {
+        counts[usize::from(v)] += 1;
+    }
+    let rows: Vec<(u16, &Label, u64)> = present
+        .iter()
+        .filter_map(|&v| table.get(v).map(|l| (v, l, counts[usize::from(v)])))
+        .collect();
+    let hex = |c: [f32; 3]| {
+        let b = c.map(|x| (x.clamp(0.0, 1.0) * 255.0).round() as u8);
+        format!("{:02X}{:02X}{:02X}", b[0], b[1], b[2])
+    };
+    if args.json {
+        let labels: Vec<serde_json::Value> = rows
+            .iter()
+            .map(|(v, l, n)| {
+                serde_json::json!({"value": v, "name": l.name, "colour": hex(l.colour),
+                    "opacity": l.opacity, "visible": l.visible, "voxels": n})
+            })
+            .collect();
+        let out = serde_json::json!({"name": map.name, "dims": map.dims, "labels": labels});
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        let [x, y, z] = map.dims;
+        println!(
+            "{}\n  grid    {x} x {y} x {z} voxels (RAS order)\n  labels  {}",
+            map.name,
+            rows.len()
+        );
+        for (v, l, n) in rows {
+            println!(
+                "    {v}: {} (colour {}, opacity {}, {}), {n} voxels",
+                l.name,
+                hex(l.colour),
+                l.opacity,
+                if l.visible { "shown" } else { "hidden" }
+            );
+        }
+    }
+    Ok(())
 }

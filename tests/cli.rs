@@ -795,3 +795,40 @@ fn info_prints_a_series_channels_and_time_points() {
     let out = dvr(&["info", many.to_str().expect("utf-8 path")]);
     assert_error(&out, &["many.nii", "5 channels", "channels = [0, 2]"]);
 }
+
+#[test]
+fn info_lists_a_label_maps_labels_named_by_its_table() {
+    let volumes = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/volumes/");
+    let map = format!("{volumes}mni152_labels.nii.gz");
+    let table = format!("{volumes}mni152_labels.label");
+    let out = dvr(&["info", &map, "--labels", "--label-table", &table, "--json"]);
+    assert_ok(&out);
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let labels = info["labels"].as_array().expect("labels");
+    let names: Vec<&str> = labels.iter().filter_map(|l| l["name"].as_str()).collect();
+    assert_eq!(names, vec!["White matter", "Grey matter"]);
+    assert_eq!(labels[0]["colour"], "F5F0E1");
+    assert!(labels.iter().all(|l| l["voxels"].as_u64() > Some(100_000)));
+    // Without a table, palette colours and numbered names.
+    let out = dvr(&["info", &map, "--labels"]);
+    assert_ok(&out);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("1: label 1"));
+    // A float map is no label map; a bad table names its line.
+    let out = dvr(&[
+        "info",
+        &format!("{volumes}mni152_statmap.nii.gz"),
+        "--labels",
+    ]);
+    assert_error(&out, &["mni152_statmap.nii.gz", "float32", "integers"]);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let bad = dir.path().join("bad.ctbl");
+    std::fs::write(&bad, "# table\n1 wm 300 0 0 255\n").expect("write");
+    let out = dvr(&[
+        "info",
+        &map,
+        "--labels",
+        "--label-table",
+        bad.to_str().expect("utf-8"),
+    ]);
+    assert_error(&out, &["bad.ctbl", "line 2", "R \"300\""]);
+}

@@ -44,8 +44,8 @@ impl LabelMap {
         };
         if matches!(v.sample_kind, SampleKind::F32 | SampleKind::F64) {
             return Err(bad(format!(
-                "{:?} samples: a label map holds integers (uint8, uint16, int16)",
-                v.sample_kind
+                "{} samples: a label map holds integers (uint8, uint16, int16)",
+                v.sample_kind.name()
             )));
         }
         let [lo, hi] = v.window.map(f64::from);
