@@ -253,7 +253,9 @@ fn resample(path: &Path, v: Volume, t: PatientTransform) -> Result<Volume, Volum
             hi[r] = hi[r].max(p[r]);
         }
     }
-    let out_dims = [0, 1, 2].map(|r| (((hi[r] - lo[r]) / vox[r]) - 1e-9).ceil() as i64 + 1);
+    // In f64 before the (saturating) cast: a header's extreme axes give a span past
+    // i64, which validate_dims then refuses by name.
+    let out_dims = [0, 1, 2].map(|r| ((((hi[r] - lo[r]) / vox[r]) - 1e-9).ceil() + 1.0) as i64);
     let out_dims = crate::validate_dims(path, out_dims)?;
     let inverse = invert(t);
     let n = crate::voxel_count(out_dims) as usize;
