@@ -201,3 +201,59 @@ fn a_played_scene_follows_its_channel_keys() {
     }
     assert_validation_clean();
 }
+
+#[test]
+fn channel_sections_need_a_volume_of_channels() {
+    // On a built-in volume they would be ignored: an error naming the section.
+    let base = "[volume]\nbuiltin = \"cloud\"\n[transfer]\na = \"cloud\"\n[[light]]\nkind = \"point\"\nposition = [1.0, 1.0, 1.0]\nintensity = 10.0\n";
+    let err = dvr_engine::scene::Scene::from_toml_str(
+        &format!("{base}[[channel]]\nvisible = false\n"),
+        "s.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("channel") && err.contains("one field"),
+        "{err}"
+    );
+    let keys = format!("{base}[[animation.channel]]\nindex = 0\nframe = 3\nvisible = false\n");
+    let err = dvr_engine::scene::Scene::from_toml_str(&keys, "s.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("animation.channel") && err.contains("one field"),
+        "{err}"
+    );
+    // More sections than the file has channels; one section on a one-channel file applies.
+    let t1 = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/assets/volumes/mni152_t1.nii.gz"
+    );
+    let file = format!("[volume]\nfile = \"{t1}\"\n[transfer]\na = \"mri-faint\"\n[[light]]\nkind = \"point\"\nposition = [1.0, 1.0, 1.0]\nintensity = 10.0\n");
+    let size = dvr_engine::graph::Extent {
+        width: 8,
+        height: 8,
+    };
+    let setup = |text: String| {
+        let scene = dvr_engine::scene::Scene::from_toml_str(&text, "t1.toml").expect("parses");
+        dvr_engine::renderer::scene_setup::SceneSetup::new(scene, size, None, 32)
+    };
+    let err = setup(format!("{file}[[channel]]\n[[channel]]\n"))
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        err.contains("2 [[channel]] sections for a volume of 1 channel"),
+        "{err}"
+    );
+    let tinted =
+        setup(format!("{file}[[channel]]\ncolour = [1.0, 0.0, 0.0]\n")).expect("one channel");
+    assert_eq!(tinted.volume.channels(), 1);
+    let lut = tinted.frame_inputs(0).lut;
+    assert!(
+        lut.diffuse_opacity
+            .iter()
+            .all(|d| d[1] == 0.0 && d[2] == 0.0),
+        "tinted red"
+    );
+}

@@ -22,8 +22,8 @@ impl Channels {
 }
 
 /// The scene's channels at time point 0 when its volume has several channels or time
-/// points (or the scene picks channels): `None` for one field at one time, which loads
-/// as a single volume.
+/// points (or the scene picks channels, or gives `[[channel]]` sections): `None` for one
+/// field at one time, which loads as a single volume.
 pub fn load_channels(scene: &Scene) -> Result<Option<Channels>, VolumeError> {
     let picked = scene.volume.channels.as_deref();
     let series = match &scene.volume.source {
@@ -32,7 +32,12 @@ pub fn load_channels(scene: &Scene) -> Result<Option<Channels>, VolumeError> {
         VolumeSource::File { path, raw: None } => {
             let series = Series::open(path, picked)?;
             let info = series.info();
-            if picked.is_none() && info.channels.len() == 1 && info.times == 1 {
+            // `[[channel]]` sections (a colour, a window) apply to one channel too.
+            if picked.is_none()
+                && scene.channels.is_empty()
+                && info.channels.len() == 1
+                && info.times == 1
+            {
                 return Ok(None);
             }
             series

@@ -95,6 +95,16 @@ impl SceneSetup {
             }
         })?;
         let views = super::medium::channel_views(&scene, &channels);
+        if scene.channels.len() > views.len() {
+            return Err(SetupError::Invalid {
+                scene: scene.name.clone(),
+                problem: format!(
+                    "channel: {} [[channel]] sections for a volume of {} channel(s)",
+                    scene.channels.len(),
+                    views.len()
+                ),
+            });
+        }
         let one_channel_kept = views.len() == 1 && scene.channels.is_empty();
         if let Some(c0) = views.first() {
             // Channel 0's TF is the scene's `transfer.a`, over the channel's window

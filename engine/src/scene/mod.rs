@@ -216,6 +216,7 @@ impl Scene {
             ));
         }
         self.volume.check(ctx)?;
+        self.check_channel_sections(ctx)?;
         let tf_err = |field: &str| {
             let field = field.to_string();
             move |source| SceneError::Transfer {
@@ -265,6 +266,25 @@ impl Scene {
     /// on [a, b − 1], and the minimum of |direction| (or of |direction × up|) over
     /// that range is at the integer frames around the continuous minimum. An orbit
     /// keeps both constant, so it needs none.
+    /// `[[channel]]` sections and channel keys need a volume that can hold channels (a
+    /// file read as a series, or `files`): a built-in or raw volume has one field, and
+    /// sections on it would be ignored without a word.
+    fn check_channel_sections(&self, ctx: &Ctx) -> Result<(), SceneError> {
+        let one_field = matches!(
+            &self.volume.source,
+            VolumeSource::Builtin { .. } | VolumeSource::File { raw: Some(_), .. }
+        );
+        let why = "a built-in or raw volume has one field; channels come from `[volume] file` \
+                   (a file of channels) or `files` (one per file)";
+        if one_field && !self.channels.is_empty() {
+            return Err(ctx.invalid("channel", why));
+        }
+        if one_field && !self.animation.channel.is_empty() {
+            return Err(ctx.invalid("animation.channel", why));
+        }
+        Ok(())
+    }
+
     fn camera_closest_approaches(&self) -> Vec<u32> {
         if self.animation.orbit.is_some() || self.animation.camera.is_empty() {
             return Vec::new();

@@ -26,9 +26,23 @@ pub struct LabelMap {
 }
 
 impl LabelMap {
-    /// Reads an integer volume file as a label map. A float file, negative values or
-    /// values past [`MAX_LABEL`] are errors naming the file.
+    /// Reads an integer volume file as a label map. A float file, negative values,
+    /// values past [`MAX_LABEL`] or an oblique grid are errors naming the file.
     pub fn load(path: &Path) -> Result<Self, VolumeError> {
+        // The loaders put an oblique grid on RAS axes by trilinear resampling, which
+        // would mix label values: refused until a nearest-neighbour path exists.
+        let oblique = crate::formats::open_series(path)?
+            .info()
+            .orientation
+            .is_some_and(|t| t.is_oblique());
+        if oblique {
+            return Err(VolumeError::Unsupported {
+                path: path.to_path_buf(),
+                reason: "an oblique label map (its axes are tilted from R, A, S): putting it \
+                         on RAS axes would interpolate label values"
+                    .into(),
+            });
+        }
         let v = Volume::load(path, None)?;
         Self::from_volume(path, &v)
     }

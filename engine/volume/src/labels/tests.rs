@@ -201,3 +201,19 @@ fn the_mni_segmentation_and_its_itksnap_table_load_on_the_t1_grid() {
         mean(2)
     );
 }
+
+#[test]
+fn an_oblique_label_map_is_refused_rather_than_interpolated() {
+    let d = dir();
+    let path = d.path().join("tilted.nii");
+    // An sform rotated 30° about x: the loaders would resample it trilinearly.
+    let (c, s) = (30f32.to_radians().cos(), 30f32.to_radians().sin());
+    let sform = [[1.0, 0.0, 0.0, 0.0], [0.0, c, -s, 0.0], [0.0, s, c, 0.0]];
+    let data = NiftiData::U8((0..27).map(|i| (i % 3) as u8).collect());
+    write::nifti_series(&path, [3, 3, 3], [1, 1], [1.0; 3], &data, None, Some(sform));
+    let msg = LabelMap::load(&path).unwrap_err().to_string();
+    assert!(
+        msg.contains("tilted.nii") && msg.contains("oblique"),
+        "{msg}"
+    );
+}
