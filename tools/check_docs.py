@@ -7,8 +7,9 @@
    docs/src/ (where the Markdown is read) and docs/book/ (where the HTML is).
 2. The Markdown outside the book (README.md, OVERVIEW.md, CHANGELOG.md, python/README.md):
    the same for their relative links, anchors by GitHub's heading slugs.
-3. OVERVIEW.md names every tracked source file (by path or file name), so the walk
-   through the code stays whole.
+3. OVERVIEW.md names every tracked source file by a path that resolves to it alone
+   (its full path, or its path from the folder its section or table row stands in; see
+   `named_files`), so the walk through the code stays whole.
 4. README.md stays the front door: at most 200 lines.
 
     tools/check_docs.py [--book docs/book] [--no-book]
@@ -19,6 +20,7 @@ Exits 1 naming every broken link, missing anchor and unnamed file.
 import argparse
 import html.parser
 import os
+import posixpath
 import re
 import subprocess
 import sys
@@ -141,52 +143,86 @@ def check_markdown(rel):
     return errors
 
 
-def sections(text):
-    """(heading, line) for every line of a Markdown text, with the `##` heading above it."""
-    heading = ""
-    for line in text.splitlines():
+TOKEN = re.compile(r"`([^`\n]+)`")
+
+
+def tracked_files():
+    """Every file git tracks, repository-relative; None outside a git checkout."""
+    try:
+        return set(subprocess.run(["git", "ls-files"], cwd=ROOT, check=True,
+                                  capture_output=True, text=True).stdout.split())
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
+def _join(folder, rel):
+    return posixpath.normpath(posixpath.join(folder, rel)) if folder else posixpath.normpath(rel)
+
+
+def named_files(overview, tracked):
+    """The tracked files OVERVIEW.md names, each by a path that resolves to it alone.
+
+    A backticked path names a file when it resolves to exactly one tracked file against
+    the folders its line stands in: the section's folder (a heading that starts with a
+    folder, `## engine/volume — …`, else the repository root), the folder a table row's
+    first cell names in it (`src/` there), and every folder the line names below those
+    (`eval/`, then `plan/`). A full repository path names its file anywhere. A
+    path that resolves to several files (`mod.rs` in a row naming `profile/` and
+    `bench/`) names none of them: write `profile/mod.rs`."""
+    dirs = {"/".join(f.split("/")[:i]) for f in tracked for i in range(1, f.count("/") + 1)}
+    named, heading = set(), ""
+    for line in overview.splitlines():
         if line.startswith("#"):
             heading = line
-        yield heading, line
-
-
-def names(overview, path):
-    """Whether OVERVIEW.md names `path` as a path, not only its file name: the path
-    itself, its last two components (`common/eval.rs`), or its file name in a row or
-    section that names its folder (`tests/`'s table naming `cut.rs`, the `src/` row of
-    the `engine/volume` section naming `nifti.rs`)."""
-    if path in overview:
-        return True
-    parts = path.split("/")
-    if len(parts) >= 3 and "/".join(parts[-2:]) in overview:
-        return True
-    base, folder = parts[-1], "/".join(parts[:-1])
-    tail = folder.split("/")[-1]
-    for heading, line in sections(overview):
-        if f"`{base}`" not in line and f"{base}`" not in line and f" {base}" not in line:
             continue
-        context = heading + " " + line
-        # The folder's path, or its last component as a row or section names it.
-        if folder in context or f"`{tail}/`" in context or f"{tail}/" in context \
-                or heading.lower().strip("# ").startswith(tail):
-            return True
-    return False
+        m = re.match(r"^#+\s+(\S+)", heading)
+        section = m.group(1).strip("/") if m and m.group(1).strip("/") in dirs else ""
+        folders = {section}
+        cells = re.split(r"(?<!\\)\|", line) if line.startswith("|") else []
+        if len(cells) > 2:
+            for t in TOKEN.findall(cells[1]):
+                if t.endswith("/") and _join(section, t) in dirs:
+                    folders.add(_join(section, t))
+                    break
+        tokens = [t for t in TOKEN.findall(line) if " " not in t]
+        grown = True
+        while grown:
+            grown = False
+            for t in (t for t in tokens if t.endswith("/")):
+                for g in list(folders) + [""]:
+                    p = _join(g, t)
+                    if p in dirs and p not in folders:
+                        folders.add(p)
+                        grown = True
+        for t in (t for t in tokens if not t.endswith("/")):
+            found = {_join(g, t) for g in folders} & tracked
+            if not found and t in tracked:
+                found = {t}
+            if len(found) == 1:
+                named |= found
+    return named
+
+
+def names(overview, path, tracked=None):
+    """Whether OVERVIEW.md names `path` by a path that resolves to it alone (see
+    `named_files`)."""
+    tracked = tracked_files() if tracked is None else tracked
+    return path in named_files(overview, tracked or {path})
 
 
 def check_overview():
-    try:
-        files = subprocess.run(["git", "ls-files", "--", *SOURCE_DIRS], cwd=ROOT, check=True,
-                               capture_output=True, text=True).stdout.split()
-    except (OSError, subprocess.CalledProcessError):
+    tracked = tracked_files()
+    if tracked is None:
         print("check_docs: not a git checkout; OVERVIEW.md's coverage not checked", file=sys.stderr)
         return []
+    files = sorted(f for f in tracked if any(f.startswith(d + "/") for d in SOURCE_DIRS))
     with open(os.path.join(ROOT, "OVERVIEW.md"), encoding="utf-8") as f:
-        overview = f.read()
+        named = named_files(f.read(), tracked)
     missing = [f for f in files
                if not any(f.startswith(x) for x in SOURCE_EXCLUDE)
                # Links (python/dvr/assets/ into assets/) are named by the files they reach.
                and not os.path.islink(os.path.join(ROOT, f))
-               and not names(overview, f)]
+               and f not in named]
     return [f"OVERVIEW.md: does not name {f}" for f in missing]
 
 

@@ -1,7 +1,7 @@
 """The Python tools that make and check the book: `tools/results_io.py`'s formatting and
 tables, `tools/check_docs.py`'s anchors and its rule that OVERVIEW.md names each source
-file by its path, and `tools/ct_views.py`'s CT in Hounsfield units. Imported from the
-checkout's tools/ folder; no GPU."""
+file by a path that resolves to it alone, and `tools/ct_views.py`'s CT in Hounsfield
+units. Imported from the checkout's tools/ folder; no GPU."""
 
 import importlib
 import sys
@@ -49,20 +49,33 @@ def test_headings_become_the_anchors_mdbook_makes(tools):
     assert c.slug("A view in a notebook") == "a-view-in-a-notebook"
 
 
-def test_overview_must_name_a_file_by_its_path_not_only_its_name(tools):
+def test_overview_must_name_a_file_by_a_path_that_resolves_to_it_alone(tools):
     c = tools["check_docs"]
     overview = "\n".join([
         "## tests",
         "| `cut.rs` | cuts |",
+        "| `common/` | `harness.rs`, `eval.rs` |",
         "## engine/volume",
         "| `src/` | loaders (`nifti/tests.rs`), `nifti.rs` |",
-        "| `python/` | `tests/` (`test_api.py`) |",
+        "## Top level",
+        "| `src/` | `profile/` (`mod.rs`), `bench/` (`mod.rs`), `eval/`: `plan/` (`plan/mod.rs`) |",
+        "Start with `engine/src/renderer/mod.rs`.",
     ])
+    # By its path from the section's folder, the row's, or one the row names below them.
     assert c.names(overview, "tests/cut.rs")
+    assert c.names(overview, "tests/common/harness.rs")
     assert c.names(overview, "engine/volume/src/nifti.rs")
     assert c.names(overview, "engine/volume/src/nifti/tests.rs")
-    # A bare name elsewhere does not name a file in another folder.
+    assert c.names(overview, "src/eval/plan/mod.rs")
+    # By its full path anywhere.
+    assert c.names(overview, "engine/src/renderer/mod.rs")
+    # A path that resolves to two files names neither: `eval.rs` in tests/common's row
+    # is tests/eval.rs or tests/common/eval.rs; `mod.rs` in src's row is profile's or bench's.
     assert not c.names(overview, "tests/common/eval.rs")
+    assert not c.names(overview, "tests/eval.rs")
+    assert not c.names(overview, "src/profile/mod.rs")
+    assert not c.names(overview, "src/bench/mod.rs")
+    # A bare name does not name a file in a folder its line does not stand in.
     assert not c.names(overview, "engine/volume/src/dicom/tests.rs")
     assert not c.names(overview, "src/eval/cut.rs")
 
