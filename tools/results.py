@@ -24,6 +24,7 @@ import argparse
 import csv
 import json
 import os
+import re
 import sys
 
 from results_io import (
@@ -59,16 +60,35 @@ def b_headline():
     meta = read_json("validation", "meta.json")
     methods = present(rows, ["ours", "svgf", "taa", "rae", "oidn-aux", "oidn"])
     n = len(scenes_of(rows))
+    others = [sc for sc in validation_scenes() if sc not in scenes_of(rows)]
+    media = scenes_of(read_csv("media", "summary.csv")) if others else []
+    where = ("in [the channel and time run](docs/src/results.md#channels-and-time)"
+             if all(sc in media for sc in others) else "in no run of it yet")
+    also = f"; its other {len(others)} scenes are {where}" if others else ""
     return "\n".join([
         means_table("validation", rows, methods),
         "",
-        f"Means over the {n} scenes of the validation set (never tuned on; 128×128, 48 "
-        f"frames, 2 spp, 256-spp references), commit {meta['commit']}, on {meta['machine']}. "
+        f"Means over {n} scenes of the validation set (never tuned on; 128×128, 48 "
+        f"frames, 2 spp, 256-spp references{also}), commit {meta['commit']}, on {meta['machine']}. "
         "GPU ms count the shared passes, the features and guides each method reads, and its "
         "own; OIDN runs on the CPU (no GPU ms); `oidn-aux` is OIDN with the albedo and normal "
         "guides. Every scene and method, and the development suite: "
         "[the results](docs/src/results.md).",
     ])
+
+
+def validation_scenes():
+    """The labels of the validation set's scene files (`name`, else the file's stem)."""
+    folder = os.path.join(ROOT, "assets", "scenes", "validation")
+    if not os.path.isdir(folder):
+        raise Missing(os.path.relpath(folder, ROOT))
+    labels = []
+    for f in sorted(os.listdir(folder)):
+        if f.endswith(".toml"):
+            with open(os.path.join(folder, f), encoding="utf-8") as fh:
+                m = re.search(r'^name\s*=\s*"([^"]+)"', fh.read(), re.M)
+            labels.append(m.group(1) if m else f[:-len(".toml")])
+    return labels
 
 
 def b_suite_means():
@@ -503,23 +523,6 @@ def b_viewer():
         f"commit {r0['commit']} ({r0['date']}) on {r0['machine']}. Source: "
         "`assets/results/viewer/viewer.csv`.",
     ]
-    try:
-        gpu = read_csv("gpu", "h200-profile.csv")
-        meta = read_json("gpu", "meta.json")
-    except Missing:
-        return "\n".join(lines)
-    at = [g for g in gpu if g["size"] == "256x256"]
-    total = sum(num(g["mean_ms"]) for g in at)
-    parts = ", ".join(f"`{g['pass']}` {num(g['mean_ms']):.3f}" for g in at)
-    lines += [
-        "",
-        f"On a GPU the device is no longer what limits the view: {meta['machine']} rendered "
-        f"a 256×256 frame of the `ours` of {meta['commit']} in {total:.2f} ms ({parts}; "
-        f"{meta['command']}, {meta['date']}): an older `ours` than today's, whose passes "
-        "have changed since, and no GPU figure of today's code exists. Frames of that "
-        "speed reach the page as fast as they are encoded. Source: "
-        "`assets/results/gpu/h200-profile.csv`.",
-    ]
     return "\n".join(lines)
 
 
@@ -556,11 +559,11 @@ def cut_frames(metrics):
     return {sc: worst_margin(frames, ["svgf", "taa"]) for sc, frames in frames_by_scene(metrics).items()}
 
 
-def set_table(folder):
+def set_table(folder, skip=()):
     """Mean PSNR per scene of an eval set run at 128×128 over 48 frames with 256-spp
     references, with ours' closest frame after frame 4 to the better of svgf and taa, and
-    ours against oidn-aux on the mean; its source line."""
-    rows = read_csv(folder, "summary.csv")
+    ours against oidn-aux on the mean; its source line. Scenes in `skip` are left out."""
+    rows = [r for r in read_csv(folder, "summary.csv") if r["scene"] not in skip]
     metrics = read_csv(folder, "metrics.csv")
     methods = present(rows, ["none", "taa", "svgf", "oidn", "oidn-aux", "ours"])
     worst = cut_frames(metrics)
@@ -586,9 +589,16 @@ def set_table(folder):
     ])
 
 
+def in_validation_run(folder):
+    """The scenes of a set's run that the validation set's run also holds: each scene's
+    figures come from one run, the validation set's."""
+    val = set(scenes_of(read_csv("validation", "summary.csv")))
+    return [sc for sc in scenes_of(read_csv(folder, "summary.csv")) if sc in val]
+
+
 def b_cuts():
-    rows = read_csv("cuts", "summary.csv")
-    return "\n".join([set_table("cuts"), "", newer_runs_note(scenes_of(rows))])
+    shared = in_validation_run("cuts")
+    return "\n".join([set_table("cuts", shared), "", validation_run_note("cuts", shared)])
 
 
 def b_media():
@@ -596,25 +606,23 @@ def b_media():
     return set_table("media")
 
 
-def newer_runs_note(scenes):
-    """Where a scene of the cuts run is also in the validation set's run, which is newer:
-    says so, naming both commits, so two figures for one scene read as two runs."""
-    cuts = read_json("cuts", "meta.json")
-    val = read_json("validation", "meta.json")
-    shared = [sc for sc in scenes if sc.startswith("val/")]
-    if not shared or val["commit"] == cuts["commit"]:
+def validation_run_note(folder, shared):
+    """Where the table leaves out a scene the validation set's run holds: where its
+    figures are, and that the images below are this run's."""
+    if not shared:
         return ""
+    val = read_json("validation", "meta.json")
     names = ", ".join(f"`{sc}`" for sc in shared)
-    return (f"{names} is also in the validation set, whose table above is a later run "
-            f"(commit {val['commit']}) of a later `ours`; the figures here are the cuts run's "
-            f"(commit {cuts['commit']}).")
+    return (f"{names}, a validation scene, is in [the validation set's table](#the-validation-set) "
+            f"(commit {val['commit']}) and not repeated here; the frames and the per-frame chart "
+            f"below are this run's (commit {read_json(folder, 'meta.json')['commit']}).")
 
 
-def set_line(folder, what):
+def set_line(folder, what, skip=()):
     """README's sentence on an eval set: ours against oidn-aux per scene, and its closest
-    frame to the better of svgf and taa after frame 4."""
-    rows = read_csv(folder, "summary.csv")
-    worst = cut_frames(read_csv(folder, "metrics.csv"))
+    frame to the better of svgf and taa after frame 4. Scenes in `skip` are left out."""
+    rows = [r for r in read_csv(folder, "summary.csv") if r["scene"] not in skip]
+    worst = cut_frames([r for r in read_csv(folder, "metrics.csv") if r["scene"] not in skip])
     psnr = {(r["scene"], r["method"]): num(r["psnr"]) for r in rows}
     scenes = scenes_of(rows)
     pairs = ", ".join(f"`{sc}` {fmt(psnr[(sc, 'ours')], 2)} / {fmt(psnr.get((sc, 'oidn-aux')), 2)}"
@@ -631,8 +639,11 @@ def set_line(folder, what):
 
 
 def b_cuts_line():
-    return (set_line("cuts", "the cut scenes") + " (the validation scene's later run is in the "
-            "results' validation table); source: `assets/results/cuts/`.")
+    shared = in_validation_run("cuts")
+    also = (f"; {', '.join(f'`{sc}`' for sc in shared)} is among the validation set's means above "
+            "([per scene](docs/src/results.md#the-validation-set))") if shared else ""
+    return (set_line("cuts", "the development set's cut scenes", shared)
+            + f"; source: `assets/results/cuts/`{also}.")
 
 
 def b_media_line():
@@ -728,7 +739,8 @@ def b_experiments_strata():
 
 
 BLOCKS = {
-    "headline": (b_headline, ["validation/summary.csv", "validation/meta.json"]),
+    "headline": (b_headline, ["validation/summary.csv", "validation/meta.json",
+                              "media/summary.csv", "../scenes/validation/*.toml"]),
     "suite-means": (b_suite_means, ["suite/summary.csv"]),
     "suite-scenes": (b_suite_scenes, ["suite/summary.csv"]),
     "ablations": (b_ablations, ["validation/summary.csv"]),
@@ -745,13 +757,15 @@ BLOCKS = {
     "rae": (b_rae, ["rae/summary.csv"]),
     "fuzz": (b_fuzz, ["fuzz/runs.csv"]),
     "rae-training": (b_rae_training, ["../rae/*.json"]),
-    "viewer": (b_viewer, ["viewer/viewer.csv", "gpu/h200-profile.csv"]),
+    "viewer": (b_viewer, ["viewer/viewer.csv"]),
     "viewer-line": (b_viewer_line, ["viewer/viewer.csv"]),
     "soak": (b_soak, ["soak/soak.csv"]),
-    "cuts": (b_cuts, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json", "validation/meta.json"]),
+    "cuts": (b_cuts, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json",
+                      "validation/summary.csv", "validation/meta.json"]),
     "media": (b_media, ["media/summary.csv", "media/metrics.csv", "media/meta.json"]),
     "media-line": (b_media_line, ["media/summary.csv", "media/metrics.csv", "media/meta.json"]),
-    "cuts-line": (b_cuts_line, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json"]),
+    "cuts-line": (b_cuts_line, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json",
+                                "validation/summary.csv"]),
     "cut-cost": (b_cut_cost, ["cut-cost/profile.csv"]),
     "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv",
                                                 "validation/metrics.csv"]),

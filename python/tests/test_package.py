@@ -40,7 +40,7 @@ def _copy_docs(root, dest):
     for rel in ("tools/results.py", "tools/results_io.py", "README.md"):
         (dest / rel).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy(root / rel, dest / rel)
-    for rel in ("docs/src", "assets/results", "assets/rae"):
+    for rel in ("docs/src", "assets/results", "assets/rae", "assets/scenes/validation"):
         shutil.copytree(root / rel, dest / rel, ignore=shutil.ignore_patterns("*.bin"))
 
 
