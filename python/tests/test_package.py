@@ -19,16 +19,55 @@ def test_metadata_has_the_summary_and_the_readme(root):
     assert meta["Description-Content-Type"].startswith("text/markdown")
 
 
+def _expand_includes(page, seen=()):
+    """A book page with mdBook's `{{#include path}}` directives replaced by the files they
+    name (paths relative to the page), as mdBook renders it."""
+    def sub(m):
+        target = (page.parent / m.group(1)).resolve()
+        assert target.is_file(), f"{page.name} includes {m.group(1)}, which does not exist"
+        assert target not in seen, f"{page.name} includes {m.group(1)} recursively"
+        return _expand_includes(target, seen + (target,))
+
+    return re.sub(r"\{\{#include ([^}\s]+)\}\}", sub, page.read_text())
+
+
+def _slug(heading):
+    text = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", heading.strip()).lower()
+    return re.sub(r"[^\w\- ]", "", text).replace(" ", "-")
+
+
 def test_the_book_includes_the_package_readme(root):
-    page = (root / "docs/src/python.md").read_text()
-    assert "{{#include ../../python/README.md}}" in page
-    # The built book (tools/test.sh builds it before these tests) shows every section
-    # of the guide on its Python page.
+    page = root / "docs/src/python.md"
+    readme = (root / "python/README.md").read_text()
+    expanded = _expand_includes(page)
+    # The whole guide is on the book's Python page, once.
+    assert expanded.count(readme.strip()) == 1
+    # Its links work in both places it is read: the README's own anchors and relative
+    # paths from python/ (GitHub), and the same text on the book's page from docs/src/.
+    text = re.sub(r"```.*?```", "", expanded, flags=re.S)
+    anchors = {_slug(h) for h in re.findall(r"^#{1,6}\s+(.+?)\s*$", text, re.M)}
+    own = {_slug(h) for h in re.findall(r"^#{1,6}\s+(.+?)\s*$",
+                                       re.sub(r"```.*?```", "", readme, flags=re.S), re.M)}
+    for link in re.findall(r"\]\(([^)\s]+)\)", re.sub(r"```.*?```", "", readme, flags=re.S)):
+        if re.match(r"^[a-z][a-z0-9+.-]*:", link):
+            continue
+        target, _, frag = link.partition("#")
+        if not target:
+            assert frag in own, f"python/README.md links to #{frag}, no heading of its own"
+            assert frag in anchors, f"#{frag} has no heading on the book's Python page"
+        else:
+            assert (root / "python" / target).exists(), f"python/README.md: broken link {link}"
+            assert (page.parent / target).exists(), f"the book's Python page: broken link {link}"
+
+
+def test_the_built_book_shows_every_section_of_the_package_readme(root):
+    # tools/test.sh builds the book before these tests.
+    readme = (root / "python/README.md").read_text()
     built = root / "docs/book/python.html"
     if not built.is_file():
         pytest.skip("the book is not built (mdbook build docs)")
     html = built.read_text()
-    headings = re.findall(r"^## (.+)$", (root / "python/README.md").read_text(), re.M)
+    headings = re.findall(r"^## (.+)$", readme, re.M)
     assert len(headings) >= 5
     for h in headings:
         assert h.replace("&", "&amp;") in html, f"the book's Python page lacks the section {h!r}"
