@@ -1,9 +1,11 @@
 """The Python tools that make and check the book: `tools/results_io.py`'s formatting and
 tables, `tools/check_docs.py`'s anchors and its rule that OVERVIEW.md names each source
 file by a path that resolves to it alone, and `tools/ct_views.py`'s CT in Hounsfield
-units. Imported from the checkout's tools/ folder; no GPU."""
+units. Imported from the checkout's tools/ folder; no GPU. And the validation set's
+README: one row per frozen scene file with the day it was frozen."""
 
 import importlib
+import re
 import sys
 
 import numpy as np
@@ -103,3 +105,15 @@ def test_the_ct_is_written_in_hounsfield_units_with_a_marker_on_the_right(root, 
     img = nib.load(str(path))
     assert np.allclose(img.affine, np.diag([1.5, 1.5, 1.5, 1.0]))
     assert np.array_equal(np.asarray(img.dataobj).transpose(2, 1, 0), hu)
+
+
+def test_the_validation_sets_readme_lists_each_scene_file_with_the_day_it_was_frozen(root):
+    folder = root / "assets/scenes/validation"
+    readme = (folder / "README.md").read_text()
+    rows = re.findall(r"^\| `([^`]+\.toml)` \| (\d{4}-\d{2}-\d{2}) \|", readme, re.M)
+    listed = [name for name, _ in rows]
+    assert sorted(listed) == sorted(p.name for p in folder.glob("*.toml"))
+    assert len(set(listed)) == len(listed)
+    # Rows in the order the scenes were frozen, so a new scene adds the last row.
+    dates = [date for _, date in rows]
+    assert dates == sorted(dates)
