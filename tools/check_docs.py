@@ -166,9 +166,9 @@ def named_files(overview, tracked):
     the folders its line stands in: the section's folder (a heading that starts with a
     folder, `## engine/volume — …`, else the repository root), the folder a table row's
     first cell names in it (`src/` there), and every folder the line names below those
-    (`eval/`, then `plan/`). A full repository path names its file anywhere. A
-    path that resolves to several files (`mod.rs` in a row naming `profile/` and
-    `bench/`) names none of them: write `profile/mod.rs`."""
+    (`eval/`, then `plan/`); a full repository path names its file wherever it resolves
+    against none of them. A path that resolves to several files (`mod.rs` in a row
+    naming `profile/` and `bench/`) names none of them: write `profile/mod.rs`."""
     dirs = {"/".join(f.split("/")[:i]) for f in tracked for i in range(1, f.count("/") + 1)}
     named, heading = set(), ""
     for line in overview.splitlines():
