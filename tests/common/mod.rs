@@ -155,6 +155,7 @@ pub fn inputs(camera: CameraMatrices, lights: Vec<GpuLight>, lut: LutUpload) -> 
         lut,
         cut: Default::default(),
         time: None,
+        labels: None,
     }
 }
 

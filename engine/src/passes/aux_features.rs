@@ -39,12 +39,17 @@ pub struct AuxFeatures {
 
 impl AuxFeatures {
     pub fn new(ctx: &GpuContext, volume: VolumeLayout) -> Result<Self> {
-        let [pooled, channels] = volume_specialization(volume);
+        let [pooled, channels, labels] = volume_specialization(volume);
         Ok(Self {
-            pipeline: ctx.pipeline("aux_features", &[pooled, channels])?,
+            pipeline: ctx.pipeline("aux_features", &[pooled, channels, labels])?,
             albedo_only: ctx.pipeline(
                 "aux_features",
-                &[("GUIDE_NORMALS", SpecValue::Bool(false)), pooled, channels],
+                &[
+                    ("GUIDE_NORMALS", SpecValue::Bool(false)),
+                    pooled,
+                    channels,
+                    labels,
+                ],
             )?,
         })
     }

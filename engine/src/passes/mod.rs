@@ -26,6 +26,8 @@ pub struct SceneBindings {
     pub environment: ImageHandle,
     pub brick_pool: ImageHandle,
     pub brick_table: ImageHandle,
+    /// The label map's look (a 1×1×1 stand-in without one).
+    pub labels: ImageHandle,
 }
 
 impl SceneBindings {
@@ -39,6 +41,7 @@ impl SceneBindings {
             .sampled("tf_emissive", self.tf_emissive)
             .sampled_nearest("majorant_grid", self.majorant)
             .sampled("brick_pool", self.brick_pool)
-            .sampled_nearest("brick_table", self.brick_table);
+            .sampled_nearest("brick_table", self.brick_table)
+            .sampled("label_look", self.labels);
     }
 }

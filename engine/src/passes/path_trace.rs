@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::gpu_block;
 use crate::graph::{Extent, Frame, History, ImageHandle, RenderGraph};
-use crate::scene::{Estimator, Phase, PipelineKey};
+use crate::scene::{Estimator, LabelMode, Phase, PipelineKey};
 use crate::shaders::frame::{
     ESTIMATOR_DELTA, ESTIMATOR_RAY_MARCH, PHASE_HG, PHASE_HYBRID, PHASE_ISOTROPIC,
 };
@@ -24,12 +24,13 @@ gpu_block! {
 }
 
 /// How the volume is held, which every pipeline that reads it is specialised for
-/// (include/volume.glsl): dense or paged through the brick pool, and how many channels
-/// its texels pack (1–4).
+/// (include/volume.glsl): dense or paged through the brick pool, how many channels its
+/// texels pack (1–4), and whether a label map's look is read beside it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct VolumeLayout {
     pub pooled: bool,
     pub channels: u32,
+    pub labels: Option<LabelMode>,
 }
 
 impl Default for VolumeLayout {
@@ -37,6 +38,7 @@ impl Default for VolumeLayout {
         Self {
             pooled: false,
             channels: 1,
+            labels: None,
         }
     }
 }
@@ -65,16 +67,23 @@ impl PathTraceFeatures {
 }
 
 /// The specialisation of a pipeline that reads the volume (include/volume.glsl).
-pub fn volume_specialization(volume: VolumeLayout) -> [(&'static str, SpecValue); 2] {
+pub fn volume_specialization(volume: VolumeLayout) -> [(&'static str, SpecValue); 3] {
+    // LABELS_* in include/specialization.glsl.
+    let labels = match volume.labels {
+        None => 0,
+        Some(LabelMode::Tint) => 1,
+        Some(LabelMode::Solid) => 2,
+    };
     [
         ("POOLED_VOLUME", SpecValue::Bool(volume.pooled)),
         ("CHANNELS", SpecValue::I32(volume.channels as i32)),
+        ("LABELS", SpecValue::I32(labels)),
     ]
 }
 
 /// The specialisation constants of a pipeline that traces paths (include/path.glsl):
 /// the path tracer's, and ours' temporal-gradient pass, which must trace the same paths.
-pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue); 6] {
+pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue); 7] {
     let estimator = match features.estimator {
         Estimator::Delta => ESTIMATOR_DELTA,
         Estimator::RayMarch => ESTIMATOR_RAY_MARCH,
@@ -84,7 +93,7 @@ pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue)
         Phase::Hg => PHASE_HG,
         Phase::Hybrid => PHASE_HYBRID,
     };
-    let [pooled, channels] = volume_specialization(features.volume);
+    let [pooled, channels, labels] = volume_specialization(features.volume);
     [
         ("ESTIMATOR", SpecValue::I32(estimator)),
         ("PHASE", SpecValue::I32(phase)),
@@ -92,6 +101,7 @@ pub fn specialization(features: PathTraceFeatures) -> [(&'static str, SpecValue)
         ("HAS_ENV_MAP", SpecValue::Bool(features.environment_map)),
         pooled,
         channels,
+        labels,
     ]
 }
 

@@ -55,6 +55,20 @@ pub struct FrameInputs {
     pub cut: Cut,
     /// The time point of a series this frame shows (`None`: the volume as set up).
     pub time: Option<SeriesTime>,
+    /// The label map's look this frame (uploaded when it differs from the last;
+    /// `None`: no label map).
+    pub labels: Option<LabelLookRef>,
+}
+
+/// A label look as a frame input: equal when it is the same one (a look is made again
+/// only when a label's look changed).
+#[derive(Clone, Debug)]
+pub struct LabelLookRef(pub std::sync::Arc<crate::volume::labels::LabelLook>);
+
+impl PartialEq for LabelLookRef {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 /// A time point of a series: the renderer uploads the volume it names when it differs

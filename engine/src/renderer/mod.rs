@@ -5,6 +5,7 @@
 
 pub mod brick_pool;
 mod inputs;
+pub mod labels;
 pub mod medium;
 pub mod packing;
 pub mod present;
@@ -17,7 +18,8 @@ pub mod timeline;
 pub mod uploads;
 
 pub use inputs::{
-    CameraMatrices, FrameInputs, FrameRequest, FrameResult, SeriesTime, FEATURE_IMAGES,
+    CameraMatrices, FrameInputs, FrameRequest, FrameResult, LabelLookRef, SeriesTime,
+    FEATURE_IMAGES,
 };
 pub use reference::{samples_per_dispatch, MAX_SAMPLES_PER_DISPATCH, PIXEL_SAMPLES_PER_DISPATCH};
 use submit::{add_readbacks, read_pixels, submit, Slot};
@@ -67,6 +69,9 @@ pub struct RendererConfig {
     /// `None`: half the largest device-local heap. Past it the volume is paged through
     /// the brick pool.
     pub gpu_memory: Option<u64>,
+    /// How a label map beside the volume is shown (the volume passes are specialised
+    /// on it); `None`: no label map.
+    pub labels: Option<crate::scene::LabelMode>,
 }
 
 impl Default for RendererConfig {
@@ -80,6 +85,7 @@ impl Default for RendererConfig {
             motion_source: denoise::MotionSource::FirstHit,
             dataset: None,
             gpu_memory: None,
+            labels: None,
         }
     }
 }
@@ -174,6 +180,8 @@ pub struct Renderer {
     current_lut: Option<LutUpload>,
     /// The cut the majorants were masked with.
     current_cut: Option<crate::scene::Cut>,
+    /// The label look on the device.
+    current_labels: Option<LabelLookRef>,
     /// The largest extinction under `current_lut`.
     majorant_max: f32,
     last_inputs: Option<FrameInputs>,
@@ -212,7 +220,20 @@ impl Renderer {
         let layout = VolumeLayout {
             pooled: matches!(volume_path, VolumePath::Pool(_)),
             channels: volume.channels(),
+            labels: config.labels,
         };
+        if config.labels.is_some() && layout.pooled {
+            return Err(EngineError::TooLarge {
+                what: format!(
+                    "volume {:?} ({:?} voxels) with a label map: a labelled volume is held as one dense texture (the brick pool pages one field) and does not fit",
+                    volume.name, volume.dims
+                ),
+                needed: volume.dims.iter().map(|&d| u64::from(d)).product::<u64>()
+                    * (volume.texel_bytes() as u64 + 4),
+                limit: config.gpu_memory.unwrap_or_else(|| scene_gpu::default_budget(&ctx)),
+                device: ctx.info.name.clone(),
+            });
+        }
         let features =
             PathTraceFeatures::new(settings.pipeline_key(), environment.is_some(), layout);
         let denoisers = create_methods(&ctx, &config, features, denoisers)?;
@@ -267,10 +288,13 @@ impl Renderer {
             &ctx,
             &mut graph,
             &mut setup,
-            &volume,
-            &volume_path,
-            environment,
-            lut_size,
+            &scene_gpu::SceneDesc {
+                volume: &volume,
+                path: &volume_path,
+                environment,
+                lut_size,
+                labels: config.labels.is_some(),
+            },
         )?;
         ctx.submit_and_wait(|cmd| graph.execute(&ctx, cmd, None, setup))?;
 
@@ -301,6 +325,7 @@ impl Renderer {
             lut_size,
             current_lut: None,
             current_cut: None,
+            current_labels: None,
             majorant_max: 0.0,
             last_inputs: None,
             slots,
@@ -631,6 +656,7 @@ impl Renderer {
             environment: self.scene.environment,
             brick_pool: self.scene.pool,
             brick_table: self.scene.brick_table,
+            labels: self.scene.labels,
         })
     }
 
@@ -646,7 +672,11 @@ impl Renderer {
                 camera: reset || last.camera != inputs.camera,
                 lights: reset || last.lights != inputs.lights,
                 // A new time point changes the medium in place, as a TF edit does.
-                transfer_function: reset || last.lut != inputs.lut || last.time != inputs.time,
+                // So does a label's look.
+                transfer_function: reset
+                    || last.lut != inputs.lut
+                    || last.time != inputs.time
+                    || last.labels != inputs.labels,
                 cut: reset || last.cut != inputs.cut,
             },
         }

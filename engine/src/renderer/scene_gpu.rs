@@ -17,6 +17,9 @@ pub struct SceneImages {
     pub environment: ImageHandle,
     pub pool: ImageHandle,
     pub brick_table: ImageHandle,
+    /// The label map's look (RGBA8: tint, mask; include/volume.glsl), uploaded by the
+    /// frames whose look changed; a 1×1×1 stand-in without a label map.
+    pub labels: ImageHandle,
 }
 
 /// Adds a pass that copies `bytes` into `image` through a staging buffer of its own
@@ -163,19 +166,33 @@ fn plan_channels(
     })
 }
 
+/// What [`create`] makes the scene images for.
+pub struct SceneDesc<'a> {
+    pub volume: &'a VolumeUpload,
+    pub path: &'a VolumePath,
+    pub environment: Option<&'a EnvironmentUpload>,
+    pub lut_size: u32,
+    /// Whether a label map's look is read beside the volume.
+    pub labels: bool,
+}
+
 /// Creates the scene images and adds their uploads to `frame`: the volume (dense, or the
 /// coarse copy beneath a brick pool), the pool and its brick table (1×1×1 stand-ins on
 /// the dense path, whose shaders never read them), the LUTs, majorant grid and
-/// environment map.
+/// environment map, and the label look (a 1×1×1 stand-in without a label map).
 pub fn create<'f>(
     ctx: &GpuContext,
     graph: &mut RenderGraph,
     frame: &mut Frame<'f>,
-    volume: &VolumeUpload,
-    path: &VolumePath,
-    environment: Option<&EnvironmentUpload>,
-    lut_size: u32,
+    desc: &SceneDesc<'_>,
 ) -> Result<SceneImages> {
+    let SceneDesc {
+        volume,
+        path,
+        environment,
+        lut_size,
+        labels,
+    } = *desc;
     let format = volume.vk_format();
     // Dense: the volume itself, and 1×1×1 pool and table no shader reads. Pooled: the
     // coarse copy, the pool (slots are written as the TF makes their bricks visible, and
@@ -232,10 +249,18 @@ pub fn create<'f>(
         env,
         bytemuck::cast_slice(rgba),
     )?;
+    let label_dims = if labels { volume.dims } else { [1; 3] };
+    let label_desc = ImageDesc::d3(label_dims, vk::Format::R8G8B8A8_UNORM);
+    let label_look = graph.image(ctx, "scene.labels", label_desc)?;
+    if !labels {
+        add_upload(ctx, graph, frame, "upload_labels", label_look, &[255; 4])?;
+    }
     // Later frames' shaders sample what this frame uploads.
     frame.add_ready_for_sampling(
         "scene_ready",
-        &[vol, tf[0], tf[1], tf[2], majorant, env, pool, table],
+        &[
+            vol, tf[0], tf[1], tf[2], majorant, env, pool, table, label_look,
+        ],
     );
     Ok(SceneImages {
         volume: vol,
@@ -244,6 +269,7 @@ pub fn create<'f>(
         environment: env,
         pool,
         brick_table: table,
+        labels: label_look,
     })
 }
 

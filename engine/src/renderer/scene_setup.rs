@@ -46,6 +46,8 @@ pub struct SceneSetup {
     pub environment: Option<Arc<EnvironmentUpload>>,
     /// The series' time points, when the volume has more than one.
     pub timeline: Option<Arc<Timeline>>,
+    /// The label map beside the volume (`[labels]`).
+    pub labels: Option<Arc<super::labels::SceneLabels>>,
 }
 
 impl SceneSetup {
@@ -60,11 +62,24 @@ impl SceneSetup {
         if let Some(channels) = super::medium::load_channels(&scene)? {
             return Self::with_channels(scene, channels, size, spp);
         }
-        let upload = match on_demand(&scene, volume_size) {
-            Some(v) => VolumeUpload::on_demand(v.name, v.blocks),
-            None => VolumeUpload::from_volume(&load_volume(&scene, volume_size)?),
-        };
-        Self::with_upload(scene, upload, size, spp)
+        match on_demand(&scene, volume_size) {
+            Some(v) => {
+                if scene.labels.is_some() {
+                    return Err(SetupError::Invalid {
+                        scene: scene.name.clone(),
+                        problem: format!(
+                            "labels: the {} volume is made brick by brick on demand and has no grid a label map could share",
+                            v.name
+                        ),
+                    });
+                }
+                Self::with_upload(scene, VolumeUpload::on_demand(v.name, v.blocks), size, spp)
+            }
+            None => {
+                let volume = load_volume(&scene, volume_size)?;
+                Self::with_volume(scene, &volume, size, spp)
+            }
+        }
     }
 
     /// [`SceneSetup::new`] for a medium of several channels: packed into one upload, each
@@ -119,6 +134,7 @@ impl SceneSetup {
             scene.channel_views = views;
         }
         let mut setup = Self::with_upload(scene, upload, size, spp)?;
+        setup.attach_labels(&channels.volumes[0].to_patient)?;
         if times > 1 {
             let first = setup.volume.clone();
             setup.timeline = Some(Arc::new(Timeline::new(channels.series, first)));
@@ -142,7 +158,38 @@ impl SceneSetup {
         size: Extent,
         spp: Option<u32>,
     ) -> Result<Self, SetupError> {
-        Self::with_upload(scene, VolumeUpload::from_volume(volume), size, spp)
+        let mut setup = Self::with_upload(scene, VolumeUpload::from_volume(volume), size, spp)?;
+        setup.attach_labels(&volume.to_patient)?;
+        Ok(setup)
+    }
+
+    /// Loads the scene's label map onto the volume's grid (`[labels]`), its labels'
+    /// views into the scene, and specialises the renderer for it.
+    fn attach_labels(
+        &mut self,
+        to_patient: &crate::volume::PatientTransform,
+    ) -> Result<(), SetupError> {
+        if let Some((labels, views)) = super::labels::load(&self.scene, &self.volume, to_patient)? {
+            self.config.labels = Some(labels.mode);
+            self.scene.label_views = views;
+            self.labels = Some(Arc::new(labels));
+        }
+        Ok(())
+    }
+
+    /// The renderer's inputs for `view` at `aspect` with the LUT of its TF state (passed
+    /// in so a session computes it once per TF edit): [`inputs_for_view`] with the
+    /// series' time point and the label map's look. Every frame, scripted or live,
+    /// takes this path.
+    pub fn inputs(&self, view: &View, aspect: f32, lut: &TfLut) -> FrameInputs {
+        FrameInputs {
+            time: self.series_time(view.time),
+            labels: self
+                .labels
+                .as_ref()
+                .map(|l| super::LabelLookRef(l.look(&view.labels))),
+            ..inputs_for_view(view, aspect, lut)
+        }
     }
 
     fn with_upload(
@@ -190,6 +237,7 @@ impl SceneSetup {
             environment,
             scene,
             timeline: None,
+            labels: None,
         })
     }
 
@@ -216,10 +264,7 @@ impl SceneSetup {
     /// takes too.
     pub fn frame_inputs(&self, f: u32) -> FrameInputs {
         let view = self.scene.view_at(f);
-        FrameInputs {
-            time: self.series_time(view.time),
-            ..inputs_for_view(&view, self.config.size.aspect(), &view.lut())
-        }
+        self.inputs(&view, self.config.size.aspect(), &view.lut())
     }
 }
 
@@ -242,6 +287,7 @@ pub fn inputs_for(camera: &Camera, aspect: f32, lights: &[Light], lut: &TfLut) -
         lut: LutUpload::from(lut),
         cut: Default::default(),
         time: None,
+        labels: None,
     }
 }
 

@@ -45,7 +45,27 @@ impl Renderer {
             });
         }
         let first = self.current_lut.is_none();
-        if self.current_lut.as_ref() != Some(lut) || self.current_cut.as_ref() != Some(cut) {
+        let labels_changed = self.current_labels != inputs.labels;
+        if labels_changed {
+            if let Some(look) = &inputs.labels {
+                let (ctx, graph) = (&self.ctx, &mut self.graph);
+                let bytes = bytemuck::cast_slice(&look.0.rgba);
+                let image = self.scene.labels;
+                scene_gpu::add_frame_upload(
+                    ctx,
+                    graph,
+                    frame,
+                    "upload_labels",
+                    slot,
+                    image,
+                    bytes,
+                )?;
+            }
+        }
+        if self.current_lut.as_ref() != Some(lut)
+            || self.current_cut.as_ref() != Some(cut)
+            || labels_changed
+        {
             let opacity: Vec<f32> = lut.diffuse_opacity.iter().map(|c| c[3]).collect();
             let scale = self.config.density_scale;
             let (dims, world) = (self.volume_dims, self.world_size);
@@ -55,6 +75,13 @@ impl Renderer {
                 let segment = &opacity[(c + 1) * n..(c + 2) * n];
                 let m = scene_gpu::majorants(&extra.bricks, segment, scale);
                 majorants.iter_mut().zip(m).for_each(|(a, b)| *a += b);
+            }
+            if let Some(look) = &inputs.labels {
+                // Tint: the medium times the mask; solid: the mask alone.
+                let solid = self.config.labels == Some(crate::scene::LabelMode::Solid);
+                for (m, &mask) in majorants.iter_mut().zip(&look.0.brick_max) {
+                    *m = if solid { mask * scale } else { *m * mask };
+                }
             }
             scene_gpu::mask_cut(&mut majorants, &self.bricks, dims, world, cut);
             self.majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
@@ -100,6 +127,7 @@ impl Renderer {
             }
             self.current_lut = Some(lut.clone());
             self.current_cut = Some(cut.clone());
+            self.current_labels = inputs.labels.clone();
         }
         self.upload_bricks(frame, slot, first || !stream)?;
         if first && self.residency.is_some() {

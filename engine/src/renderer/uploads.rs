@@ -107,6 +107,25 @@ impl VolumeUpload {
             .vk_components(super::packing::components(self.channels()))
     }
 
+    /// The value at `voxel` in data units (the first channel's with several); `None`
+    /// outside, or for a volume made on demand (no bytes on the host).
+    pub fn data_value(&self, voxel: [u32; 3]) -> Option<f32> {
+        let [nx, ny, nz] = self.dims.map(|d| d as usize);
+        let [x, y, z] = voxel.map(|c| c as usize);
+        if self.blocks.is_some() || x >= nx || y >= ny || z >= nz {
+            return None;
+        }
+        let at = ((z * ny + y) * nx + x) * self.texel_bytes();
+        let b = self.bytes.get(at..at + self.format.bytes())?;
+        let d = match self.format {
+            VolumeFormat::R8 => f32::from(b[0]) / 255.0,
+            VolumeFormat::R16 => f32::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0,
+            VolumeFormat::R32F => f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        };
+        let [lo, hi] = self.window;
+        Some(lo + d * (hi - lo))
+    }
+
     /// Bytes of one texel.
     pub fn texel_bytes(&self) -> usize {
         self.format.bytes() * super::packing::components(self.channels()) as usize

@@ -132,6 +132,23 @@ pub struct ChannelKey {
     pub interpolation: Interpolation,
 }
 
+/// `[[animation.label]]`: sets the visibility, opacity and/or colour of label `value`
+/// at `frame` (visibility holds until the next key; opacity and colour interpolate).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LabelKey {
+    pub value: u16,
+    pub frame: u32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub visible: Option<bool>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub opacity: Option<f64>,
+    #[serde(default, alias = "color", skip_serializing_if = "Option::is_none")]
+    pub colour: Option<DVec3>,
+    #[serde(default, skip_serializing_if = "Interpolation::is_linear")]
+    pub interpolation: Interpolation,
+}
+
 /// `[[animation.clip]]`: sets any of point, normal, enabled of plane `index` at `frame`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -227,6 +244,8 @@ pub struct Animation {
     pub time: Vec<TimeKey>,
     /// `[[animation.channel]]`: keyframes of the channels' visibility and colour.
     pub channel: Vec<ChannelKey>,
+    /// `[[animation.label]]`: keyframes of the labels' visibility, opacity and colour.
+    pub label: Vec<LabelKey>,
 }
 
 /// `[animation]` as written.
@@ -251,6 +270,8 @@ pub(crate) struct AnimationFile {
     time: Vec<TimeKey>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     channel: Vec<ChannelKey>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    label: Vec<LabelKey>,
 }
 
 fn default_frames() -> u32 {
@@ -269,6 +290,7 @@ impl Default for AnimationFile {
             crop: Vec::new(),
             time: Vec::new(),
             channel: Vec::new(),
+            label: Vec::new(),
         }
     }
 }
@@ -284,6 +306,7 @@ impl AnimationFile {
             crop: self.crop,
             time: self.time,
             channel: self.channel,
+            label: self.label,
         };
         (self.frames, a)
     }
@@ -298,6 +321,7 @@ impl AnimationFile {
             clip: a.clip.clone(),
             time: a.time.clone(),
             channel: a.channel.clone(),
+            label: a.label.clone(),
             crop: a.crop.clone(),
         }
     }
@@ -327,6 +351,7 @@ impl Animation {
         a.crop.iter_mut().for_each(|k| k.frame = f(k.frame));
         a.time.iter_mut().for_each(|k| k.frame = f(k.frame));
         a.channel.iter_mut().for_each(|k| k.frame = f(k.frame));
+        a.label.iter_mut().for_each(|k| k.frame = f(k.frame));
         a
     }
 
@@ -399,6 +424,28 @@ impl Animation {
             }
             if let Some(c) = k.colour {
                 ctx.colour(&format!("animation.channel[{j}].colour"), c)?;
+            }
+        }
+        for (j, k) in self.label.iter().enumerate() {
+            let same = |o: &LabelKey| o.frame == k.frame && o.value == k.value;
+            if let Some(i) = self.label[..j].iter().position(same) {
+                return duplicate("label", i, j, k.frame);
+            }
+            if let Some(o) = k.opacity {
+                if !(0.0..=1.0).contains(&o) {
+                    return Err(ctx.invalid(
+                        format!("animation.label[{j}].opacity"),
+                        format!("{o} must be in [0, 1]"),
+                    ));
+                }
+            }
+            if let Some(c) = k.colour {
+                if !(c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0) {
+                    return Err(ctx.invalid(
+                        format!("animation.label[{j}].colour"),
+                        format!("{c} must be in [0, 1] in every component"),
+                    ));
+                }
             }
         }
         for (j, k) in self.clip.iter().enumerate() {

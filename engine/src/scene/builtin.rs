@@ -344,6 +344,9 @@ pub(crate) fn build(name: &str) -> Result<Scene, SceneError> {
         animation,
         channels: Vec::new(),
         channel_views: Vec::new(),
+        labels: None,
+        label_sections: Vec::new(),
+        label_views: Vec::new(),
     };
     scene.check(&ctx)?;
     Ok(scene)

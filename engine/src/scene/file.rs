@@ -17,6 +17,7 @@ use super::camera::CameraSpec;
 use super::channel::{ChannelFile, ChannelSpec};
 use super::cut::{ClipPlane, CropBox, Cut};
 use super::error::{Ctx, SceneError};
+use super::labels::{LabelFile, LabelsSpec};
 use super::light::LightFile;
 use super::render::RenderSettings;
 use super::transfer_ref::TransferSpec;
@@ -43,6 +44,10 @@ struct SceneFile {
     crop: Option<CropBox>,
     #[serde(default, rename = "channel", skip_serializing_if = "Vec::is_empty")]
     channels: Vec<ChannelFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    labels: Option<LabelsSpec>,
+    #[serde(default, rename = "label", skip_serializing_if = "Vec::is_empty")]
+    label: Vec<LabelFile>,
     #[serde(default)]
     animation: AnimationFile,
 }
@@ -78,6 +83,9 @@ pub(crate) fn parse(text: &str, origin: &str, base: Option<&Path>) -> Result<Sce
         animation,
         channels,
         channel_views: Vec::new(),
+        labels: file.labels.map(|l| l.resolve(&ctx)),
+        label_sections: file.label,
+        label_views: Vec::new(),
     };
     scene.check(&ctx)?;
     Ok(scene)
@@ -102,6 +110,8 @@ pub(crate) fn write(scene: &Scene) -> Result<String, SceneError> {
         clip: scene.cut.planes.clone(),
         crop: scene.cut.crop,
         channels: scene.channels.iter().map(|c| c.file.clone()).collect(),
+        labels: scene.labels.clone(),
+        label: scene.label_sections.clone(),
         animation: AnimationFile::join(scene.frames, &scene.animation),
     };
     let body = toml::to_string(&file).map_err(|source| SceneError::Serialize {

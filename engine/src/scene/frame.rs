@@ -148,6 +148,33 @@ impl Scene {
         views
     }
 
+    /// The labels' views at `frame`: visibility, opacity and colour after their
+    /// `[[animation.label]]` keys.
+    pub fn labels_at(&self, frame: u32) -> Vec<super::LabelView> {
+        let f = self.clamp_frame(frame);
+        let mut views = self.label_views.clone();
+        for l in &mut views {
+            let keys = || self.animation.label.iter().filter(|k| k.value == l.value);
+            l.visible = track(
+                l.visible,
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.visible?))),
+                f,
+            );
+            l.opacity = track(
+                f64::from(l.opacity),
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.opacity?))),
+                f,
+            ) as f32;
+            let colour = track(
+                glam::Vec3::from(l.colour).as_dvec3(),
+                keys().filter_map(|k| Some((k.frame, k.interpolation, k.colour?))),
+                f,
+            );
+            l.colour = colour.as_vec3().to_array();
+        }
+        views
+    }
+
     /// The time point the scene shows at `frame` (its `[[animation.time]]` keys).
     pub fn time_at(&self, frame: u32) -> f64 {
         let keys = self

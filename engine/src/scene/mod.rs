@@ -43,6 +43,7 @@ pub mod cut;
 pub mod error;
 mod file;
 pub mod frame;
+pub mod labels;
 pub mod light;
 pub mod render;
 pub mod transfer_ref;
@@ -56,14 +57,15 @@ use std::path::Path;
 
 pub use crate::bytes::parse_memory_size;
 pub use animation::{
-    Animation, CameraKey, ChannelKey, ClipKey, CropKey, Interpolation, LightKey, Orbit, TfKey,
-    TimeKey, DEFAULT_FRAMES,
+    Animation, CameraKey, ChannelKey, ClipKey, CropKey, Interpolation, LabelKey, LightKey, Orbit,
+    TfKey, TimeKey, DEFAULT_FRAMES,
 };
 pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR, MAX_CAMERA_DISTANCE};
 pub use channel::{ChannelFile, ChannelSpec, ChannelView, MAX_CHANNELS};
 pub use cut::{ClipPlane, CropBox, CropUnits, Cut, MAX_CLIP_PLANES};
 pub use error::SceneError;
 pub use frame::{changed, Change, FrameState};
+pub use labels::{LabelFile, LabelMode, LabelView, LabelsSpec};
 pub use light::{
     AreaLight, EnvMode, EnvSource, EnvironmentLight, Facing, Light, LightKind, PointLight,
 };
@@ -105,6 +107,13 @@ pub struct Scene {
     /// field): filled when the scene meets its volume (`SceneSetup`), which knows the
     /// channels' names, windows and colours.
     pub channel_views: Vec<ChannelView>,
+    /// `[labels]`: the label map beside the volume, its table and mode.
+    pub labels: Option<LabelsSpec>,
+    /// The `[[label]]` sections, in file order.
+    pub label_sections: Vec<LabelFile>,
+    /// Every label of the map as its views start (sorted by value; empty without a
+    /// map): filled when the scene meets its label map (`SceneSetup`).
+    pub label_views: Vec<LabelView>,
 }
 
 /// Longest scene name, in bytes (see [`Scene::check`]).
@@ -217,6 +226,13 @@ impl Scene {
         }
         self.volume.check(ctx)?;
         self.check_channel_sections(ctx)?;
+        labels::check_sections(ctx, self.labels.as_ref(), &self.label_sections)?;
+        if self.labels.is_none() && !self.animation.label.is_empty() {
+            return Err(ctx.invalid(
+                "animation.label",
+                "label keys without a [labels] file = \"...\" to apply to",
+            ));
+        }
         let tf_err = |field: &str| {
             let field = field.to_string();
             move |source| SceneError::Transfer {

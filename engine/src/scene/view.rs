@@ -66,6 +66,8 @@ pub struct View {
     pub channels: Vec<ChannelView>,
     /// The time point of a series (fractional: the two around it interpolated).
     pub time: f64,
+    /// Each label of the label map, by value (empty without one).
+    pub labels: Vec<super::LabelView>,
 }
 
 impl View {
@@ -94,6 +96,7 @@ impl Scene {
             cut: self.cut_at(frame),
             channels: self.channels_at(frame),
             time: self.time_at(frame),
+            labels: self.labels_at(frame),
         }
     }
 }

@@ -17,15 +17,17 @@
 //! pipelines (estimator, phase, emission) or a new environment map builds a new renderer
 //! on the same device; denoisers are rebuilt with fresh histories.
 
+mod labels;
 pub mod orbit;
 
+pub use labels::{LabelEdit, Pick};
 pub use orbit::{Anatomical, OrbitCamera};
 
 use crate::denoise::registry;
 use crate::error::EngineError;
 use crate::gpu::GpuContext;
 use crate::graph::Extent;
-use crate::renderer::scene_setup::{inputs_for_view, load_environment, SceneSetup, SetupError};
+use crate::renderer::scene_setup::{load_environment, SceneSetup, SetupError};
 use crate::renderer::{
     FrameInputs, FrameRequest, FrameResult, PresentTarget, Renderer, SettingsChange,
 };
@@ -94,6 +96,9 @@ pub enum Edit {
     /// One channel of a multi-channel medium: what is given changes (the renderer
     /// re-traces ours' gradients under it, as for a TF edit).
     Channel(ChannelEdit),
+    /// A label of the label map (or every label): its colour, opacity or visibility
+    /// (the renderer re-traces ours' gradients under it, as for a TF edit).
+    Label(LabelEdit),
 }
 
 /// A change to channel `index`: its TF (over its window, or in data units), its window,
@@ -264,6 +269,7 @@ impl Session {
                 self.view.time = time;
             }
             Edit::Channel(edit) => self.edit_channel(edit)?,
+            Edit::Label(edit) => self.edit_label(edit)?,
         }
         Ok(Vec::new())
     }
@@ -277,6 +283,7 @@ impl Session {
         self.view.camera = view.camera;
         self.view.cut = view.cut;
         self.view.time = view.time;
+        self.view.labels = view.labels;
         let channels = view.channels != self.view.channels;
         self.view.channels = view.channels;
         self.set_tf(view.tf);
@@ -329,19 +336,16 @@ impl Session {
     /// leaving the current view as it is.
     pub fn reference_at(&mut self, frame: u32, spp: u32, batch: u32) -> Result<Vec<[f32; 4]>> {
         let view = self.setup.scene.view_at(frame);
-        let inputs = FrameInputs {
-            time: self.setup.series_time(view.time),
-            ..inputs_for_view(&view, self.view_size.aspect(), &view.lut())
-        };
+        let inputs = self
+            .setup
+            .inputs(&view, self.view_size.aspect(), &view.lut());
         Ok(self.renderer_mut()?.reference(&inputs, spp, batch)?)
     }
 
     /// The renderer's inputs for the current view.
     fn inputs(&self) -> FrameInputs {
-        FrameInputs {
-            time: self.setup.series_time(self.view.time),
-            ..inputs_for_view(&self.view, self.view_size.aspect(), &self.lut)
-        }
+        self.setup
+            .inputs(&self.view, self.view_size.aspect(), &self.lut)
     }
 
     /// A camera move through the orbit camera; refused (and undone) when it would put

@@ -3,8 +3,10 @@
 //! the volume's grid by nearest neighbour through the patient transforms (interpolating
 //! label values makes labels that are not there). Its label table is `labels/table.rs`.
 
+mod look;
 mod table;
 
+pub use look::{LabelLook, Look, SMOOTHING_SIGMA};
 pub use table::{Label, LabelTable, PALETTE};
 
 use crate::orientation::invert;

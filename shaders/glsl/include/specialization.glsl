@@ -20,5 +20,11 @@ layout(constant_id = 4) const bool POOLED_VOLUME = false;
 // Fields in the medium (1–4), packed as the volume texture's components; channel c's TF
 // is the c-th segment of each LUT. One channel compiles today's single-field code.
 layout(constant_id = 5) const int CHANNELS = 1;
+// A label map beside the volume (include/volume.glsl, label_look): none; the medium
+// tinted and masked by it; or the labels alone as solid tissue.
+#define LABELS_NONE 0
+#define LABELS_TINT 1
+#define LABELS_SOLID 2
+layout(constant_id = 6) const int LABELS = LABELS_NONE;
 
 #endif

@@ -15,6 +15,10 @@ layout(binding = 5) uniform sampler3D majorant_grid;       // max μt per brick 
 // specialised for it (POOLED_VOLUME); volume_density is then the coarse copy beneath it.
 layout(binding = 30) uniform sampler3D brick_pool;         // resident bricks with aprons
 layout(binding = 31) uniform sampler3D brick_table;        // per brick: slot, stand-in (texelFetch)
+// A label map's look on the volume's grid (engine/volume/src/labels/look.rs), read when
+// LABELS is not LABELS_NONE: rgb the tint of the labels there, a the mask (each label's
+// opacity where shown, 0 where hidden), both filtered so boundaries are smooth.
+layout(binding = 32) uniform sampler3D label_look;
 
 #define POOL_BRICK 32
 #define POOL_APRON 2
@@ -96,17 +100,39 @@ vec4 medium_albedo_opacity(vec4 dens, out vec4 share) {
     return vec4(albedo * inv, opacity);
 }
 
-// Extinction coefficient at p (per world unit): with several channels, the sum of theirs.
+vec4 label_look_at(vec3 p) { return texture(label_look, to_uvw(p)); }
+
+// The gradient of the label mask (mask per voxel; grows into what is shown): the normal
+// of a label's surface, smooth because the mask is filtered.
+vec3 label_gradient(vec3 p) {
+    vec3 h = box_size() / vec3(frame.dims.xyz);
+    return 0.5 * vec3(
+        label_look_at(p + vec3(h.x, 0, 0)).a - label_look_at(p - vec3(h.x, 0, 0)).a,
+        label_look_at(p + vec3(0, h.y, 0)).a - label_look_at(p - vec3(0, h.y, 0)).a,
+        label_look_at(p + vec3(0, 0, h.z)).a - label_look_at(p - vec3(0, 0, h.z)).a);
+}
+
+// Where the mask changes faster than this per voxel, the medium's surface is a label's
+// boundary (a hidden label's face), and its normal is the mask's, as a cut face takes
+// the cut's.
+const float LABEL_EDGE = 0.05;
+
+// Extinction coefficient at p (per world unit): with several channels, the sum of theirs;
+// with a label map, times its mask (solid: the mask alone).
 float extinction_at(vec3 p) {
+    if (LABELS == LABELS_SOLID) return label_look_at(p).a * frame.box_min.w;
+    float opacity;
     if (CHANNELS > 1) {
         vec4 dens = densities_at(p);
-        float opacity = 0.0;
+        opacity = 0.0;
         for (int c = 0; c < CHANNELS; ++c) {
             opacity += texture(tf_diffuse_opacity, channel_lut_coord(dens[c], c)).a;
         }
-        return opacity * frame.box_min.w;
+    } else {
+        opacity = tf_albedo_opacity(density_at(p)).a;
     }
-    return tf_albedo_opacity(density_at(p)).a * frame.box_min.w;
+    if (LABELS == LABELS_TINT) opacity *= label_look_at(p).a;
+    return opacity * frame.box_min.w;
 }
 
 // Central-difference gradient of density, in density per voxel.
@@ -136,6 +162,7 @@ struct MediumPoint {
     vec4 dens;            // several: each channel's density
     vec4 share;           // several: each channel's share of the extinction
     vec4 albedo_opacity;  // albedo, opacity (several: the sum, which may pass 1)
+    vec4 look;            // with a label map: its tint and mask here
 };
 
 MediumPoint medium_point(vec3 p) {
@@ -144,6 +171,7 @@ MediumPoint medium_point(vec3 p) {
     m.density = 0.0;
     m.dens = vec4(0.0);
     m.share = vec4(0.0);
+    m.look = vec4(1.0);
     if (CHANNELS > 1) {
         m.dens = densities_at(p);
         m.albedo_opacity = medium_albedo_opacity(m.dens, m.share);
@@ -151,10 +179,28 @@ MediumPoint medium_point(vec3 p) {
         m.density = density_at(p);
         m.albedo_opacity = tf_albedo_opacity(m.density);
     }
+    if (LABELS != LABELS_NONE) {
+        m.look = label_look_at(p);
+        m.albedo_opacity = LABELS == LABELS_SOLID
+            ? m.look
+            : vec4(m.albedo_opacity.rgb * m.look.rgb, m.albedo_opacity.a * m.look.a);
+    }
     return m;
 }
 
 vec3 medium_emission(MediumPoint m) {
+    if (LABELS == LABELS_SOLID) return vec3(0.0);
+    if (LABELS == LABELS_TINT) {
+        vec3 e = vec3(0.0);
+        if (CHANNELS > 1) {
+            for (int c = 0; c < CHANNELS; ++c) {
+                e += m.share[c] * texture(tf_emissive, channel_lut_coord(m.dens[c], c)).rgb;
+            }
+        } else {
+            e = tf_emission(m.density);
+        }
+        return e * m.look.rgb;
+    }
     if (CHANNELS > 1) {
         vec3 e = vec3(0.0);
         for (int c = 0; c < CHANNELS; ++c) {
@@ -166,6 +212,7 @@ vec3 medium_emission(MediumPoint m) {
 }
 
 vec4 medium_specular(MediumPoint m) {
+    if (LABELS == LABELS_SOLID) return vec4(0.0, 0.0, 0.0, 1.0);  // diffuse tissue
     if (CHANNELS > 1) {
         vec4 s = vec4(0.0);
         for (int c = 0; c < CHANNELS; ++c) {
@@ -177,8 +224,14 @@ vec4 medium_specular(MediumPoint m) {
 }
 
 // The density gradient (density per voxel); with several channels, the channels'
-// gradients weighted by their shares of the extinction at the point.
+// gradients weighted by their shares of the extinction at the point; with a label map,
+// the mask's where the point is on a label's boundary (solid: always).
 vec3 medium_gradient(MediumPoint m) {
+    if (LABELS == LABELS_SOLID) return label_gradient(m.p);
+    if (LABELS == LABELS_TINT) {
+        vec3 g = label_gradient(m.p);
+        if (dot(g, g) > LABEL_EDGE * LABEL_EDGE) return g;
+    }
     if (CHANNELS > 1) {
         vec3 h = box_size() / vec3(frame.dims.xyz);
         vec4 gx = densities_at(m.p + vec3(h.x, 0, 0)) - densities_at(m.p - vec3(h.x, 0, 0));

@@ -1,0 +1,149 @@
+//! A scene's label map on the renderer's side: loaded from `[labels]`, put on the
+//! volume's grid, its labels' views made from the table and the `[[label]]` sections,
+//! and the filtered look ([`LabelLook`]) the renderer uploads, made again only when a
+//! label's look changes. Picking reads the map and the volume under a world point.
+
+use super::uploads::VolumeUpload;
+use crate::scene::labels::{look_of, unlabelled};
+use crate::scene::{LabelMode, LabelView, Scene};
+use crate::volume::labels::{LabelLook, LabelMap, LabelTable};
+use crate::volume::{PatientTransform, VolumeError};
+use glam::Vec3;
+use std::sync::{Arc, Mutex};
+
+/// A label map on the volume's grid, with the last look made from it.
+pub struct SceneLabels {
+    pub map: LabelMap,
+    pub mode: LabelMode,
+    brick: u32,
+    grid: [u32; 3],
+    cache: Mutex<Option<(Vec<LabelView>, Arc<LabelLook>)>>,
+}
+
+impl std::fmt::Debug for SceneLabels {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneLabels")
+            .field("map", &self.map.path)
+            .field("mode", &self.mode)
+            .finish()
+    }
+}
+
+/// What `[labels]` gives: the map on the grid and its labels' views as they start.
+pub fn load(
+    scene: &Scene,
+    volume: &VolumeUpload,
+    to_patient: &PatientTransform,
+) -> Result<Option<(SceneLabels, Vec<LabelView>)>, VolumeError> {
+    let Some(spec) = &scene.labels else {
+        return Ok(None);
+    };
+    let map = LabelMap::load(&spec.file)?.onto(volume.dims, to_patient);
+    let mut table = match &spec.table {
+        Some(path) => LabelTable::load(path)?,
+        None => LabelTable::default(),
+    };
+    let present = map.present();
+    let missing = table.complete(&present);
+    if spec.table.is_some() && !missing.is_empty() {
+        log::warn!(
+            "label map {}: values {missing:?} are not in the table {}; they take palette colours",
+            spec.file.display(),
+            spec.table
+                .as_ref()
+                .map_or(String::new(), |t| t.display().to_string())
+        );
+    }
+    let mut views: Vec<LabelView> = table
+        .labels
+        .iter()
+        .filter(|l| present.binary_search(&l.value).is_ok())
+        .map(|l| LabelView {
+            value: l.value,
+            name: l.name.clone(),
+            colour: l.colour,
+            opacity: l.opacity,
+            visible: l.visible,
+        })
+        .collect();
+    for (i, s) in scene.label_sections.iter().enumerate() {
+        match views.binary_search_by_key(&s.value, |v| v.value) {
+            Ok(k) => views[k] = views[k].clone().with(s),
+            Err(k) if s.value == 0 => views.insert(k, unlabelled(spec.mode).with(s)),
+            Err(_) => {
+                return Err(VolumeError::Unsupported {
+                    path: spec.file.clone(),
+                    reason: format!(
+                        "label[{i}].value = {}: the map has no such label (it has {})",
+                        s.value,
+                        list(&present)
+                    ),
+                })
+            }
+        }
+    }
+    for (i, k) in scene.animation.label.iter().enumerate() {
+        if views.binary_search_by_key(&k.value, |v| v.value).is_err() {
+            return Err(VolumeError::Unsupported {
+                path: spec.file.clone(),
+                reason: format!(
+                    "animation.label[{i}].value = {}: the map has no such label (it has {})",
+                    k.value,
+                    list(&present)
+                ),
+            });
+        }
+    }
+    let labels = SceneLabels {
+        map,
+        mode: spec.mode,
+        brick: volume.bricks.brick,
+        grid: volume.bricks.grid,
+        cache: Mutex::new(None),
+    };
+    Ok(Some((labels, views)))
+}
+
+fn list(values: &[u16]) -> String {
+    let head: Vec<String> = values.iter().take(12).map(u16::to_string).collect();
+    let more = values.len().saturating_sub(12);
+    match more {
+        0 => head.join(", "),
+        n => format!("{} and {n} more", head.join(", ")),
+    }
+}
+
+impl SceneLabels {
+    /// The look of the map under `views` (the last one again when they have not changed).
+    pub fn look(&self, views: &[LabelView]) -> Arc<LabelLook> {
+        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((v, look)) = cache.as_ref() {
+            if v == views {
+                return look.clone();
+            }
+        }
+        let mode = self.mode;
+        let look = Arc::new(LabelLook::new(
+            &self.map,
+            |value| look_of(views, mode, value),
+            self.brick,
+            self.grid,
+        ));
+        *cache = Some((views.to_vec(), look.clone()));
+        look
+    }
+
+    /// The label value at world point `p` of a volume spanning `world` units centred on
+    /// the origin (0 outside).
+    pub fn at(&self, p: Vec3, world: [f32; 3]) -> u16 {
+        let v = voxel_of(p, world, self.map.dims);
+        self.map.at(v[0], v[1], v[2])
+    }
+}
+
+/// The voxel holding world point `p` (unclamped).
+pub fn voxel_of(p: Vec3, world: [f32; 3], dims: [u32; 3]) -> [i64; 3] {
+    let uvw = p / Vec3::from(world) + 0.5;
+    let v = uvw * Vec3::from(dims.map(|d| d as f32));
+    [v.x, v.y, v.z].map(|c| c.floor() as i64)
+}

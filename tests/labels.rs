@@ -1,0 +1,274 @@
+//! A label map beside the volume on the device: a map that changes nothing renders the
+//! frames no map renders, a hidden label is empty medium (Beer–Lambert through a hidden
+//! slab), a label's surface is smooth (a voxelised sphere's first-hit normals follow the
+//! sphere), and picking names the label under a pixel.
+
+mod common;
+
+use common::*;
+use dvr_engine::renderer::scene_setup::SceneSetup;
+use dvr_engine::renderer::{FrameRequest, LabelLookRef, FEATURE_IMAGES};
+use dvr_engine::scene::{Estimator, LabelMode};
+use dvr_engine::volume::labels::{LabelLook, LabelMap, Look, SMOOTHING_SIGMA};
+use dvr_engine::volume::PatientTransform;
+use std::sync::Arc;
+
+fn map(dims: [u32; 3], label: impl Fn(u32, u32, u32) -> u16) -> LabelMap {
+    let mut values = Vec::new();
+    for z in 0..dims[2] {
+        for y in 0..dims[1] {
+            for x in 0..dims[0] {
+                values.push(label(x, y, z));
+            }
+        }
+    }
+    LabelMap {
+        name: "test".into(),
+        path: "test.nii".into(),
+        dims,
+        to_patient: PatientTransform::aligned([1.0; 3]),
+        values,
+    }
+}
+
+fn look(m: &LabelMap, brick: u32, grid: [u32; 3], f: impl Fn(u16) -> Look) -> LabelLookRef {
+    LabelLookRef(Arc::new(LabelLook::new(m, f, brick, grid)))
+}
+
+const SHOWN: Look = Look {
+    colour: [1.0; 3],
+    mask: 1.0,
+};
+const HIDDEN: Look = Look {
+    colour: [1.0; 3],
+    mask: 0.0,
+};
+
+/// Camera rays along z through an absorbing unit cube whose voxels z in [8, 16) of 32
+/// are a hidden label: T = exp(−μt · 0.75).
+fn hidden_slab_transmittance(estimator: Estimator) -> f64 {
+    let n = 32;
+    let mut s = settings(8, 1);
+    s.settings.set_estimator(estimator);
+    s.config.density_scale = 1.5;
+    s.config.labels = Some(LabelMode::Tint);
+    s.settings.set_step_size(0.25).expect("step");
+    s.settings.set_filter_sigma(0.0).expect("pinhole");
+    let volume = constant_volume(n, 1.0);
+    let slab = map([n; 3], |_, _, z| if (8..16).contains(&z) { 2 } else { 1 });
+    let labels = look(&slab, n, [1; 3], |v| if v == 2 { HIDDEN } else { SHOWN });
+    let mut r = renderer(context(), s, &volume, &["none"]);
+    let i = dvr_engine::renderer::FrameInputs {
+        labels: Some(labels),
+        ..inputs(
+            front_camera(3.0, 2.0),
+            vec![environment(1.0)],
+            constant_lut(1.0, 0.0),
+        )
+    };
+    let img = r.reference(&i, 4096, 512).expect("reference render");
+    mean_rgb(&img)[0]
+}
+
+#[test]
+fn a_hidden_label_is_empty_medium_to_delta_tracking_and_ray_marching() {
+    let expected = (-1.5f64 * 0.75).exp();
+    for estimator in [Estimator::Delta, Estimator::RayMarch] {
+        let t = hidden_slab_transmittance(estimator);
+        assert!(
+            ((t - expected) / expected).abs() < 0.01,
+            "{estimator:?}: T = {t}, exp(-1.125) = {expected}"
+        );
+    }
+    assert_validation_clean();
+}
+
+/// The phantom's frames with the renderer's inputs changed by `edit`, read back for
+/// `ours` and the noisy input.
+fn phantom_frames(
+    labels: Option<LabelMode>,
+    look_of: impl Fn(&SceneSetup) -> Option<LabelLookRef>,
+) -> Vec<Vec<(String, Vec<[f32; 4]>)>> {
+    let mut setup = builtin_setup("phantom/orbit", 3, 24);
+    setup.config.labels = labels;
+    let look = look_of(&setup);
+    let mut r = setup
+        .renderer(context(), &["ours", "svgf"])
+        .expect("renderer");
+    let request = FrameRequest {
+        readback: true,
+        ..Default::default()
+    };
+    let mut out = Vec::new();
+    for f in 0..3 {
+        let i = dvr_engine::renderer::FrameInputs {
+            labels: look.clone(),
+            ..setup.frame_inputs(f)
+        };
+        out.extend(r.frame(&i, &request).expect("frame"));
+    }
+    out.extend(r.flush().expect("flush"));
+    out.sort_by_key(|f| f.index);
+    out.into_iter().map(|f| f.images).collect()
+}
+
+#[test]
+fn a_map_of_one_visible_label_with_a_unit_tint_renders_the_frames_of_no_map() {
+    let none = phantom_frames(None, |_| None);
+    let one = phantom_frames(Some(LabelMode::Tint), |s| {
+        let v = &s.volume;
+        let m = map(v.dims, |_, _, _| 7);
+        Some(look(&m, v.bricks.brick, v.bricks.grid, |_| SHOWN))
+    });
+    assert_eq!(none.len(), 3);
+    for (f, (a, b)) in none.iter().zip(&one).enumerate() {
+        for ((name, x), (_, y)) in a.iter().zip(b) {
+            let same = x
+                .iter()
+                .zip(y)
+                .all(|(p, q)| p.map(f32::to_bits) == q.map(f32::to_bits));
+            assert!(
+                same,
+                "frame {f}, {name}: a map that changes nothing changed the image"
+            );
+        }
+    }
+    assert_validation_clean();
+}
+
+/// Angles (degrees) between the first-hit normals and a sphere's own, over the surface
+/// pixels of a `size`² view of a sphere of radius 20 voxels in a 64³ label map, shown
+/// as solid tissue.
+fn sphere_normal_errors(size: u32, sigma: f32) -> Vec<(glam::Vec3, f64)> {
+    let n = SPHERE_GRID;
+    let mut s = settings(size, 1);
+    s.config.density_scale = 150.0;
+    s.config.labels = Some(LabelMode::Solid);
+    let volume = constant_volume(n, 0.5);
+    let sphere = map([n; 3], |x, y, z| sphere_label([x, y, z].map(|i| i as i64)));
+    let shown = |v| if v == 1 { SHOWN } else { HIDDEN };
+    let labels = LabelLookRef(Arc::new(LabelLook::filtered(
+        &sphere, shown, n, [1; 3], sigma,
+    )));
+    let mut r = renderer(context(), s, &volume, &["none"]);
+    let i = dvr_engine::renderer::FrameInputs {
+        labels: Some(labels),
+        ..inputs(
+            front_camera(2.0, 25.0),
+            vec![environment(1.0)],
+            constant_lut(1.0, 0.8),
+        )
+    };
+    let request = FrameRequest {
+        readback: true,
+        features: true,
+        ..Default::default()
+    };
+    let mut done: Vec<_> = r.frame(&i, &request).expect("frame").into_iter().collect();
+    done.extend(r.flush().expect("flush"));
+    let image = |name: &str| {
+        done[0]
+            .images
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, i)| i.clone())
+            .expect("features read back")
+    };
+    let (pos, nrm, alb) = (
+        image(FEATURE_IMAGES[0]),
+        image(FEATURE_IMAGES[1]),
+        image(FEATURE_IMAGES[2]),
+    );
+    drop(r);
+    assert_validation_clean();
+    let mut errors = Vec::new();
+    for ((p, nm), a) in pos.iter().zip(&nrm).zip(&alb) {
+        if a[3] < 0.5 {
+            continue; // not on the threshold surface
+        }
+        // The sphere's normal at the hit, facing the camera as feature normals do (a
+        // grazing ray may cross the threshold just past the silhouette).
+        let p = glam::Vec3::new(p[0], p[1], p[2]);
+        let d = p - glam::Vec3::new(0.0, 0.0, 2.0);
+        let own = if p.dot(d) > 0.0 { -p } else { p }.normalize();
+        let nm = glam::Vec3::new(nm[0], nm[1], nm[2]).normalize();
+        errors.push((p, angle(own, nm)));
+    }
+    errors
+}
+
+#[test]
+fn a_label_surface_is_smooth_its_normals_follow_the_sphere() {
+    let hits = sphere_normal_errors(256, SMOOTHING_SIGMA);
+    let errors: Vec<f64> = hits.iter().map(|h| h.1).collect();
+    // The sphere (radius 0.3125 of the unit box at distance 2, 25° field) covers about a
+    // third of the image.
+    assert!(
+        errors.len() > 256 * 256 / 5,
+        "{} surface pixels",
+        errors.len()
+    );
+    let within = errors.iter().filter(|&&e| e < 10.0).count() as f64 / errors.len() as f64;
+    println!(
+        "labelled sphere at 256²: {:.1}% of {} surface pixels within 10° of the sphere's normal",
+        within * 100.0,
+        errors.len()
+    );
+    assert!(within >= 0.95, "{:.1}% within 10°", within * 100.0);
+    // The same without the filter: trilinear reads of the raw indicator leave the voxel
+    // facets in the normals.
+    let raw = sphere_normal_errors(256, 0.0);
+    let raw_within = raw.iter().filter(|h| h.1 < 10.0).count() as f64 / raw.len() as f64;
+    // And a nearest-neighbour look-up of the labels (central differences of the label
+    // indicator at the same surface points): normals along the voxel axes.
+    let nearest = |p: glam::Vec3| {
+        let v = (p + 0.5) * SPHERE_GRID as f32;
+        let at = |o: glam::Vec3| {
+            let q = (v + o).floor();
+            f32::from(sphere_label([q.x as i64, q.y as i64, q.z as i64]))
+        };
+        let g = glam::Vec3::new(
+            at(glam::Vec3::X) - at(-glam::Vec3::X),
+            at(glam::Vec3::Y) - at(-glam::Vec3::Y),
+            at(glam::Vec3::Z) - at(-glam::Vec3::Z),
+        );
+        let d = p - glam::Vec3::new(0.0, 0.0, 2.0);
+        let own = if p.dot(d) > 0.0 { -p } else { p }.normalize();
+        // The normal along the indicator's gradient, turned to face the camera.
+        let n = if g.dot(d) < 0.0 { g } else { -g };
+        if g == glam::Vec3::ZERO {
+            90.0
+        } else {
+            angle(own, n)
+        }
+    };
+    let near_within =
+        hits.iter().filter(|h| nearest(h.0) < 10.0).count() as f64 / hits.len() as f64;
+    println!(
+        "unfiltered (trilinear reads of the indicator): {:.1}% within 10°; nearest-neighbour look-up: {:.1}%",
+        raw_within * 100.0,
+        near_within * 100.0
+    );
+    assert!(
+        raw_within < within && near_within < within,
+        "the filter is what smooths the surface"
+    );
+}
+
+const SPHERE_GRID: u32 = 64;
+
+/// Label 1 inside a sphere of radius 20 voxels at the centre of a 64³ grid, 0 outside.
+fn sphere_label(v: [i64; 3]) -> u16 {
+    let n = i64::from(SPHERE_GRID);
+    if v.iter().any(|&c| c < 0 || c >= n) {
+        return 0;
+    }
+    let d = v.map(|i| i as f32 + 0.5 - n as f32 / 2.0);
+    u16::from(d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= 400.0)
+}
+
+fn angle(a: glam::Vec3, b: glam::Vec3) -> f64 {
+    f64::from(a.normalize().dot(b.normalize()).clamp(-1.0, 1.0))
+        .acos()
+        .to_degrees()
+}
