@@ -272,3 +272,94 @@ fn angle(a: glam::Vec3, b: glam::Vec3) -> f64 {
         .acos()
         .to_degrees()
 }
+
+/// Picking through a session on the phantom with its built-in labels, shown as solid
+/// tissue one label at a time: looking straight at a voxel of each label near the
+/// label's centroid, the pick names that label.
+#[test]
+fn picking_names_the_label_at_the_centre_of_each_label_of_the_phantom() {
+    use dvr_engine::scene::{CameraSpec, Scene};
+    use dvr_engine::session::{Edit, LabelEdit, Session};
+    let scene = Scene::from_toml_str(
+        r#"
+        [volume]
+        builtin = "phantom"
+        size = 48
+        [transfer]
+        a = "ct-bone"
+        [labels]
+        builtin = "phantom"
+        mode = "solid"
+        [[light]]
+        kind = "environment"
+        intensity = 1.0
+        "#,
+        "pick.toml",
+    )
+    .expect("scene");
+    let extent = dvr_engine::graph::Extent {
+        width: 33,
+        height: 33,
+    };
+    let setup = SceneSetup::new(scene, extent, Some(1), 48).expect("setup");
+    let labels = setup.labels.clone().expect("built-in labels");
+    let (dims, world) = (setup.volume.dims, setup.volume.world_size);
+    let mut s = Session::new(setup, context(), &["none"]).expect("session");
+    let values: Vec<u16> = s.view().labels.iter().map(|l| l.value).collect();
+    assert_eq!(
+        values,
+        [1, 2, 3, 4, 5],
+        "scalp, skull, brain, ventricles, vessels"
+    );
+    for value in values {
+        // The label's voxel nearest its centroid, in world units.
+        let voxels: Vec<glam::Vec3> = (0..labels.map.values.len())
+            .filter(|&i| labels.map.values[i] == value)
+            .map(|i| {
+                let [nx, ny, _] = dims.map(|d| d as usize);
+                let v = [i % nx, (i / nx) % ny, i / (nx * ny)];
+                glam::Vec3::from(v.map(|c| c as f32 + 0.5))
+                    / glam::Vec3::from(dims.map(|d| d as f32))
+                    * glam::Vec3::from(world)
+                    - glam::Vec3::from(world) * 0.5
+            })
+            .collect();
+        let centroid = voxels.iter().sum::<glam::Vec3>() / voxels.len() as f32;
+        let target = *voxels
+            .iter()
+            .min_by(|a, b| a.distance(centroid).total_cmp(&b.distance(centroid)))
+            .expect("the label has voxels");
+        s.edit(Edit::Label(LabelEdit {
+            value: None,
+            visible: Some(false),
+            ..Default::default()
+        }))
+        .expect("hide all");
+        s.edit(Edit::Label(LabelEdit {
+            value: Some(value),
+            visible: Some(true),
+            ..Default::default()
+        }))
+        .expect("show one");
+        s.edit(Edit::Camera(CameraSpec {
+            position: (target + glam::Vec3::new(0.3, 1.4, 0.4)).as_dvec3(),
+            target: target.as_dvec3(),
+            up: glam::DVec3::Z,
+            fov_y_degrees: 20.0,
+        }))
+        .expect("camera");
+        let pick = s
+            .pick(16, 16)
+            .expect("pick")
+            .expect("the ray meets the label");
+        assert_eq!(
+            (pick.label, pick.label_name.as_deref().is_some()),
+            (value, true),
+            "looking at label {value} at {target}: {pick:?}"
+        );
+    }
+    let err = s.pick(33, 0).unwrap_err().to_string();
+    assert!(err.contains("outside the 33x33 image"), "{err}");
+    drop(s);
+    assert_validation_clean();
+}

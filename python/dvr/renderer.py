@@ -7,6 +7,7 @@ import numpy as np
 
 from . import _native
 from .channels import Channel
+from .labels import Labels
 from .live import CameraView, ClipsView, CropView, LightsView, SettingsView, _as_dict, _plain
 from .scene import Scene, TransferFunction
 
@@ -192,6 +193,20 @@ class Renderer:
         """The channels of a multi-channel medium (empty for one field), each a live
         :class:`~dvr.channels.Channel`: ``r.channels[1].visible = False``."""
         return [Channel(self._r, i) for i in range(len(self._r.channels()))]
+
+    @property
+    def labels(self) -> Labels:
+        """The labels of the scene's label map (``[labels]``; empty without one), by
+        value, each a live :class:`~dvr.labels.Label`: ``r.labels[3].visible = False``,
+        ``r.labels.hide_all()``."""
+        return Labels(self._r)
+
+    def pick(self, x, y):
+        """What lies under pixel ``(x, y)`` (row 0 at the top) at the features pass's first
+        hit: a dict with ``position`` (world), ``voxel``, ``intensity`` (data units),
+        ``label`` (0: none) and ``label_name``; ``None`` where the ray meets nothing.
+        Renders one frame of the current view to find it."""
+        return self._r.pick(int(x), int(y))
 
     @property
     def denoisers(self) -> tuple:

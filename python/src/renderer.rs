@@ -16,7 +16,7 @@ use dvr_engine::renderer::medium::{load_channels, Channels};
 use dvr_engine::renderer::scene_setup::{load_volume, SceneSetup, DEFAULT_VOLUME_SIZE};
 use dvr_engine::renderer::{FrameRequest, FrameResult, FEATURE_IMAGES};
 use dvr_engine::scene::{parse_memory_size, TfState, ViewSections};
-use dvr_engine::session::{ChannelEdit, Edit, Session, SessionError};
+use dvr_engine::session::{ChannelEdit, Edit, LabelEdit, Session, SessionError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::sync::{Mutex, PoisonError};
@@ -383,6 +383,77 @@ impl Renderer {
             visible,
         };
         self.edit(py, Edit::Channel(edit))
+    }
+
+    /// The label map's mode (`"tint"` or `"solid"`; `None` without a label map) and
+    /// each of its labels: `{"value", "name", "colour", "opacity", "visible"}` by value.
+    fn labels<'py>(&self, py: Python<'py>) -> PyResult<(Option<String>, Vec<Bound<'py, PyDict>>)> {
+        let (mode, views) = self.locked(py, |me| {
+            let s = &me.session;
+            let mode = s.setup().labels.as_ref().map(|l| l.mode);
+            Ok((mode, s.view().labels.clone()))
+        })?;
+        let mode = mode.map(|m| match m {
+            dvr_engine::scene::LabelMode::Tint => "tint".to_string(),
+            dvr_engine::scene::LabelMode::Solid => "solid".to_string(),
+        });
+        let views = views
+            .iter()
+            .map(|l| {
+                let d = PyDict::new(py);
+                d.set_item("value", l.value)?;
+                d.set_item("name", &l.name)?;
+                d.set_item("colour", l.colour.to_vec())?;
+                d.set_item("opacity", l.opacity)?;
+                d.set_item("visible", l.visible)?;
+                Ok(d)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        Ok((mode, views))
+    }
+
+    /// Edits label `value` (`None`: every label): what is given changes. Raises
+    /// `ValueError` naming the field.
+    #[pyo3(signature = (value, colour = None, opacity = None, visible = None))]
+    fn edit_label(
+        &self,
+        py: Python<'_>,
+        value: Option<u16>,
+        colour: Option<(f32, f32, f32)>,
+        opacity: Option<f32>,
+        visible: Option<bool>,
+    ) -> PyResult<()> {
+        let edit = LabelEdit {
+            value,
+            colour: colour.map(|(r, g, b)| [r, g, b]),
+            opacity,
+            visible,
+        };
+        self.edit(py, Edit::Label(edit))
+    }
+
+    /// What lies under pixel (x, y) (row 0 at the top): `{"position", "voxel",
+    /// "intensity", "label", "label_name"}`, or `None` where the ray meets nothing.
+    /// Renders one frame of the current view.
+    fn pick<'py>(&self, py: Python<'py>, x: i64, y: i64) -> PyResult<Option<Bound<'py, PyDict>>> {
+        if x < 0 || y < 0 || x > i64::from(u32::MAX) || y > i64::from(u32::MAX) {
+            return Err(value_error(format!(
+                "pick({x}, {y}): pixel coordinates must be >= 0"
+            )));
+        }
+        let pick = self.locked(py, |me| {
+            me.session.pick(x as u32, y as u32).map_err(session_error)
+        })?;
+        pick.map(|p| {
+            let d = PyDict::new(py);
+            d.set_item("position", p.position.to_vec())?;
+            d.set_item("voxel", p.voxel.to_vec())?;
+            d.set_item("intensity", p.intensity)?;
+            d.set_item("label", p.label)?;
+            d.set_item("label_name", p.label_name)?;
+            Ok(d)
+        })
+        .transpose()
     }
 
     /// The transfer function in effect: `{"a": tf, "b": tf or None, "blend": x,

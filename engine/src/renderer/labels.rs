@@ -38,17 +38,44 @@ pub fn load(
     let Some(spec) = &scene.labels else {
         return Ok(None);
     };
-    let map = LabelMap::load(&spec.file)?.onto(volume.dims, to_patient);
-    let mut table = match &spec.table {
-        Some(path) => LabelTable::load(path)?,
-        None => LabelTable::default(),
+    let (map, builtin_table) = match (&spec.file, &spec.builtin) {
+        (Some(file), _) => (LabelMap::load(file)?.onto(volume.dims, to_patient), None),
+        (None, Some(name)) => {
+            let dataset = match &scene.volume.source {
+                crate::scene::VolumeSource::Builtin { dataset, .. } => Some(dataset.name()),
+                _ => None,
+            };
+            if dataset != Some(name.as_str()) {
+                return Err(VolumeError::Unsupported {
+                    path: name.into(),
+                    reason: format!(
+                        "labels.builtin = {name:?} labels the built-in {name} volume; this scene's volume is {}",
+                        dataset.map_or("a file".to_string(), |d| format!("the built-in {d}"))
+                    ),
+                });
+            }
+            let (map, table) = LabelMap::builtin(name, volume.dims, to_patient)?;
+            (map, Some(table))
+        }
+        (None, None) => {
+            return Err(VolumeError::Unsupported {
+                path: "labels".into(),
+                reason: "[labels] names neither a file nor a built-in".into(),
+            })
+        }
+    };
+    let origin = map.path.clone();
+    let mut table = match (&spec.table, builtin_table) {
+        (Some(path), _) => LabelTable::load(path)?,
+        (None, Some(t)) => t,
+        (None, None) => LabelTable::default(),
     };
     let present = map.present();
     let missing = table.complete(&present);
     if spec.table.is_some() && !missing.is_empty() {
         log::warn!(
             "label map {}: values {missing:?} are not in the table {}; they take palette colours",
-            spec.file.display(),
+            origin.display(),
             spec.table
                 .as_ref()
                 .map_or(String::new(), |t| t.display().to_string())
@@ -72,7 +99,7 @@ pub fn load(
             Err(k) if s.value == 0 => views.insert(k, unlabelled(spec.mode).with(s)),
             Err(_) => {
                 return Err(VolumeError::Unsupported {
-                    path: spec.file.clone(),
+                    path: origin.clone(),
                     reason: format!(
                         "label[{i}].value = {}: the map has no such label (it has {})",
                         s.value,
@@ -85,7 +112,7 @@ pub fn load(
     for (i, k) in scene.animation.label.iter().enumerate() {
         if views.binary_search_by_key(&k.value, |v| v.value).is_err() {
             return Err(VolumeError::Unsupported {
-                path: spec.file.clone(),
+                path: origin.clone(),
                 reason: format!(
                     "animation.label[{i}].value = {}: the map has no such label (it has {})",
                     k.value,

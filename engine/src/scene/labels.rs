@@ -26,11 +26,15 @@ pub enum LabelMode {
     Solid,
 }
 
-/// `[labels]` as written.
+/// `[labels]` as written: a file, or a built-in dataset's segmentation (`phantom`,
+/// `mri`; its volume must be that dataset).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LabelsSpec {
-    pub file: PathBuf,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub builtin: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub table: Option<PathBuf>,
     #[serde(default)]
@@ -119,7 +123,7 @@ pub fn look_of(views: &[LabelView], mode: LabelMode, value: u16) -> Look {
 impl LabelsSpec {
     /// Paths joined to the scene file's folder.
     pub(crate) fn resolve(mut self, ctx: &Ctx) -> Self {
-        self.file = ctx.resolve(&self.file);
+        self.file = self.file.map(|f| ctx.resolve(&f));
         self.table = self.table.map(|t| ctx.resolve(&t));
         self
     }
@@ -130,6 +134,22 @@ pub(crate) fn check_sections(
     labels: Option<&LabelsSpec>,
     sections: &[LabelFile],
 ) -> Result<(), SceneError> {
+    if let Some(l) = labels {
+        if l.file.is_some() == l.builtin.is_some() {
+            return Err(ctx.invalid(
+                "labels",
+                "give one of file = \"...\" (a label map) or builtin = \"phantom\" | \"mri\"",
+            ));
+        }
+        if let Some(b) = &l.builtin {
+            if !matches!(b.as_str(), "phantom" | "mri") {
+                return Err(ctx.invalid(
+                    "labels.builtin",
+                    format!("{b:?} has no built-in labels (phantom, mri)"),
+                ));
+            }
+        }
+    }
     if labels.is_none() && !sections.is_empty() {
         return Err(ctx.invalid(
             "label",

@@ -3,8 +3,14 @@
 //! (the label and the intensity at the features pass's first hit).
 
 use super::{invalid_edit, Result, Session};
+use crate::renderer::labels::voxel_of;
 use crate::renderer::{FrameRequest, FEATURE_IMAGES};
+use crate::scene::labels::look_of;
 use glam::Vec3;
+
+/// How far (voxels, per axis) a pick looks around the first hit for the label that
+/// makes the surface: the filter's reach (`volume::labels::SMOOTHING_SIGMA` is 1 voxel).
+const PICK_REACH: i64 = 2;
 
 /// A change to label `value` (`None`: every label of the map).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -130,19 +136,40 @@ impl Session {
         }
         let p = Vec3::new(position[0], position[1], position[2]);
         let volume = &self.setup.volume;
-        let v = crate::renderer::labels::voxel_of(p, volume.world_size, volume.dims);
-        let voxel = [0, 1, 2].map(|a| v[a].clamp(0, i64::from(volume.dims[a]) - 1) as u32);
-        let intensity = volume.data_value(voxel).unwrap_or(f32::NAN);
+        let (world, dims) = (volume.world_size, volume.dims);
+        let clamp = |v: [i64; 3]| [0, 1, 2].map(|a| v[a].clamp(0, i64::from(dims[a]) - 1) as u32);
+        let mut voxel = clamp(voxel_of(p, world, dims));
         let (label, label_name) = match &self.setup.labels {
             Some(labels) => {
-                let value = labels.map.at(
-                    i64::from(voxel[0]),
-                    i64::from(voxel[1]),
-                    i64::from(voxel[2]),
-                );
-                let name = self
-                    .view
-                    .labels
+                // A label's surface is its filtered mask's, which reaches past its
+                // voxels: the label that makes the surface is that of the nearest shown
+                // voxel within the filter's reach.
+                let views = &self.view.labels;
+                let mode = labels.mode;
+                let at = |v: [i64; 3]| labels.map.at(v[0], v[1], v[2]);
+                let centre = voxel_of(p, world, dims);
+                let q = (p / Vec3::from(world) + 0.5) * Vec3::from(dims.map(|d| d as f32));
+                let r = PICK_REACH;
+                let mut best: Option<(f32, [i64; 3])> = None;
+                for dz in -r..=r {
+                    for dy in -r..=r {
+                        for dx in -r..=r {
+                            let v = [centre[0] + dx, centre[1] + dy, centre[2] + dz];
+                            if look_of(views, mode, at(v)).mask <= 0.0 {
+                                continue;
+                            }
+                            let d = (Vec3::from(v.map(|c| c as f32 + 0.5)) - q).length_squared();
+                            if best.is_none_or(|(b, _)| d < b) {
+                                best = Some((d, v));
+                            }
+                        }
+                    }
+                }
+                if let Some((_, v)) = best {
+                    voxel = clamp(v);
+                }
+                let value = at(voxel.map(i64::from));
+                let name = views
                     .iter()
                     .find(|l| l.value == value)
                     .map(|l| l.name.clone());
@@ -150,6 +177,7 @@ impl Session {
             }
             None => (0, None),
         };
+        let intensity = volume.data_value(voxel).unwrap_or(f32::NAN);
         Ok(Some(Pick {
             position: p.to_array(),
             voxel,

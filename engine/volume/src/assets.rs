@@ -38,6 +38,16 @@ pub fn mri_volume() -> PathBuf {
     assets_dir().join("volumes/mni152_t1.nii.gz")
 }
 
+/// The segmentation of the MNI152 head (white matter, grey matter) and its ITK-SNAP
+/// label file: the `mri` dataset's built-in labels.
+pub fn mri_labels() -> (PathBuf, PathBuf) {
+    let dir = assets_dir().join("volumes");
+    (
+        dir.join("mni152_labels.nii.gz"),
+        dir.join("mni152_labels.label"),
+    )
+}
+
 /// The folder of transfer-function presets (`<name>.toml`).
 pub fn transfer_presets() -> PathBuf {
     assets_dir().join("transfer")

@@ -49,6 +49,57 @@ impl LabelMap {
         Self::from_volume(path, &v)
     }
 
+    /// A built-in dataset's segmentation on the grid of `dims` voxels placed by
+    /// `to_patient` (the dataset's own volume), with its table: `phantom` (scalp, skull,
+    /// brain, ventricles, vessels; made at the volume's size) or `mri` (white and grey
+    /// matter of the MNI152 head, read from the assets).
+    pub fn builtin(
+        name: &str,
+        dims: [u32; 3],
+        to_patient: &PatientTransform,
+    ) -> Result<(Self, LabelTable), VolumeError> {
+        match name {
+            "phantom" => {
+                let [n, ny, nz] = dims;
+                if ny != n || nz != n {
+                    return Err(VolumeError::Unsupported {
+                        path: PathBuf::from(name),
+                        reason: format!(
+                            "the phantom's labels are made on its own cubic grid, not {dims:?} voxels (use them with `builtin = \"phantom\"`)"
+                        ),
+                    });
+                }
+                let map = Self {
+                    name: "phantom labels".into(),
+                    path: PathBuf::from("phantom"),
+                    dims,
+                    to_patient: *to_patient,
+                    values: crate::phantom::labels(n),
+                };
+                let labels = crate::phantom::LABELS
+                    .iter()
+                    .map(|&(value, name, colour)| Label {
+                        value,
+                        name: name.into(),
+                        colour,
+                        opacity: 1.0,
+                        visible: true,
+                    })
+                    .collect();
+                Ok((map, LabelTable { labels }))
+            }
+            "mri" => {
+                let (file, table) = crate::assets::mri_labels();
+                let map = Self::load(&file)?.onto(dims, to_patient);
+                Ok((map, LabelTable::load(&table)?))
+            }
+            _ => Err(VolumeError::UnknownBuiltin {
+                name: name.into(),
+                valid: "phantom, mri".into(),
+            }),
+        }
+    }
+
     /// The label values of a loaded integer volume: its densities brought back through
     /// its window (exact for integer samples: a window spans at most 65535 steps of the
     /// 16-bit density, or the 8-bit values themselves).

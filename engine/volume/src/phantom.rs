@@ -197,6 +197,59 @@ pub(crate) fn generate(n: u32) -> Vec<u16> {
     })
 }
 
+/// The phantom's tissue classes as labels: what [`labels`] writes per voxel.
+pub const LABELS: [(u16, &str, [f32; 3]); 5] = [
+    (1, "scalp", [0.85, 0.66, 0.56]),
+    (2, "skull", [0.95, 0.93, 0.84]),
+    (3, "brain", [0.86, 0.58, 0.56]),
+    (4, "ventricles", [0.40, 0.62, 0.95]),
+    (5, "vessels", [0.92, 0.16, 0.14]),
+];
+
+/// The phantom's segmentation at `n`³ voxels: the class whose region holds each voxel's
+/// centre (0 outside the scalp), from the same shapes [`generate`] fills. A vessel voxel
+/// is one whose centre lies within a voxel of a centre line, where the vessels are
+/// drawn (three voxels inside the skull on).
+pub(crate) fn labels(n: u32) -> Vec<u16> {
+    let dims = [n; 3];
+    let h = 2.0 / n as f32;
+    let lines: Vec<Vec<[f32; 2]>> = VESSELS
+        .iter()
+        .map(|v| (0..n).map(|i| v.at(centre(i, n))).collect())
+        .collect();
+    let vessel_r = 0.5 * (VESSEL_CORE + VESSEL_EDGE);
+    fill_slices(dims, |z, slice| {
+        for y in 0..n {
+            for x in 0..n {
+                let p = [centre(x, n), centre(y, n), centre(z, n)];
+                let idx = [x, y, z];
+                let label = if ellipsoid(p, [0.0; 3], SKIN_R) >= 0.0 {
+                    0
+                } else if ellipsoid(p, [0.0; 3], BONE_R) >= 0.0 {
+                    1
+                } else {
+                    let d_brain = ellipsoid(p, [0.0; 3], BRAIN_R) / h;
+                    let vessel = d_brain + 3.0 < 0.5
+                        && VESSELS.iter().zip(&lines).any(|(v, line)| {
+                            let q = line[idx[v.axis] as usize];
+                            let [a, b] = v.across();
+                            let (du, dv) = ((p[a] - q[0]) / h, (p[b] - q[1]) / h);
+                            du * du + dv * dv < vessel_r * vessel_r
+                        });
+                    let ventricle = VENTRICLES.iter().any(|&(c, r)| ellipsoid(p, c, r) < 0.0);
+                    match () {
+                        _ if d_brain >= 0.0 => 2,
+                        _ if vessel => 5,
+                        _ if ventricle => 4,
+                        _ => 3,
+                    }
+                };
+                slice[(y * n + x) as usize] = label;
+            }
+        }
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
