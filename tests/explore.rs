@@ -538,3 +538,69 @@ fn a_channel_switches_off_takes_a_tf_and_the_time_slider_scrubs_a_series() {
         "scrubbing the time barely changed the view ({d_time:.2})"
     );
 }
+
+#[test]
+fn labels_hide_and_take_a_colour_and_a_click_picks_the_label_under_it() {
+    let Some(x) = xvfb() else { return };
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/assets/scenes/development/phantom-labels-skull-orbit.toml"
+    );
+    let run = |name: &str, script: &str| {
+        let shot = dir.path().join(name);
+        let size = format!("{SIZE}x{SIZE}");
+        let mut args = vec![
+            "explore",
+            "--scene",
+            scene,
+            "--size",
+            &size,
+            "--frames",
+            "20",
+            "--screenshot",
+            shot.to_str().expect("utf-8 path"),
+        ];
+        if !script.is_empty() {
+            args.extend(["--script", script]);
+        }
+        let out = dvr(Some(&x.display), &args, dir.path());
+        assert_clean(&out);
+        (
+            Shot::open(&shot),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+        )
+    };
+    let (all, _) = run("all.png", "");
+    // The scalp and skull hidden, the vessels green, then a click at the view's centre.
+    let (edited, stdout) = run(
+        "edited.png",
+        "label:1:off@2;label:2:off@2;label:5:colour:0,1,0@3;pick:128,128@6;pick:2,2@7",
+    );
+    let d = mean_abs_diff(&all, &edited, SIZE, SIZE);
+    eprintln!("mean |Δ| with the scalp and skull hidden: {d:.2}\n{stdout}");
+    assert!(
+        d > 1.0,
+        "hiding two labels barely changed the view ({d:.2})"
+    );
+    let picked = stdout
+        .lines()
+        .find(|l| l.starts_with("pick (128, 128): label"))
+        .unwrap_or_else(|| panic!("no pick line:\n{stdout}"));
+    // Inside the open head the ray meets the brain, its ventricles or a vessel: never
+    // the hidden scalp or skull.
+    assert!(
+        [
+            "label 3 \"brain\"",
+            "label 4 \"ventricles\"",
+            "label 5 \"vessels\""
+        ]
+        .iter()
+        .any(|l| picked.contains(l)),
+        "{picked}"
+    );
+    assert!(
+        stdout.contains("pick (2, 2): nothing"),
+        "a corner of the view meets nothing:\n{stdout}"
+    );
+}

@@ -37,11 +37,13 @@ fn look(m: &LabelMap, brick: u32, grid: [u32; 3], f: impl Fn(u16) -> Look) -> La
 
 const SHOWN: Look = Look {
     colour: [1.0; 3],
-    mask: 1.0,
+    opacity: 1.0,
+    visible: true,
 };
 const HIDDEN: Look = Look {
     colour: [1.0; 3],
-    mask: 0.0,
+    opacity: 1.0,
+    visible: false,
 };
 
 /// Camera rays along z through an absorbing unit cube whose voxels z in [8, 16) of 32
@@ -351,7 +353,7 @@ fn picking_names_the_label_at_the_centre_of_each_label_of_the_phantom() {
         let pick = s
             .pick(16, 16)
             .expect("pick")
-            .expect("the ray meets the label");
+            .unwrap_or_else(|| panic!("the ray meets label {value} at {target}"));
         assert_eq!(
             (pick.label, pick.label_name.as_deref().is_some()),
             (value, true),

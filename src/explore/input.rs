@@ -128,6 +128,18 @@ pub enum Command {
     Time(f64),
     /// Playback on or off.
     Play(bool),
+    /// A change to one label of the label map (`None`: every label; the labels panel).
+    Label(Option<u16>, LabelCommand),
+    /// What lies under view pixel (x, y) (a click that is not a drag).
+    Pick(f64, f64),
+}
+
+/// What a `label:` script command does (the labels panel's controls).
+#[derive(Clone, Debug, PartialEq)]
+pub enum LabelCommand {
+    Visible(bool),
+    Colour([f32; 3]),
+    Opacity(f32),
 }
 
 /// What a `channel:` script command does (the channels panel's controls).
@@ -203,6 +215,9 @@ pub fn camera_edit(command: &Command) -> Option<Edit> {
 pub struct Pointer {
     pub position: Option<(f64, f64)>,
     pub drag: Option<DragKind>,
+    /// Whether the left button went down and came up without the cursor moving (a
+    /// click picks; a drag orbits).
+    pub clicked: bool,
 }
 
 impl Pointer {
@@ -211,10 +226,24 @@ impl Pointer {
         let last = self.position.replace((x, y));
         match (self.drag, last) {
             (Some(kind), Some((lx, ly))) if (x, y) != (lx, ly) => {
+                self.clicked = false;
                 Some(Command::Drag(kind, x - lx, y - ly))
             }
             _ => None,
         }
+    }
+
+    /// A button press over the view.
+    pub fn pressed(&mut self, button: MouseButton) {
+        self.drag = DragKind::from_button(button);
+        self.clicked = button == MouseButton::Left;
+    }
+
+    /// A button release: a pick where the left button clicked without dragging.
+    pub fn released(&mut self) -> Option<Command> {
+        self.drag = None;
+        let (x, y) = self.position?;
+        std::mem::take(&mut self.clicked).then_some(Command::Pick(x, y))
     }
 }
 
@@ -330,6 +359,38 @@ impl Script {
                         _ => bail!(usage()),
                     };
                     Command::Channel(i, change)
+                }
+                "label" => {
+                    let usage = || {
+                        format!("script command {part:?}: label:V|all:on, label:V|all:off, label:V|all:colour:R,G,B or label:V|all:opacity:O")
+                    };
+                    let (v, what) = args.trim().split_once(':').with_context(usage)?;
+                    let value = match v.trim() {
+                        "all" => None,
+                        v => Some(v.parse::<u16>().ok().with_context(usage)?),
+                    };
+                    let unit = |s: &str| s.trim().parse::<f32>().ok().filter(|c| (0.0..=1.0).contains(c));
+                    let change = match what.trim().split_once(':') {
+                        None if what.trim() == "on" => LabelCommand::Visible(true),
+                        None if what.trim() == "off" => LabelCommand::Visible(false),
+                        Some(("colour" | "color", rgb)) => {
+                            let v: Vec<f32> = rgb.split(',').map(unit).collect::<Option<_>>().filter(|v: &Vec<f32>| v.len() == 3).with_context(usage)?;
+                            LabelCommand::Colour([v[0], v[1], v[2]])
+                        }
+                        Some(("opacity", o)) => LabelCommand::Opacity(unit(o).with_context(usage)?),
+                        _ => bail!(usage()),
+                    };
+                    Command::Label(value, change)
+                }
+                "pick" => {
+                    let usage = || format!("script command {part:?}: pick:X,Y (view pixels)");
+                    let v: Vec<f64> = args
+                        .split(',')
+                        .map(|c| c.trim().parse::<f64>().ok().filter(|c| c.is_finite() && *c >= 0.0))
+                        .collect::<Option<_>>()
+                        .filter(|v: &Vec<f64>| v.len() == 2)
+                        .with_context(usage)?;
+                    Command::Pick(v[0], v[1])
                 }
                 "time" => Command::Time(
                     args.trim()

@@ -27,6 +27,7 @@ mod channel_panel;
 mod cut_panel;
 mod frame;
 mod input;
+mod label_panel;
 mod model;
 mod moving;
 mod orientation;
@@ -48,7 +49,7 @@ use dvr_engine::renderer::scene_setup::{load_volume, on_demand, SceneSetup};
 use dvr_engine::renderer::{FrameRequest, FrameResult, PresentTarget, Screenshot};
 use dvr_engine::scene::{Scene, TfState, View, VolumeSource};
 use dvr_engine::session::{Edit, Session};
-use input::{camera_edit, Command, DragKind, Key, Pointer, Script};
+use input::{camera_edit, Command, Key, Pointer, Script};
 use moving::MovingScale;
 use overlay::EguiOverlay;
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
@@ -263,6 +264,7 @@ impl Explorer {
             split: 0.5,
             channels: view.channels,
             time: view.time,
+            labels: view.labels,
         };
         let mut ui = UiState::new(histogram, setup.volume.window);
         ui.playback =

@@ -1,9 +1,9 @@
 //! Model application: what the UI and the script edit reaches the session as edits
 //! (denoisers, render settings, TF, lights) and the swapchain.
 
-use super::input::ChannelCommand;
+use super::input::{ChannelCommand, LabelCommand};
 use super::*;
-use dvr_engine::session::ChannelEdit;
+use dvr_engine::session::{ChannelEdit, LabelEdit};
 
 impl Explorer {
     /// The renderer's denoisers: the shown one, and the right-hand one when split.
@@ -71,6 +71,23 @@ impl Explorer {
                 self.model.channels[i] = session.view().channels[i].clone();
             }
         }
+        if self.model.labels != self.applied.labels {
+            for (l, was) in self.model.labels.iter().zip(&self.applied.labels) {
+                if l == was {
+                    continue;
+                }
+                let edit = LabelEdit {
+                    value: Some(l.value),
+                    colour: (l.colour != was.colour).then_some(l.colour),
+                    opacity: (l.opacity != was.opacity).then_some(l.opacity),
+                    visible: (l.visible != was.visible).then_some(l.visible),
+                };
+                if let Err(e) = session.edit(Edit::Label(edit)) {
+                    self.ui.set_status(e.to_string());
+                }
+            }
+            self.model.labels = session.view().labels.clone();
+        }
         if self.model.time != self.applied.time {
             if let Err(e) = session.edit(Edit::Time(self.model.time)) {
                 self.ui.set_status(e.to_string());
@@ -99,6 +116,34 @@ impl Explorer {
         }
         self.applied = self.model.clone();
         Ok(done)
+    }
+
+    /// Picks what lies under view pixel (x, y): the panel shows it, stdout says it (so a
+    /// script's picks can be read).
+    fn pick(&mut self, x: f64, y: f64) {
+        let (vw, vh) = self.view_size();
+        let (rw, rh) = self.ui.stats.render_size;
+        if x >= f64::from(vw) || y >= f64::from(vh) || rw == 0 || rh == 0 {
+            return;
+        }
+        let px = ((x * f64::from(rw) / f64::from(vw)) as u32).min(rw - 1);
+        let py = ((y * f64::from(rh) / f64::from(vh)) as u32).min(rh - 1);
+        let Some(session) = self.gfx.as_mut().and_then(|g| g.session.as_mut()) else {
+            return;
+        };
+        let text = match session.pick(px, py) {
+            Ok(Some(p)) => format!(
+                "pick ({x:.0}, {y:.0}): label {}{} · intensity {} · voxel {:?}",
+                p.label,
+                p.label_name.map_or(String::new(), |n| format!(" \"{n}\"")),
+                p.intensity,
+                p.voxel
+            ),
+            Ok(None) => format!("pick ({x:.0}, {y:.0}): nothing"),
+            Err(e) => format!("pick ({x:.0}, {y:.0}): {e}"),
+        };
+        println!("{text}");
+        self.ui.pick = Some(text);
     }
 
     /// C: every cut off, or back on (the ones that were on, all when none was).
@@ -164,6 +209,27 @@ impl Explorer {
                 )),
             },
             Command::Time(t) => self.model.time = *t,
+            Command::Label(value, change) => {
+                let mut any = false;
+                for l in self.model.labels.iter_mut() {
+                    if value.is_some_and(|v| v != l.value) {
+                        continue;
+                    }
+                    any = true;
+                    match change {
+                        LabelCommand::Visible(v) => l.visible = *v,
+                        LabelCommand::Colour(c) => l.colour = *c,
+                        LabelCommand::Opacity(o) => l.opacity = *o,
+                    }
+                }
+                if !any {
+                    self.ui.set_status(match value {
+                        Some(v) => format!("label {v} is not in the label map"),
+                        None => "the scene has no label map".into(),
+                    });
+                }
+            }
+            Command::Pick(x, y) => self.pick(*x, *y),
             Command::Play(on) => self.ui.playback.playing = *on,
             Command::Key(Key::Cut) => self.toggle_cuts(),
             Command::Resize(w, h) => {

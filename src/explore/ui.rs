@@ -7,6 +7,7 @@
 use super::channel_panel;
 use super::cut_panel;
 use super::input::SHORTCUTS;
+use super::label_panel;
 use super::orientation;
 use super::tf_editor::{self, TfEditor};
 use dvr_engine::denoise::DENOISERS;
@@ -46,6 +47,8 @@ pub struct Model {
     pub channels: Vec<scene::ChannelView>,
     /// The time point of a series.
     pub time: f64,
+    /// The labels of the label map (empty without one).
+    pub labels: Vec<scene::LabelView>,
 }
 
 /// Frame statistics the panel shows.
@@ -117,6 +120,9 @@ pub struct UiState {
     pub channel_histograms: Vec<Vec<f32>>,
     /// A series' playback (one time point: not shown).
     pub playback: channel_panel::Playback,
+    /// The labels panel's search text, and what the last pick found.
+    pub label_search: String,
+    pub pick: Option<String>,
 }
 
 /// What the UI asks the frame loop to do besides editing the model.
@@ -141,6 +147,8 @@ impl UiState {
             channel: 0,
             channel_histograms: Vec::new(),
             playback: channel_panel::Playback::new(1),
+            label_search: String::new(),
+            pick: None,
         }
     }
 
@@ -251,6 +259,11 @@ fn panel(ui: &mut egui::Ui, state: &mut UiState, model: &mut Model, requests: &m
         egui::CollapsingHeader::new("Channels")
             .default_open(true)
             .show(ui, |ui| channel_panel::channels(ui, state, model));
+    }
+    if !model.labels.is_empty() {
+        egui::CollapsingHeader::new("Labels")
+            .default_open(true)
+            .show(ui, |ui| label_panel::labels(ui, state, model));
     }
     if state.playback.times > 1 {
         egui::CollapsingHeader::new("Time")

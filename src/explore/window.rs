@@ -181,9 +181,13 @@ impl ApplicationHandler for Explorer {
             }
             WindowEvent::MouseInput { state, button, .. } => match state {
                 ElementState::Pressed if !self.egui_ctx.is_pointer_over_egui() => {
-                    self.pointer.drag = DragKind::from_button(button);
+                    self.pointer.pressed(button);
                 }
-                ElementState::Released => self.pointer.drag = None,
+                ElementState::Released => {
+                    if let Some(pick) = self.pointer.released() {
+                        self.command(&pick);
+                    }
+                }
                 _ => {}
             },
             WindowEvent::CursorMoved { position, .. } => {

@@ -26,8 +26,9 @@ pub struct SceneBindings {
     pub environment: ImageHandle,
     pub brick_pool: ImageHandle,
     pub brick_table: ImageHandle,
-    /// The label map's look (a 1×1×1 stand-in without one).
+    /// The label map's look and shape (1×1×1 stand-ins without one).
     pub labels: ImageHandle,
+    pub label_shape: ImageHandle,
 }
 
 impl SceneBindings {
@@ -42,6 +43,7 @@ impl SceneBindings {
             .sampled_nearest("majorant_grid", self.majorant)
             .sampled("brick_pool", self.brick_pool)
             .sampled_nearest("brick_table", self.brick_table)
-            .sampled("label_look", self.labels);
+            .sampled("label_look", self.labels)
+            .sampled("label_shape", self.label_shape);
     }
 }

@@ -657,6 +657,7 @@ impl Renderer {
             brick_pool: self.scene.pool,
             brick_table: self.scene.brick_table,
             labels: self.scene.labels,
+            label_shape: self.scene.label_shape,
         })
     }
 

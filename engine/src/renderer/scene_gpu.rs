@@ -17,9 +17,11 @@ pub struct SceneImages {
     pub environment: ImageHandle,
     pub pool: ImageHandle,
     pub brick_table: ImageHandle,
-    /// The label map's look (RGBA8: tint, mask; include/volume.glsl), uploaded by the
-    /// frames whose look changed; a 1×1×1 stand-in without a label map.
+    /// The label map's look (RGBA8: tint, opacity) and shape (R8: the shown labels'
+    /// filtered indicator; include/volume.glsl), uploaded by the frames whose look
+    /// changed; 1×1×1 stand-ins without a label map.
     pub labels: ImageHandle,
+    pub label_shape: ImageHandle,
 }
 
 /// Adds a pass that copies `bytes` into `image` through a staging buffer of its own
@@ -252,14 +254,26 @@ pub fn create<'f>(
     let label_dims = if labels { volume.dims } else { [1; 3] };
     let label_desc = ImageDesc::d3(label_dims, vk::Format::R8G8B8A8_UNORM);
     let label_look = graph.image(ctx, "scene.labels", label_desc)?;
+    let shape_desc = ImageDesc::d3(label_dims, vk::Format::R8_UNORM);
+    let label_shape = graph.image(ctx, "scene.label_shape", shape_desc)?;
     if !labels {
         add_upload(ctx, graph, frame, "upload_labels", label_look, &[255; 4])?;
+        add_upload(ctx, graph, frame, "upload_label_shape", label_shape, &[255])?;
     }
     // Later frames' shaders sample what this frame uploads.
     frame.add_ready_for_sampling(
         "scene_ready",
         &[
-            vol, tf[0], tf[1], tf[2], majorant, env, pool, table, label_look,
+            vol,
+            tf[0],
+            tf[1],
+            tf[2],
+            majorant,
+            env,
+            pool,
+            table,
+            label_look,
+            label_shape,
         ],
     );
     Ok(SceneImages {
@@ -270,6 +284,7 @@ pub fn create<'f>(
         pool,
         brick_table: table,
         labels: label_look,
+        label_shape,
     })
 }
 

@@ -49,17 +49,17 @@ impl Renderer {
         if labels_changed {
             if let Some(look) = &inputs.labels {
                 let (ctx, graph) = (&self.ctx, &mut self.graph);
-                let bytes = bytemuck::cast_slice(&look.0.rgba);
-                let image = self.scene.labels;
-                scene_gpu::add_frame_upload(
-                    ctx,
-                    graph,
-                    frame,
-                    "upload_labels",
-                    slot,
-                    image,
-                    bytes,
-                )?;
+                let rgba = bytemuck::cast_slice(&look.0.rgba);
+                for (name, image, bytes) in [
+                    ("upload_labels", self.scene.labels, rgba),
+                    (
+                        "upload_label_shape",
+                        self.scene.label_shape,
+                        &look.0.shape[..],
+                    ),
+                ] {
+                    scene_gpu::add_frame_upload(ctx, graph, frame, name, slot, image, bytes)?;
+                }
             }
         }
         if self.current_lut.as_ref() != Some(lut)

@@ -73,7 +73,8 @@ impl LabelView {
     pub fn look(&self) -> Look {
         Look {
             colour: self.colour,
-            mask: if self.visible { self.opacity } else { 0.0 },
+            opacity: self.opacity,
+            visible: self.visible,
         }
     }
 
@@ -115,7 +116,8 @@ pub fn look_of(views: &[LabelView], mode: LabelMode, value: u16) -> Look {
         // A value no view names (none: the views are the map's labels).
         Err(_) => Look {
             colour: [1.0; 3],
-            mask: 0.0,
+            opacity: 1.0,
+            visible: false,
         },
     }
 }

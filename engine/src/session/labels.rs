@@ -155,7 +155,8 @@ impl Session {
                     for dy in -r..=r {
                         for dx in -r..=r {
                             let v = [centre[0] + dx, centre[1] + dy, centre[2] + dz];
-                            if look_of(views, mode, at(v)).mask <= 0.0 {
+                            let l = look_of(views, mode, at(v));
+                            if !l.visible || l.opacity <= 0.0 {
                                 continue;
                             }
                             let d = (Vec3::from(v.map(|c| c as f32 + 0.5)) - q).length_squared();

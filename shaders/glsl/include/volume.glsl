@@ -16,9 +16,11 @@ layout(binding = 5) uniform sampler3D majorant_grid;       // max μt per brick 
 layout(binding = 30) uniform sampler3D brick_pool;         // resident bricks with aprons
 layout(binding = 31) uniform sampler3D brick_table;        // per brick: slot, stand-in (texelFetch)
 // A label map's look on the volume's grid (engine/volume/src/labels/look.rs), read when
-// LABELS is not LABELS_NONE: rgb the tint of the labels there, a the mask (each label's
-// opacity where shown, 0 where hidden), both filtered so boundaries are smooth.
+// LABELS is not LABELS_NONE: per voxel its label's tint (rgb) and mask (a: the label's
+// opacity where shown, 0 where hidden), and the shape: the shown labels' indicator,
+// filtered, whose gradient is a label surface's smooth normal.
 layout(binding = 32) uniform sampler3D label_look;
+layout(binding = 33) uniform sampler3D label_shape;
 
 #define POOL_BRICK 32
 #define POOL_APRON 2
@@ -100,16 +102,19 @@ vec4 medium_albedo_opacity(vec4 dens, out vec4 share) {
     return vec4(albedo * inv, opacity);
 }
 
+float label_shape_at(vec3 p) { return texture(label_shape, to_uvw(p)).r; }
+
+// The labels' tint and mask at p.
 vec4 label_look_at(vec3 p) { return texture(label_look, to_uvw(p)); }
 
-// The gradient of the label mask (mask per voxel; grows into what is shown): the normal
-// of a label's surface, smooth because the mask is filtered.
+// The gradient of the filtered shape (per voxel; grows into what is shown): the normal
+// of a label's surface, smooth because the shape is filtered.
 vec3 label_gradient(vec3 p) {
     vec3 h = box_size() / vec3(frame.dims.xyz);
     return 0.5 * vec3(
-        label_look_at(p + vec3(h.x, 0, 0)).a - label_look_at(p - vec3(h.x, 0, 0)).a,
-        label_look_at(p + vec3(0, h.y, 0)).a - label_look_at(p - vec3(0, h.y, 0)).a,
-        label_look_at(p + vec3(0, 0, h.z)).a - label_look_at(p - vec3(0, 0, h.z)).a);
+        label_shape_at(p + vec3(h.x, 0, 0)) - label_shape_at(p - vec3(h.x, 0, 0)),
+        label_shape_at(p + vec3(0, h.y, 0)) - label_shape_at(p - vec3(0, h.y, 0)),
+        label_shape_at(p + vec3(0, 0, h.z)) - label_shape_at(p - vec3(0, 0, h.z)));
 }
 
 // Where the mask changes faster than this per voxel, the medium's surface is a label's

@@ -1,35 +1,44 @@
-//! How a label map looks to the renderer: per voxel a tint (its label's colour) and a
-//! mask (its label's opacity where shown, 0 where hidden), each filtered by a Gaussian
-//! of [`SMOOTHING_SIGMA`] voxels. Interpolating label values would make labels that are
-//! not there; filtering the indicator of what is shown instead gives a label's surface
-//! a smooth boundary whose gradient follows it (trilinear interpolation of the raw
-//! indicator alone leaves voxel facets: a sphere's normals stray by tens of degrees).
-//! The filter is symmetric, so across a flat boundary it moves no medium: a ray through
-//! a hidden slab loses exactly the slab's optical depth.
+//! How a label map looks to the renderer: per voxel its label's tint and mask (the
+//! label's opacity where shown, 0 where hidden), read with trilinear filtering, and the
+//! map's *shape*: the indicator of the shown labels filtered by a Gaussian of
+//! [`SMOOTHING_SIGMA`] voxels, whose gradient is the normal of a label's surface.
+//!
+//! Interpolating label values would make labels that are not there, so the mask is
+//! interpolated instead: a hidden label's voxels are empty at their centres, with the
+//! half-voxel ramp a trilinear read of the density has too, and a label one voxel thin
+//! still shows or hides. Across a flat boundary the ramp is symmetric, so it moves no
+//! medium: a ray through a hidden slab loses exactly the slab's optical depth. The
+//! normals come from the filtered shape because the raw indicator's gradient is a voxel
+//! facet's (a sphere's normals stray by tens of degrees); filtering the mask itself
+//! would smooth the normals too, but leaves a ghost of a hidden label's outer layer and
+//! erases structures under two voxels across.
 
 use super::LabelMap;
 use rayon::prelude::*;
 
-/// Standard deviation of the filter, in voxels: enough for normals within 10° on a
-/// voxelised sphere of radius 20 (the labels test), small enough that a label 3 voxels
-/// across keeps most of its mask.
+/// Standard deviation of the shape's filter, in voxels: enough for normals within 10°
+/// on a voxelised sphere of radius 20 (the labels test).
 pub const SMOOTHING_SIGMA: f32 = 1.0;
 const RADIUS: usize = 3;
 
-/// What one label value looks like: its tint and mask (opacity × shown).
+/// What one label value looks like.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Look {
     pub colour: [f32; 3],
-    pub mask: f32,
+    /// Scales the medium's extinction inside the label.
+    pub opacity: f32,
+    pub visible: bool,
 }
 
-/// The filtered look on the map's grid, and per brick the largest mask a trilinear read
-/// inside the brick can see (the majorant grid multiplies by it: hidden space is skipped).
+/// The look on the map's grid, and per brick the largest mask a trilinear read inside
+/// the brick can see (the majorant grid multiplies by it: hidden space is skipped).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LabelLook {
     pub dims: [u32; 3],
-    /// RGBA8 per voxel, x fastest: tint (the filtered colour, weighted by mask), mask.
+    /// RGBA8 per voxel, x fastest: the label's tint and mask (opacity where shown).
     pub rgba: Vec<[u8; 4]>,
+    /// R8 per voxel: the shown labels' indicator, filtered.
+    pub shape: Vec<u8>,
     pub brick: u32,
     pub grid: [u32; 3],
     pub brick_max: Vec<f32>,
@@ -48,26 +57,23 @@ fn kernel(sigma: f32) -> [f32; 2 * RADIUS + 1] {
 /// One pass of the filter along axis `axis` (stride `stride` between neighbours,
 /// `len` voxels along it), clamping at the edges (the outermost voxels extend outward,
 /// so the volume's own faces are not boundaries).
-fn filter_axis(src: &[[f32; 4]], dims: [usize; 3], axis: usize, sigma: f32) -> Vec<[f32; 4]> {
+fn filter_axis(src: &[f32], dims: [usize; 3], axis: usize, sigma: f32) -> Vec<f32> {
     let k = kernel(sigma);
     let [nx, ny, _] = dims;
     let stride = [1, nx, nx * ny][axis];
     let len = dims[axis];
     let slice = nx * ny;
-    let mut out = vec![[0f32; 4]; src.len()];
+    let mut out = vec![0f32; src.len()];
     out.par_chunks_mut(slice)
         .enumerate()
         .for_each(|(z, plane)| {
             for (o, cell) in plane.iter_mut().enumerate() {
                 let i = z * slice + o;
                 let pos = [o % nx, o / nx, z][axis];
-                let mut acc = [0f32; 4];
+                let mut acc = 0f32;
                 for (t, w) in k.iter().enumerate() {
                     let q = (pos + t).saturating_sub(RADIUS).min(len - 1);
-                    let j = i + q * stride - pos * stride;
-                    for (a, s) in acc.iter_mut().zip(src[j]) {
-                        *a += w * s;
-                    }
+                    acc += w * src[i + q * stride - pos * stride];
                 }
                 *cell = acc;
             }
@@ -92,16 +98,17 @@ impl LabelLook {
         sigma: f32,
     ) -> Self {
         let mut table = vec![None; super::MAX_LABEL as usize + 1];
-        let mut field: Vec<[f32; 4]> = map
-            .values
-            .iter()
-            .map(|&v| {
-                let l = *table[usize::from(v)].get_or_insert_with(|| look(v));
-                let [r, g, b] = l.colour;
-                let m = l.mask.clamp(0.0, 1.0);
-                [r * m, g * m, b * m, m]
-            })
-            .collect();
+        let mut look_at = |v: u16| *table[usize::from(v)].get_or_insert_with(|| look(v));
+        let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+        let mut rgba = Vec::with_capacity(map.values.len());
+        let mut field = Vec::with_capacity(map.values.len());
+        for &v in &map.values {
+            let l = look_at(v);
+            let [r, g, b] = l.colour;
+            let mask = if l.visible { l.opacity } else { 0.0 };
+            rgba.push([unorm(r), unorm(g), unorm(b), unorm(mask)]);
+            field.push(if l.visible { 1.0f32 } else { 0.0 });
+        }
         let dims = map.dims.map(|d| d as usize);
         let uniform = field.windows(2).all(|w| w[0] == w[1]);
         if !uniform && sigma > 0.0 {
@@ -109,20 +116,12 @@ impl LabelLook {
                 field = filter_axis(&field, dims, axis, sigma);
             }
         }
-        let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
-        let rgba: Vec<[u8; 4]> = field
-            .iter()
-            .map(|&[r, g, b, m]| {
-                // The tint is the mask-weighted mean colour; where nothing is shown it
-                // does not matter.
-                let inv = if m > 1e-6 { 1.0 / m } else { 0.0 };
-                [unorm(r * inv), unorm(g * inv), unorm(b * inv), unorm(m)]
-            })
-            .collect();
+        let shape: Vec<u8> = field.iter().map(|&x| unorm(x)).collect();
         let brick_max = brick_maxima(&rgba, map.dims, brick, grid);
         Self {
             dims: map.dims,
             rgba,
+            shape,
             brick,
             grid,
             brick_max,

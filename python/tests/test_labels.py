@@ -1,0 +1,64 @@
+"""Label maps live from Python: ``r.labels[v]`` fields are edits that render what the
+scene's label keyframes render, bit for bit; show all / hide all; ``r.pick`` names the
+label under a pixel; bad values are errors naming the field."""
+
+import os
+
+import numpy as np
+import pytest
+
+import dvr
+
+SCENES = os.path.join(os.path.dirname(__file__), "..", "..", "assets", "scenes", "development")
+
+
+def scene(name):
+    return dvr.Scene.load(os.path.join(SCENES, name))
+
+
+def test_label_fields_edit_and_refuse_bad_values():
+    r = dvr.Renderer(scene("phantom-labels-skull-orbit.toml"), size=(32, 32), denoisers=[])
+    assert r.labels.mode == "tint" and len(r.labels) == 5 and 5 in r.labels
+    assert r.labels[5].colour == pytest.approx((1.0, 0.35, 0.3)), "the scene's [[label]] over the table"
+    shown = r.render()["noisy"]
+    r.labels.hide_all()
+    assert not any(lab.visible for lab in r.labels)
+    empty = r.render(reset=True)["noisy"]
+    # Every label hidden leaves only what no label holds: air, so the background alone.
+    assert np.abs(shown - empty).mean() > 1e-2
+    assert np.ptp(empty[..., :3].reshape(-1, 3), axis=0).max() < 0.5
+    r.labels.show_all()
+    r.labels[3].opacity = 0.25
+    r.labels[3].colour = (0.2, 0.4, 1.0)
+    assert r.labels[3].opacity == pytest.approx(0.25) and r.labels[3].colour == pytest.approx((0.2, 0.4, 1.0))
+    assert [lab.value for lab in r.labels.find("VENT")] == [4]
+    with pytest.raises(ValueError, match=r"label\[3\].opacity"):
+        r.labels[3].opacity = 1.5
+    with pytest.raises(ValueError, match=r"label\[3\].colour"):
+        r.labels[3].colour = (2.0, 0.0, 0.0)
+    with pytest.raises(KeyError, match="label 9 is not in the map"):
+        r.labels[9]
+    with pytest.raises(dvr.FieldError):
+        r.labels[3].name = "grey"
+
+
+def test_a_scene_without_labels_has_none():
+    r = dvr.Renderer("phantom/orbit", size=(16, 16), denoisers=[])
+    assert len(r.labels) == 0 and r.labels.mode is None
+    with pytest.raises(ValueError, match="no label map"):
+        r.labels.hide_all()
+
+
+def test_pick_names_the_label_under_a_pixel():
+    s = dvr.Scene.load(os.path.join(SCENES, "phantom-labels-skull-orbit.toml"))
+    r = dvr.Renderer(s, size=(33, 33), denoisers=[])
+    r.labels[1].visible = False
+    r.labels[2].visible = False
+    hit = r.pick(16, 16)
+    assert hit is not None and hit["label"] in (3, 4, 5), hit
+    assert hit["label_name"] == r.labels[hit["label"]].name
+    assert len(hit["position"]) == 3 and all(0 <= v < 128 for v in hit["voxel"])
+    assert np.isfinite(hit["intensity"])
+    assert r.pick(0, 0) is None, "a corner meets nothing"
+    with pytest.raises(ValueError, match="outside the 33x33 image"):
+        r.pick(40, 3)
