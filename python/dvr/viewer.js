@@ -357,6 +357,90 @@ function channelsPanel(model, send, uid) {
   return box;
 }
 
+// The labels panel (a renderer with a label map; hidden otherwise): per label its
+// colour (a colour picker), whether it is shown, its opacity, its value and name; show
+// all and hide all; a search box filtering the rows by name or value (a parcellation
+// has a hundred labels: the rows scroll). Edits go to the kernel as messages; the rows
+// show the kernel's `labels` (the renderer's), whoever changed them, except a colour
+// being picked or an opacity being dragged.
+function labelsPanel(model, send) {
+  const rows = el("div", { class: "dvr-label-rows" });
+  const search = el("input", { type: "search", class: "dvr-label-search", placeholder: "search labels" });
+  const mode = el("span", { class: "dvr-label-mode" });
+  const box = el("div", { class: "dvr-labels-panel" },
+    el("div", { class: "dvr-row" }, "labels ", mode,
+      button("show all", "dvr-labels-show", () => send({ type: "labels", visible: true })),
+      button("hide all", "dvr-labels-hide", () => send({ type: "labels", visible: false }))),
+    search,
+    el("div", { class: "dvr-hint" }, "colour · shown · opacity · value name"),
+    rows);
+  let inputs = [];
+  function build(labels) {
+    rows.replaceChildren();
+    inputs = labels.map((l) => {
+      const value = l.value;
+      const colour = el("input", { type: "color", class: "dvr-label-colour", title: "colour" });
+      colour.addEventListener("input", () => {
+        colour.dataset.picking = "1";
+        send({ type: "label", value, colour: fromHex(colour.value) });
+      });
+      colour.addEventListener("change", () => delete colour.dataset.picking);
+      const on = el("input", { type: "checkbox", class: "dvr-label-visible", title: "shown" });
+      on.addEventListener("change", () => send({ type: "label", value, visible: on.checked }));
+      const opacity = slider("0", "1", "0.01", l.opacity, (o) => send({ type: "label", value, opacity: o }), "dvr-label-opacity");
+      opacity.title = "opacity";
+      opacity.addEventListener("pointerdown", () => (opacity.dataset.held = "1"));
+      for (const ev of ["pointerup", "pointercancel", "change"]) opacity.addEventListener(ev, () => delete opacity.dataset.held);
+      const name = el("span", { class: "dvr-label-name" });
+      const row = el("div", { class: "dvr-label", "data-value": value }, colour, on, opacity, name);
+      rows.append(row);
+      return { value, row, colour, on, opacity, name };
+    });
+  }
+  function filter() {
+    const t = search.value.trim().toLowerCase();
+    for (const r of inputs) r.row.hidden = !!t && !r.name.textContent.toLowerCase().includes(t);
+  }
+  function update() {
+    const labels = model.get("labels") || [];
+    box.hidden = !labels.length;
+    mode.textContent = model.get("label_mode") ? `(${model.get("label_mode")})` : "";
+    // The map's values are fixed for the renderer's life: rows are built once.
+    if (labels.length !== inputs.length || labels.some((l, i) => l.value !== inputs[i].value)) build(labels);
+    labels.forEach((l, i) => {
+      const r = inputs[i];
+      if (!r.colour.dataset.picking) r.colour.value = hex(l.colour);
+      if (!r.opacity.dataset.held) r.opacity.value = l.opacity;
+      r.on.checked = l.visible;
+      r.name.textContent = `${l.value} ${l.name}`;
+      r.row.classList.toggle("dvr-label-hidden", !l.visible);
+    });
+    filter();
+  }
+  search.addEventListener("input", filter);
+  model.on("change:labels", update);
+  model.on("change:label_mode", update);
+  update();
+  return box;
+}
+
+// The pick readout: what lies under the pixel last clicked in the image (the kernel's
+// `picked`): the label's value and name, the intensity, the voxel.
+function pickReadout(model) {
+  const out = el("div", { class: "dvr-pick" }, "click the image to pick");
+  const num = (v) => (v === null || v === undefined ? "–" : Math.abs(v) >= 1000 || v === Math.round(v) ? v.toFixed(0) : v.toPrecision(4));
+  model.on("change:picked", () => {
+    const p = model.get("picked") || {};
+    out.dataset.label = p.hit ? p.label : "";
+    if (!p.hit) out.textContent = `(${p.x}, ${p.y}): nothing`;
+    else {
+      const label = p.label ? `${p.label} ${p.label_name || ""}`.trim() : "no label";
+      out.textContent = `label ${label} · intensity ${num(p.intensity)} · voxel (${p.voxel.join(", ")})`;
+    }
+  });
+  return out;
+}
+
 // The time slider (a series of time points; hidden otherwise): 0 to times - 1 in
 // fractional steps (the renderer mixes the two time points around a fraction), play and
 // pause, and the speed in time points per second. Playback runs in the kernel's render
@@ -488,6 +572,7 @@ function render({ model, el: root }) {
     { class: "dvr-panel" },
     el("div", { class: "dvr-row" }, "frame ", counter, " · ", fps, " fps"),
     el("div", { class: "dvr-row" }, "drag latency ", latency),
+    pickReadout(model),
     el("label", {}, "denoiser ", denoiserSel),
     el("label", {}, "split ", splitSel, splitPos),
     el("label", {}, "spp ", spp, sppRange),
@@ -495,6 +580,7 @@ function render({ model, el: root }) {
     sidesRow,
     time,
     channelsPanel(model, send, uid),
+    labelsPanel(model, send),
     el("label", {}, "TF preset ", presetSel),
     tfEditor(model, uid, send),
     el("div", { class: "dvr-hint" }, "drag a point · double-click adds · shift-click removes"),
@@ -523,6 +609,7 @@ function render({ model, el: root }) {
   // Mouse: left drag orbits, right (or middle) drag pans, the wheel zooms. Movements
   // are summed and sent at most once per animation frame.
   let seq = 0, drag = null, sum = [0, 0], scheduled = false;
+  let frameSize = [0, 0]; // the rendered size of the frame shown
   const sentAt = new Map(); // seq -> time sent
   const flush = () => {
     scheduled = false;
@@ -531,8 +618,13 @@ function render({ model, el: root }) {
     sum = [0, 0];
   };
   stage.addEventListener("contextmenu", (ev) => ev.preventDefault());
+  // A left press and release that moved less than this many CSS pixels is a click: a
+  // pick, not a drag (a drag of that little does orbit, by a hair).
+  const CLICK_PX = 4;
+  let down = null;
   stage.addEventListener("pointerdown", (ev) => {
     drag = ev.button === 0 ? "orbit" : "pan";
+    down = ev.button === 0 ? [ev.clientX, ev.clientY] : null;
     stage.setPointerCapture(ev.pointerId);
     ev.preventDefault();
   });
@@ -548,8 +640,23 @@ function render({ model, el: root }) {
   const end = () => {
     flush();
     drag = null;
+    down = null;
   };
-  stage.addEventListener("pointerup", end);
+  // The page pixel to the rendered image's pixel (row 0 at the top): the image is
+  // drawn scaled to the stage's width (CSS pixels, whatever the display's scaling),
+  // so the offset within it scaled by the frame's size over the drawn size.
+  const imagePixel = (ev) => {
+    const r = img.getBoundingClientRect();
+    const w = frameSize[0] || model.get("width"), h = frameSize[1] || model.get("height");
+    const x = Math.floor(((ev.clientX - r.left) / r.width) * w), y = Math.floor(((ev.clientY - r.top) / r.height) * h);
+    return x >= 0 && y >= 0 && x < w && y < h ? [x, y] : null;
+  };
+  stage.addEventListener("pointerup", (ev) => {
+    const click = down && Math.hypot(ev.clientX - down[0], ev.clientY - down[1]) < CLICK_PX;
+    end();
+    const at = click ? imagePixel(ev) : null;
+    if (at) send({ type: "pick", x: at[0], y: at[1] });
+  });
   stage.addEventListener("pointercancel", end);
   stage.addEventListener(
     "wheel",
@@ -592,6 +699,7 @@ function render({ model, el: root }) {
     img.src = next;
     img.dataset.frame = msg.frame;
     img.style.aspectRatio = `${msg.width} / ${msg.height}`;
+    frameSize = [msg.width, msg.height];
     counter.textContent = msg.frame;
     fps.textContent = msg.fps.toFixed(1);
     // Latency of an edit: from its message leaving the page to the first frame that

@@ -4,17 +4,18 @@ Code: anywhere ipywidgets render).
 A thread renders the view for as long as the viewer is open: a still view keeps
 refining. Each frame is tone-mapped and encoded (JPEG by default) and sent to the
 browser only when the browser has shown the one before, so a lagging browser drops
-frames instead of queueing them. Mouse drags, the wheel and the panel (TF editor,
-denoiser switch, split view, spp, channels, time) come back as messages; the thread
-applies the newest of them before its next frame (drags are summed, never queued), as
-edits of the live :class:`dvr.Renderer`, which the temporal denoisers reproject. The
-same renderer can be edited from other cells (``v.renderer.lights[0].intensity = 30``)
-while the viewer runs.
+frames instead of queueing them. Mouse drags, clicks (picks), the wheel and the panel
+(TF editor, denoiser switch, split view, spp, channels, labels, time) come back as
+messages; the thread applies the newest of them before its next frame (drags are
+summed, never queued), as edits of the live :class:`dvr.Renderer`, which the temporal
+denoisers reproject. The same renderer can be edited from other cells
+(``v.renderer.lights[0].intensity = 30``) while the viewer runs.
 
 The panel always shows the renderer's current state: the render thread compares the
-renderer's TF, clip planes, crop box, spp and channels with what the panel shows after
-each frame and sends any change, whichever road it came by (the page, another cell, a
-preset); each frame carries the time point it shows, which the time slider follows.
+renderer's TF, clip planes, crop box, spp, channels and labels with what the panel
+shows after each frame and sends any change, whichever road it came by (the page,
+another cell, a preset); each frame carries the time point it shows, which the time
+slider follows.
 
 The render thread stops when the viewer is closed (:meth:`Viewer.close`, or the
 frontend closing its comm) or the kernel is interrupted while idle. A closed viewer
@@ -42,6 +43,7 @@ except ImportError as e:  # pragma: no cover - the notebook extra is missing
 from . import _native
 from . import viewer_capture as capture
 from . import viewer_channels as series
+from . import viewer_labels as labelling
 from . import viewer_panel as panel
 from .renderer import Renderer
 from .scene import Scene, TransferFunction
@@ -89,7 +91,11 @@ class Viewer(anywidget.AnyWidget):
     the view's edges and a scale bar in mm. A medium of several channels gets a
     channels panel (each channel's colour, whether it is shown, and which channel's TF
     the editor edits); a series of time points a time slider, with playback at
-    ``speed`` time points per second (``playing``) moved on by the render thread.
+    ``speed`` time points per second (``playing``) moved on by the render thread; a
+    renderer with a label map a labels panel (each label's colour, whether it is
+    shown, its opacity; show all, hide all, and a search by name). A click in the image
+    (a press and release without a drag) picks: the panel's readout shows the label
+    and the intensity under the cursor (:meth:`dvr.Renderer.pick`; also ``picked``).
     """
 
     _esm = (_HERE / "viewer.js").read_text(encoding="utf-8")
@@ -113,6 +119,13 @@ class Viewer(anywidget.AnyWidget):
     channels = traitlets.List().tag(sync=True)
     channel = traitlets.Int(0).tag(sync=True)
     tf_channel = traitlets.Int(-1).tag(sync=True)
+    # The labels panel (a renderer with a label map): each label's value, name, colour,
+    # opacity and visible (the renderer's), and the map's mode ("tint" or "solid"; ""
+    # without a map). `picked`: what lies under the pixel the page last clicked (see
+    # viewer_labels.picked), for the readout.
+    labels = traitlets.List().tag(sync=True)
+    label_mode = traitlets.Unicode("").tag(sync=True)
+    picked = traitlets.Dict().tag(sync=True)
     # Playback of a series: the render thread moves the time on while `playing`.
     playing = traitlets.Bool(False).tag(sync=True)
     speed = traitlets.Float(4.0).tag(sync=True)
@@ -151,6 +164,7 @@ class Viewer(anywidget.AnyWidget):
             info = panel.volume_info(renderer)
             limit = panel.spp_limit(renderer)
             n_channels, times = len(renderer._r.channels()), renderer.times
+            mode, label_rows = renderer._r.labels()
         except BaseException:
             if self._owns:
                 renderer.close()  # made here: its device memory goes now, not at GC
@@ -168,6 +182,7 @@ class Viewer(anywidget.AnyWidget):
             width=renderer.size[0],
             height=renderer.size[1],
             times=times,
+            label_mode=mode or "",
         )
         self.renderer = renderer
         self._format, self._quality = format, quality
@@ -180,7 +195,10 @@ class Viewer(anywidget.AnyWidget):
         self._local = threading.local()
         self._shown = {}  # what the panel shows of the renderer's state, as last synced
         self._n_channels = n_channels
-        self._sync(renderer._r.view(), renderer._r.tf(), series.read(renderer, n_channels, times))
+        # The map's label values are fixed for the renderer's life: the page's edits are
+        # checked against them.
+        self._label_values = frozenset(d["value"] for d in label_rows) if mode else frozenset()
+        self._sync(renderer._r.view(), renderer._r.tf(), self._read(renderer))
         if limit is None:
             self.status = "the engine did not say its spp limit: the box keeps the renderer's spp"
         self._stop = threading.Event()
@@ -356,6 +374,8 @@ class Viewer(anywidget.AnyWidget):
             self._pending.set("view", msg["side"], _seq(msg))
         elif kind in ("channel", "time", "play"):
             series.on_message(self, kind, msg, _seq(msg))
+        elif kind in ("label", "labels", "pick"):
+            labelling.on_message(self, kind, msg, _seq(msg))
         elif kind in ("screenshot", "movie"):
             # Off the kernel's message thread: a movie takes seconds to minutes.
             threading.Thread(target=self._capture_from_page, args=(kind,), name=f"dvr-{kind}", daemon=True).start()
@@ -424,10 +444,17 @@ class Viewer(anywidget.AnyWidget):
 
     # Kernel to browser.
 
+    def _read(self, renderer):
+        """What the panel shows beyond the view and TF: :func:`viewer_channels.read`'s
+        and :func:`viewer_labels.read`'s (the render thread calls it under its lock)."""
+        extra = series.read(renderer, self._n_channels, self.times)
+        extra.update(labelling.read(renderer, bool(self._label_values)))
+        return extra
+
     def _sync(self, view, tf, extra):
-        """Shows the renderer's TF (or the chosen channel's), clip planes, crop box, spp
-        and channels in the panel where they differ from what it shows (whoever changed
-        them). `extra` is :func:`viewer_channels.read`'s."""
+        """Shows the renderer's TF (or the chosen channel's), clip planes, crop box, spp,
+        channels and labels in the panel where they differ from what it shows (whoever
+        changed them). `extra` is :meth:`_read`'s."""
         a = tf["a"]
         state = {
             "tf": (-1, a["point"], a.get("name", "")),
@@ -440,6 +467,8 @@ class Viewer(anywidget.AnyWidget):
             index = min(max(self.channel, 0), len(extra["channels"]) - 1)
             state["channels"] = series.rows(extra["channels"])
             state["tf"] = (index, *series.editor_tf(extra["channels"][index]))
+        if "labels" in extra:
+            state["labels"] = extra["labels"]
         changed = {k: v for k, v in state.items() if self._shown.get(k) != v}
         if not changed:
             return
@@ -454,6 +483,8 @@ class Viewer(anywidget.AnyWidget):
                 self.preset = name if name in self.presets else ""
             if "channels" in changed:
                 self._show("channels", changed["channels"])
+            if "labels" in changed:
+                self._show("labels", changed["labels"])
             if "clip" in changed:
                 self.clip_planes = changed["clip"]
             if "crop" in changed:
@@ -502,6 +533,14 @@ class _Pending:
             if seq is not None:
                 self.seq = max(self.seq, seq)
 
+    def edit(self, kind, change, seq=None):
+        """Changes the pending edits of `kind` (a dict, made if none) in place with
+        `change`, under the lock: for an edit that supersedes some of those before it."""
+        with self._lock:
+            change(self._edits.setdefault(kind, {}))
+            if seq is not None:
+                self.seq = max(self.seq, seq)
+
     def merge(self, kind, key, fields, seq=None):
         """Edits of one item of `kind` (a channel, by index), field by field: each field
         keeps its newest value."""
@@ -532,11 +571,13 @@ def _render_loop(viewer_ref, renderer, pending, stop, acked):
                 return
             edits, seq = pending.take()
             status = _apply(renderer, edits)
+            # A pick renders a frame of the view as edited, before the shown one.
+            answer = labelling.pick(renderer, edits["pick"]) if "pick" in edits else None
             try:
                 playback.step(renderer, viewer.times, viewer.playing, viewer.speed)
                 out = renderer.render()
                 view, tf = renderer._r.view(), renderer._r.tf()
-                extra = series.read(renderer, viewer._n_channels, viewer.times)
+                extra = viewer._read(renderer)
             except Exception as e:  # noqa: BLE001 - shown in the panel, then the loop ends
                 viewer.status = f"render failed: {e}"
                 return
@@ -548,6 +589,10 @@ def _render_loop(viewer_ref, renderer, pending, stop, acked):
             viewer.status = status
             # A refused edit leaves the panel showing it: show the renderer's again.
             viewer._shown.clear()
+        if isinstance(answer, str):
+            viewer.status = answer
+        elif answer is not None:
+            viewer.picked = answer
         try:
             viewer._sync(view, tf, extra)
             image, names = _compose(out, viewer.denoiser, viewer.split, viewer.split_position)
@@ -624,8 +669,9 @@ def _apply(renderer, edits):
             renderer.pan(*edits["pan"])
         if "zoom" in edits:
             renderer.zoom(edits["zoom"][0])
-        # Last: a refused channel edit loses no camera move of the same frame.
+        # Last: a refused channel or label edit loses no camera move of the same frame.
         series.apply(renderer, edits)
+        labelling.apply(renderer, edits)
     except (ValueError, TypeError, RuntimeError) as e:
         return str(e)
     return ""

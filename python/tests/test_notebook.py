@@ -5,7 +5,8 @@ kernel with the preset's points intact, the raw input shows in the split view, a
 plane is added from the cuts panel, a screenshot and a movie are written, an interrupted
 kernel stops the render loop, and a closed viewer leaves no thread and no renderer and
 its last frame in the saved notebook; a series' channels panel and time slider edit
-the view. The example notebooks run through nbclient."""
+the view; a label map's panel edits its labels, and a click picks the label under it.
+The example notebooks run through nbclient."""
 
 import base64
 import json
@@ -276,6 +277,114 @@ def test_the_channels_panel_and_the_time_slider(lab, browser, series_file):
     assert state()["status"] == "" and page.locator(".dvr-status").inner_text() == "", page.locator(".dvr-status").inner_text()
     assert errors == []
     nb.run(3)
+    page.close()
+
+
+LABELLED = """
+name = "labelled"
+[volume]
+builtin = "phantom"
+size = 48
+[transfer]
+a = "ct-bone"
+[labels]
+builtin = "phantom"
+mode = "solid"
+[[light]]
+kind = "environment"
+intensity = 1.0
+"""
+
+
+def test_the_labels_panel_and_picking(lab, browser):
+    """The phantom with its built-in labels as solid tissue, on a page drawn at twice
+    the CSS pixel density: a label hidden, a colour picked, the list searched, hide all
+    and one shown again from the panel, each reaching the kernel's renderer; a click in
+    the image picks the label under it (the page pixel mapped to the rendered pixel), a
+    drag still orbits without picking. (The same server as the tests above.)"""
+    (lab.root / "labelled.toml").write_text(LABELLED)
+    write_notebook(
+        lab.root / "labels.ipynb",
+        [
+            "import dvr, json\n"
+            "v = dvr.Viewer(dvr.Scene.load('labelled.toml'), size=(33, 33), denoisers=['ours'])\n"
+            "v",
+            "r = v.renderer\n"
+            "print('state', json.dumps({'visible': [l.visible for l in r.labels], 'colour': [l.colour for l in r.labels],"
+            " 'picked': v.picked, 'camera': r.camera.position, 'status': v.status}))",
+            "v.close()",
+        ],
+    )
+    page = browser.new_page(viewport={"width": 1400, "height": 1200}, device_scale_factor=2)
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    nb = Notebook(page, lab, "labels.ipynb")
+    nb.run(0)
+
+    def state():
+        return json.loads(nb.run(1).split("state ", 1)[1])
+
+    def frame():
+        return int(page.locator(".dvr-frame-counter").inner_text())
+
+    first = wait_for("the first frame", lambda: image_stats(page, ".dvr-frame"))
+    rows = page.locator(".dvr-label")
+    assert page.locator(".dvr-label-name").all_inner_texts() == ["1 scalp", "2 skull", "3 brain", "4 ventricles", "5 vessels"]
+    page.locator(".dvr-labels-panel").scroll_into_view_if_needed()
+
+    # The scalp hidden: the skull shows, the view changes.
+    before = shown_after(page, max(first[0], frame()))
+    rows.nth(0).locator(".dvr-label-visible").uncheck()
+    wait_for("the scalp hidden in the kernel", lambda: state()["visible"] == [False, True, True, True, True])
+    hidden = shown_after(page, frame() + 1)
+    assert difference(before, hidden) > 2.0, difference(before, hidden)
+    # The skull's colour picked: in the kernel and in the view.
+    rows.nth(1).locator(".dvr-label-colour").fill("#ff0000")
+    wait_for("the colour in the kernel", lambda: state()["colour"][1] == [1.0, 0.0, 0.0])
+    red = shown_after(page, frame() + 1)
+    assert (red[1] - red[3]) - (hidden[1] - hidden[3]) > 5.0, (hidden[:4], red[:4])
+    # The search filters the rows (in the page only).
+    page.fill(".dvr-label-search", "VENT")
+    assert [rows.nth(i).is_visible() for i in range(5)] == [False, False, False, True, False]
+    page.fill(".dvr-label-search", "")
+    # Hide all, then the skull shown again.
+    page.click(".dvr-labels-hide")
+    wait_for("all hidden in the kernel", lambda: state()["visible"] == [False] * 5)
+    rows.nth(1).locator(".dvr-label-visible").check()
+    wait_for("the skull alone in the kernel", lambda: state()["visible"] == [False, True, False, False, False])
+
+    # A click in the image, from the front: the pixel under the cursor is picked.
+    page.click(".dvr-view-anterior")
+    shown_after(page, frame() + 2)
+
+    def at(px, py):
+        """Where the centre of rendered pixel (px, py) is on the page (running a cell
+        scrolls the notebook: the image is brought into view and measured again)."""
+        page.locator(".dvr-stage").scroll_into_view_if_needed()
+        box = page.locator(".dvr-frame").bounding_box()
+        return box["x"] + (px + 0.5) / 33 * box["width"], box["y"] + (py + 0.5) / 33 * box["height"]
+
+    page.mouse.click(*at(20, 12))
+    wait_for("the off-centre pick in the kernel", lambda: (p := state()["picked"]) and (p["x"], p["y"]) == (20, 12))
+    page.mouse.click(*at(16, 16))
+    picked = wait_for("the centre's pick", lambda: (p := state()["picked"]) and (p["x"], p["y"]) == (16, 16) and p)
+    assert (picked["label"], picked["label_name"]) == (2, "skull"), picked
+    readout = page.locator(".dvr-pick")
+    wait_for("the readout", lambda: "skull" in readout.inner_text())
+    assert readout.get_attribute("data-label") == "2" and "intensity" in readout.inner_text()
+    # A drag orbits and picks nothing.
+    camera = state()["camera"]
+    x, y = at(16, 16)
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x + 60, y, steps=6)
+    page.mouse.up()
+    wait_for("the orbit", lambda: state()["camera"] != camera)
+    assert state()["picked"] == picked
+
+    assert state()["status"] == "" and page.locator(".dvr-status").inner_text() == "", page.locator(".dvr-status").inner_text()
+    assert errors == []
+    nb.run(2)
     page.close()
 
 

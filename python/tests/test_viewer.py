@@ -610,3 +610,147 @@ def test_a_volume_of_one_field_shows_neither_panel(viewer):
     assert "one time point" in v.status
     v._on_message(v, {"type": "channel", "index": 0, "visible": False}, [])
     assert "not a channel" in v.status and v.running
+
+
+# Label maps: the labels panel and picking.
+
+LABELLED = """
+name = "labelled"
+[volume]
+builtin = "phantom"
+size = 48
+[transfer]
+a = "ct-bone"
+[labels]
+builtin = "phantom"
+mode = "solid"
+[[light]]
+kind = "environment"
+intensity = 1.0
+"""
+
+
+@pytest.fixture
+def label_viewer(monkeypatch, tmp_path):
+    """The phantom with its built-in labels (scalp, skull, brain, ventricles, vessels)
+    shown as solid tissue."""
+    sent, resent = Recorder(), []
+    monkeypatch.setattr(dvr.Viewer, "send", lambda self, content, buffers=None: sent(content, buffers))
+    monkeypatch.setattr(dvr.Viewer, "send_state", lambda self, key=None: resent.append(key))
+    path = tmp_path / "labelled.toml"
+    path.write_text(LABELLED)
+    v = dvr.Viewer(dvr.Scene.load(path), size=(33, 33), denoisers=["ours"])
+    yield v, sent, resent
+    v.close()
+
+
+def panel_rows(r):
+    """The labels panel's rows as the renderer's label API reads them."""
+    return [{"value": l.value, "name": l.name, "colour": list(l.colour), "opacity": l.opacity, "visible": l.visible} for l in r.labels]
+
+
+def test_the_labels_panel_shows_the_renderers_labels_and_edits_them(label_viewer):
+    v, sent, _ = label_viewer
+    r = v.renderer
+    assert v.label_mode == "solid"
+    assert [(l["value"], l["name"]) for l in v.labels] == [(1, "scalp"), (2, "skull"), (3, "brain"), (4, "ventricles"), (5, "vessels")]
+    assert v.labels == panel_rows(r)
+    # Refused with a reason, and nothing reaches the renderer.
+    for msg, reason in [
+        ({"type": "label", "value": 9, "visible": False}, "not a label"),
+        ({"type": "label", "value": 0, "visible": False}, "not a label"),
+        ({"type": "label", "value": True, "visible": False}, "not a label"),
+        ({"type": "label", "value": "2", "visible": False}, "not a label"),
+        ({"type": "label", "value": 2, "visible": "no"}, "visible"),
+        ({"type": "label", "value": 2, "colour": [1, 0, 2]}, "colour"),
+        ({"type": "label", "value": 2, "colour": [float("nan"), 0, 0]}, "colour"),
+        ({"type": "label", "value": 2, "opacity": 1.5}, "opacity"),
+        ({"type": "label", "value": 2, "opacity": -0.1}, "opacity"),
+        ({"type": "label", "value": 2, "name": "bone"}, "unknown field"),
+        ({"type": "label", "value": 2}, "nothing to edit"),
+        ({"type": "labels", "visible": 1}, "visible"),
+        ({"type": "labels", "visible": True, "value": 2}, "visible"),
+        ({"type": "pick", "x": 33, "y": 0}, "outside the 33x33 image"),
+        ({"type": "pick", "x": -1, "y": 0}, "outside"),
+        ({"type": "pick", "x": 1.5, "y": 0}, "whole numbers"),
+        ({"type": "pick", "x": True, "y": 0}, "whole numbers"),
+    ]:
+        v._on_message(v, msg, [])
+        assert reason in v.status, (msg, v.status)
+    time.sleep(0.3)
+    assert all(l.visible and l.opacity == 1.0 for l in r.labels) and v.picked == {}
+    # Edits from the page, through the label API: a label hidden, a colour, an opacity
+    # (a flood of opacities is one pending edit, the newest).
+    for i in range(500):
+        v._on_message(v, {"type": "label", "value": 3, "opacity": i / 499, "seq": 1}, [])
+    assert len(v._pending._edits.get("labels", {})) <= 1
+    before = v._last[1].copy()
+    v._on_message(v, {"type": "label", "value": 2, "visible": False}, [])
+    v._on_message(v, {"type": "label", "value": 3, "colour": [1.0, 0.0, 0.5], "opacity": 0.25}, [])
+    wait_for("the edits in the renderer", lambda: not r.labels[2].visible and r.labels[3].opacity == 0.25)
+    assert r.labels[3].colour == pytest.approx((1.0, 0.0, 0.5))
+    wait_for("the rows", lambda: v.labels == panel_rows(r))
+    assert [l["visible"] for l in v.labels] == [True, False, True, True, True]
+    frames_after(sent, v, len(sent.frames))
+    assert np.abs(v._last[1] - before).mean() > 1e-3, "the view changed"
+    # Hide all, then one shown again, in one frame's edits: the order holds.
+    v._on_message(v, {"type": "label", "value": 1, "visible": True}, [])
+    v._on_message(v, {"type": "labels", "visible": False}, [])
+    v._on_message(v, {"type": "label", "value": 4, "visible": True}, [])
+    wait_for("only the ventricles shown", lambda: [l.visible for l in r.labels] == [False, False, False, True, False])
+    v._on_message(v, {"type": "labels", "visible": True}, [])
+    wait_for("all shown", lambda: all(l.visible for l in r.labels))
+    wait_for("the rows", lambda: v.labels == panel_rows(r))
+    assert v.running
+
+
+def test_the_labels_panel_follows_edits_from_another_cell(label_viewer):
+    v, _, _ = label_viewer
+    r = v.renderer
+    r.labels.hide_all()
+    r.labels[5].visible = True
+    r.labels[5].colour = (0.1, 0.2, 0.3)
+    wait_for("the cell's edits in the rows", lambda: [l["visible"] for l in v.labels] == [False] * 4 + [True])
+    wait_for("the colour", lambda: v.labels[4]["colour"] == pytest.approx([0.1, 0.2, 0.3]))
+
+
+def test_a_click_picks_the_label_and_intensity_under_it(label_viewer):
+    v, _, _ = label_viewer
+    r = v.renderer
+    # A front view of the phantom with only the skull shown: the image's centre is skull.
+    v._on_message(v, {"type": "view", "side": "anterior"}, [])
+    v._on_message(v, {"type": "labels", "visible": False}, [])
+    v._on_message(v, {"type": "label", "value": 2, "visible": True}, [])
+    wait_for("only the skull shown", lambda: [l.visible for l in r.labels] == [False, True, False, False, False])
+    v._on_message(v, {"type": "pick", "x": 16, "y": 16, "seq": 7}, [])
+    wait_for("the pick", lambda: v.picked)
+    p = v.picked
+    assert p["hit"] and (p["x"], p["y"], p["seq"]) == (16, 16, 7)
+    assert (p["label"], p["label_name"]) == (2, "skull"), p
+    assert p["intensity"] is not None and p["intensity"] > 0 and len(p["voxel"]) == 3
+    # What the renderer's own pick says at the same pixel of the same view.
+    assert r.pick(16, 16)["label"] == 2
+    # The brain alone: the centre is brain, its intensity another.
+    v._on_message(v, {"type": "labels", "visible": False}, [])
+    v._on_message(v, {"type": "label", "value": 3, "visible": True}, [])
+    v._on_message(v, {"type": "pick", "x": 16, "y": 16, "seq": 8}, [])
+    wait_for("the second pick", lambda: v.picked.get("seq") == 8)
+    assert (v.picked["label"], v.picked["label_name"]) == (3, "brain"), v.picked
+    # A corner ray meets nothing.
+    v._on_message(v, {"type": "pick", "x": 0, "y": 0, "seq": 9}, [])
+    wait_for("the corner's pick", lambda: v.picked.get("seq") == 9)
+    assert v.picked == {"x": 0, "y": 0, "seq": 9, "hit": False}
+
+
+def test_a_renderer_without_labels_has_no_labels_panel(viewer):
+    v, _ = viewer
+    assert v.labels == [] and v.label_mode == ""
+    v._on_message(v, {"type": "label", "value": 1, "visible": False}, [])
+    assert "not a label" in v.status
+    v._on_message(v, {"type": "labels", "visible": False}, [])
+    assert "no label map" in v.status
+    # A pick still says the intensity there, with no label.
+    v._on_message(v, {"type": "pick", "x": 8, "y": 8, "seq": 1}, [])
+    wait_for("the pick", lambda: v.picked)
+    assert v.picked["hit"] is False or (v.picked["label"] == 0 and v.picked["label_name"] is None), v.picked
+    assert v.running
