@@ -153,10 +153,11 @@ fn to_text(info: &SeriesInfo) -> String {
 /// entry (name, colour, opacity, shown).
 fn labels(args: &InfoArgs) -> Result<()> {
     let path = &args.paths[0];
-    let map = LabelMap::load(path).with_context(|| format!("reading {}", path.display()))?;
+    let (map, own) =
+        LabelMap::load_with_table(path).with_context(|| format!("reading {}", path.display()))?;
     let mut table = match &args.label_table {
         Some(t) => LabelTable::load(t).with_context(|| format!("reading {}", t.display()))?,
-        None => LabelTable::default(),
+        None => own.unwrap_or_default(),
     };
     let present = map.present();
     let unnamed = table.complete(&present);

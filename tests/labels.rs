@@ -365,3 +365,107 @@ fn picking_names_the_label_at_the_centre_of_each_label_of_the_phantom() {
     drop(s);
     assert_validation_clean();
 }
+
+/// What a scene's `[labels]` gets wrong is an error naming the field or the file.
+#[test]
+fn bad_label_sections_and_maps_are_errors_naming_them() {
+    use dvr_engine::scene::Scene;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = |labels: &str| {
+        format!(
+            "[volume]\nbuiltin = \"phantom\"\nsize = 16\n[transfer]\na = \"ct-bone\"\n[[light]]\nkind = \"environment\"\nintensity = 1.0\n{labels}"
+        )
+    };
+    let parse_err = |labels: &str| {
+        Scene::from_toml_str(&scene(labels), "bad.toml")
+            .unwrap_err()
+            .to_string()
+    };
+    let e = parse_err(
+        "[labels]\nbuiltin = \"phantom\"\n[[label]]\nvalue = 2\ncolour = [2.0, 0.0, 0.0]\n",
+    );
+    assert!(e.contains("label[0].colour") && e.contains("[0, 1]"), "{e}");
+    let e = parse_err("[labels]\nbuiltin = \"phantom\"\n[[label]]\nvalue = 2\nopacity = 1.5\n");
+    assert!(e.contains("label[0].opacity"), "{e}");
+    let e = parse_err("[[label]]\nvalue = 2\nvisible = false\n");
+    assert!(e.contains("without a [labels]"), "{e}");
+    let e = parse_err("[labels]\nbuiltin = \"cloud\"\n");
+    assert!(
+        e.contains("labels.builtin") && e.contains("no built-in labels"),
+        "{e}"
+    );
+    let e = parse_err("[labels]\n");
+    assert!(e.contains("labels") && e.contains("give one of"), "{e}");
+    let e = parse_err("[labels]\nbuiltin = \"phantom\"\nmode = \"wire\"\n");
+    assert!(e.contains("wire"), "{e}");
+
+    let setup_err = |labels: &str| {
+        let s = Scene::from_toml_str(&scene(labels), "bad.toml").expect("parses");
+        let size = dvr_engine::graph::Extent {
+            width: 8,
+            height: 8,
+        };
+        match SceneSetup::new(s, size, Some(1), 16) {
+            Ok(_) => panic!("{labels}: set up"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let e = setup_err("[labels]\nbuiltin = \"phantom\"\n[[label]]\nvalue = 9\nvisible = false\n");
+    assert!(
+        e.contains("label[0].value = 9") && e.contains("1, 2, 3, 4, 5"),
+        "{e}"
+    );
+    // An NRRD label map with no space directions, on another grid than the built-in
+    // phantom's: nothing says how the grids meet.
+    let nrrd = dir.path().join("seg.nrrd");
+    let mut bytes =
+        b"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 8 8 8\nencoding: raw\n\n".to_vec();
+    bytes.extend(vec![1u8; 512]);
+    std::fs::write(&nrrd, bytes).expect("write");
+    let e = setup_err(&format!(
+        "[labels]\nfile = {:?}\n",
+        nrrd.display().to_string()
+    ));
+    assert!(
+        e.contains("seg.nrrd")
+            && e.contains("[8, 8, 8]")
+            && e.contains("nothing says how the grids meet"),
+        "{e}"
+    );
+    // A float map is not a label map.
+    let float = dir.path().join("prob.nrrd");
+    let mut bytes =
+        b"NRRD0004\ntype: float\ndimension: 3\nsizes: 16 16 16\nendian: little\nencoding: raw\n\n"
+            .to_vec();
+    bytes.extend((0..4096).flat_map(|_| 0.5f32.to_le_bytes()));
+    std::fs::write(&float, bytes).expect("write");
+    let e = setup_err(&format!(
+        "[labels]\nfile = {:?}\n",
+        float.display().to_string()
+    ));
+    assert!(
+        e.contains("prob.nrrd") && e.contains("label values") && e.contains("integers"),
+        "{e}"
+    );
+    // A table line that does not parse names its line.
+    let table = dir.path().join("seg.label");
+    std::fs::write(
+        &table,
+        "# ITK-SNAP\n0 0 0 0 0 0 0 \"Clear\"\n1 300 0 0 1 1 1 \"bad\"\n",
+    )
+    .expect("write");
+    let same_grid = dir.path().join("same.nrrd");
+    let mut bytes =
+        b"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 16 16 16\nencoding: raw\n\n".to_vec();
+    bytes.extend(vec![1u8; 4096]);
+    std::fs::write(&same_grid, bytes).expect("write");
+    let e = setup_err(&format!(
+        "[labels]\nfile = {:?}\ntable = {:?}\n",
+        same_grid.display().to_string(),
+        table.display().to_string()
+    ));
+    assert!(
+        e.contains("seg.label") && e.contains("line 3") && e.contains("300"),
+        "{e}"
+    );
+}

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use dvr_engine::scene::Scene;
 use dvr_engine::transfer::TransferFunction;
-use dvr_engine::volume::labels::LabelTable;
+use dvr_engine::volume::labels::{LabelMap, LabelTable};
 use dvr_engine::volume::{
     RawFormat, RawParams, Series, Volume, VolumeError, MAX_ANISOTROPY, MAX_DIM, MAX_SPACING_MM,
     MAX_VOXELS, MIN_SPACING_MM,
@@ -214,6 +214,12 @@ pub fn volume_zarr(bytes: &[u8], scratch: &Path) {
         let _ = std::fs::write(&path, data);
     }
     check_loaded(Volume::load_within(&open, None, budget));
+    // The same store as a label map: an image's `labels/` group, a label image's
+    // `image-label` colours and names.
+    if let Ok((map, _table)) = LabelMap::load_with_table(&open) {
+        let voxels: u64 = map.dims.iter().map(|&d| u64::from(d)).product();
+        assert_eq!(map.values.len() as u64, voxels, "label map dims {:?}", map.dims);
+    }
 }
 
 /// A volume a loader returned must be what its limits allow (README "Reliability"):

@@ -1,11 +1,12 @@
 """OME-Zarr input: images written by the ome-zarr and zarr packages (OME-Zarr 0.5 on Zarr
 v3, OME-NGFF 0.4 on Zarr v2) load at each resolution level with the shape, spacing and
 voxels those packages report; bad metadata, missing chunks and unknown codecs get clear
-messages."""
+messages; an image's `labels/` group is a scene's label map."""
 
 import json
 import pathlib
 import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -13,7 +14,7 @@ import zarr
 from ome_zarr.format import FormatV04, FormatV05
 from ome_zarr.io import parse_url
 from ome_zarr.reader import Multiscales, Reader
-from ome_zarr.writer import write_image
+from ome_zarr.writer import write_image, write_labels
 
 import dvr
 
@@ -149,3 +150,40 @@ def test_the_finest_level_within_the_memory_budget_is_read(tmp_path):
     assert dvr.load_volume(path, gpu_memory="64K").shape == (16, 32, 32)
     with pytest.raises(ValueError, match="gpu_memory"):
         dvr.load_volume(path, gpu_memory="lots")
+
+
+@pytest.mark.parametrize("version", ["0.5", "0.4"])
+def test_a_labels_group_written_by_ome_zarr_is_the_scenes_label_map(tmp_path, version, dvr_bin):
+    """An image with a `labels/` group (ome-zarr-py's `write_labels`, its `image-label`
+    colours and names): `[labels] file` naming the image takes its first label image,
+    with the table its metadata holds; the labels render, hide and pick."""
+    fmt = FORMATS[version]
+    data = image()
+    seg = np.zeros(data.shape, np.uint8)
+    seg[4:10, 5:12, 6:14] = 1
+    seg[10:16, 5:12, 6:14] = 7
+    path = tmp_path / "img.zarr"
+    root = zarr.group(store=parse_url(str(path), mode="w", fmt=fmt).store, zarr_format=fmt.zarr_format)
+    write_image(image=data, group=root, fmt=fmt, axes="zyx")
+    write_labels(
+        seg, root, "seg", fmt=fmt, axes="zyx",
+        label_metadata={
+            "colors": [{"label-value": 1, "rgba": [255, 0, 0, 255]}, {"label-value": 7, "rgba": [0, 128, 255, 128]}],
+            "properties": [{"label-value": 1, "name": "tumour"}, {"label-value": 7, "name": "oedema"}],
+        },
+    )  # fmt: skip
+    scene = tmp_path / "s.toml"
+    scene.write_text(
+        f'[volume]\nfile = "{path}"\n[transfer]\na = "ct-bone"\n[labels]\nfile = "{path}"\nmode = "solid"\n'
+        '[[light]]\nkind = "environment"\nintensity = 1.0\n'
+    )
+    r = dvr.Renderer(dvr.Scene.load(str(scene)), size=(24, 24), denoisers=[])
+    assert [(lab.value, lab.name) for lab in r.labels] == [(1, "tumour"), (7, "oedema")]
+    assert r.labels[1].colour == pytest.approx((1.0, 0.0, 0.0))
+    assert r.labels[7].opacity == pytest.approx(128 / 255)
+    shown = r.render()["noisy"]
+    r.labels.hide_all()
+    hidden = r.render(reset=True)["noisy"]
+    assert np.abs(shown - hidden).mean() > 1e-3
+    out = subprocess.run([str(dvr_bin), "info", str(path), "--labels"], capture_output=True, text=True, check=True).stdout
+    assert "1: tumour (colour FF0000" in out and "7: oedema (colour 0080FF" in out, out

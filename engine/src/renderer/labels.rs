@@ -38,8 +38,14 @@ pub fn load(
     let Some(spec) = &scene.labels else {
         return Ok(None);
     };
-    let (map, builtin_table) = match (&spec.file, &spec.builtin) {
-        (Some(file), _) => (LabelMap::load(file)?.onto(volume.dims, to_patient), None),
+    let (map, own_table) = match (&spec.file, &spec.builtin) {
+        (Some(file), _) => {
+            let (map, own_table) = LabelMap::load_with_table(file)?;
+            if map.dims != volume.dims {
+                check_placed(scene, &map.path, map.dims, volume.dims)?;
+            }
+            (map.onto(volume.dims, to_patient), own_table)
+        }
         (None, Some(name)) => {
             let dataset = match &scene.volume.source {
                 crate::scene::VolumeSource::Builtin { dataset, .. } => Some(dataset.name()),
@@ -65,7 +71,7 @@ pub fn load(
         }
     };
     let origin = map.path.clone();
-    let mut table = match (&spec.table, builtin_table) {
+    let mut table = match (&spec.table, own_table) {
         (Some(path), _) => LabelTable::load(path)?,
         (None, Some(t)) => t,
         (None, None) => LabelTable::default(),
@@ -129,6 +135,48 @@ pub fn load(
         cache: Mutex::new(None),
     };
     Ok(Some((labels, views)))
+}
+
+/// A label map on another grid than the volume's is put on it through both files'
+/// patient transforms: refused, naming the file without one, when either states none
+/// (a raw file, a built-in procedural volume), since nothing then says how the grids
+/// meet.
+fn check_placed(
+    scene: &Scene,
+    file: &std::path::Path,
+    map_dims: [u32; 3],
+    volume_dims: [u32; 3],
+) -> Result<(), VolumeError> {
+    use crate::scene::VolumeSource;
+    let stated = |p: &std::path::Path| -> Result<bool, VolumeError> {
+        crate::volume::labels::states_orientation(p)
+    };
+    let volume_file = match &scene.volume.source {
+        VolumeSource::File { path, raw: None } => Some(path.as_path()),
+        VolumeSource::Files { paths } => paths.first().map(|p| p.as_path()),
+        VolumeSource::File { raw: Some(_), .. } | VolumeSource::Builtin { .. } => None,
+    };
+    let unplaced = if !stated(file)? {
+        Some("the label map states no patient transform (affine)".to_string())
+    } else {
+        match volume_file {
+            Some(p) if stated(p)? => None,
+            Some(p) => Some(format!(
+                "the volume {} states no patient transform",
+                p.display()
+            )),
+            None => Some("the volume (built-in or raw) has no patient transform".into()),
+        }
+    };
+    match unplaced {
+        None => Ok(()),
+        Some(why) => Err(VolumeError::Unsupported {
+            path: file.to_path_buf(),
+            reason: format!(
+                "a label map of {map_dims:?} voxels for a volume of {volume_dims:?}: {why}, so nothing says how the grids meet (give the map on the volume's grid, or files with affines)"
+            ),
+        }),
+    }
 }
 
 fn list(values: &[u16]) -> String {

@@ -4,14 +4,26 @@
 //! label values makes labels that are not there). Its label table is `labels/table.rs`.
 
 mod look;
+mod ome;
 mod table;
 
 pub use look::{LabelLook, Look, SMOOTHING_SIGMA};
+pub use ome::{first_label_image, image_label_table};
 pub use table::{Label, LabelTable, PALETTE};
 
 use crate::orientation::invert;
 use crate::{PatientTransform, SampleKind, Volume, VolumeError};
 use std::path::{Path, PathBuf};
+
+/// Whether the file at `path` states where its voxels lie in patient space (an affine,
+/// DICOM's position and orientation); raw files do not. Header-only for the formats with
+/// headers (raw and DICOM are read whole).
+pub fn states_orientation(path: &Path) -> Result<bool, VolumeError> {
+    Ok(crate::formats::open_series(path)?
+        .info()
+        .orientation
+        .is_some())
+}
 
 /// Largest label value: labels are held as u16.
 pub const MAX_LABEL: u32 = u16::MAX as u32;
@@ -98,6 +110,25 @@ impl LabelMap {
                 valid: "phantom, mri".into(),
             }),
         }
+    }
+
+    /// The label map a file gives, and the table its own metadata holds: an OME-Zarr
+    /// label image's `image-label`, and for an OME-Zarr image with a `labels/` group the
+    /// first label image it lists; any other file as [`LabelMap::load`], no table.
+    pub fn load_with_table(path: &Path) -> Result<(Self, Option<LabelTable>), VolumeError> {
+        let own = image_label_table(path)?;
+        if own.is_none() {
+            if let Some(first) = first_label_image(path)? {
+                log::info!(
+                    "{}: its first label image, {}",
+                    path.display(),
+                    first.display()
+                );
+                let table = image_label_table(&first)?;
+                return Ok((Self::load(&first)?, table));
+            }
+        }
+        Ok((Self::load(path)?, own))
     }
 
     /// The label values of a loaded integer volume: its densities brought back through

@@ -262,14 +262,18 @@ fn store(path: &Path, max_read: u64) -> Result<Arc<Store>, VolumeError> {
 fn read_image(group: &Path) -> Result<Image, VolumeError> {
     let group_node = Group::open(store(group, MAX_METADATA_BYTES)?, "/")
         .map_err(|e| malformed(group, "zarr group", e.to_string()))?;
-    // `omero` is read by `omero.rs`, leniently (the metadata crate requires every
-    // channel's colour and full window, which writers often leave out).
+    // `omero` is read by `omero.rs` and a label image's `image-label` by
+    // `labels/ome.rs`, leniently (the metadata crate requires every channel's colour and
+    // full window, which writers often leave out, and refuses the `image-label` that
+    // ome-zarr-py writes for 0.5).
     let mut attributes = serde_json::Value::Object(group_node.attributes().clone());
-    if let Some(a) = attributes.as_object_mut() {
-        a.remove("omero");
-    }
-    if let Some(a) = attributes.get_mut("ome").and_then(|o| o.as_object_mut()) {
-        a.remove("omero");
+    for key in ["omero", "image-label"] {
+        if let Some(a) = attributes.as_object_mut() {
+            a.remove(key);
+        }
+        if let Some(a) = attributes.get_mut("ome").and_then(|o| o.as_object_mut()) {
+            a.remove(key);
+        }
     }
     let ome: AnyOmeFields = serde_json::from_value(attributes).map_err(|e| {
         malformed(
