@@ -5,7 +5,8 @@
 # book's results pages and README's headline table from those files.
 #
 #   tools/measure.sh SET [SET ...]     SET: demo static development validation paper
-#                                           suite cost rae cuts cut-cost
+#                                           suite cost rae cuts cut-cost labels
+#                                           labels-cost
 #
 # Needs a release build (cargo build --release). The eval sets also add Intel OIDN with
 # tools/oidn_eval.py, which needs a Python with the dvr package, pyoidn, numpy, OpenEXR
@@ -208,8 +209,56 @@ with open("assets/results/cut-cost/profile.csv", "w", newline="") as f:
 EOF2
       meta cut-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit with and without [[clip]] point [0,0,0] normal [1,0,0], alternating, two runs each"
       ;;
+    labels)
+      # The label-map scenes: two development scenes and the validation scene, at the
+      # validation set's size and reference count.
+      d=assets/scenes/development
+      args=(--scene "$d/phantom-labels-skull-orbit.toml,$d/mri-labels-fade.toml,assets/scenes/validation/mri-labels-solid-orbit.toml"
+        --size 128x128 --frames 48 --ref-spp 256 --aux --denoiser none,taa,svgf,ours)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      oidn "$out"
+      KEEP_METRICS=1 keep labels "$out"
+      meta labels "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
+      ;;
+    labels-cost)
+      # The MNI head under the opaque TF without a label map, with its segmentation
+      # shown (tint) and with the grey matter hidden, profiled alternately (two runs
+      # each), so the machine's drift falls on all three.
+      mkdir -p "$out"
+      "$dvr" scenes --dump mri/point-light > "$out/none.toml"
+      { cat "$out/none.toml"; printf '
+[labels]
+builtin = "mri"
+'; } > "$out/shown.toml"
+      { cat "$out/shown.toml"; printf '
+[[label]]
+value = 2
+visible = false
+'; } > "$out/hidden.toml"
+      t0=$(date +%s.%N)
+      for run in 1 2; do
+        for labels in none shown hidden; do
+          "$dvr" profile --scene "$out/$labels.toml" --frames 20 --size 256x256 --denoiser ours \
+            --json "$out/$labels-$run.json" >/dev/null
+        done
+      done
+      secs=$(echo "$(date +%s.%N) - $t0" | bc)
+      python3 - "$out" <<'EOF2'
+import csv, json, sys
+out = sys.argv[1]
+with open("assets/results/labels-cost/profile.csv", "w", newline="") as f:
+    w = csv.writer(f)
+    w.writerow(["scene", "labels", "run", "path_trace_ms", "frame_ms"])
+    for run in (1, 2):
+        for labels, what in (("none", "no label map"), ("shown", "shown (tint)"), ("hidden", "grey matter hidden")):
+            p = json.load(open(f"{out}/{labels}-{run}.json"))
+            pt = next(x["median_ms"] for x in p["passes"] if x["pass"] == "path_trace")
+            w.writerow(["mri/point-light", what, run, f"{pt:.3f}", f"{p['total']['median_ms']:.3f}"])
+EOF2
+      meta labels-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = mri/point-light without a label map, with [labels] builtin = \"mri\" shown, and with label 2 hidden, alternating, two runs each"
+      ;;
     *)
-      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost)" >&2
+      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost labels labels-cost)" >&2
       exit 2
       ;;
   esac

@@ -1,13 +1,18 @@
 """The channels of a multi-channel medium as a renderer shows them: each a live view
 whose fields are edits (``r.channels[1].visible = False``)."""
 
-from .live import FieldError
+from .live import _Item, _rgb, item_field
 from .scene import TransferFunction
 
 __all__ = ["Channel"]
 
 
-class Channel:
+def _pair(w):
+    lo, hi = (float(x) for x in w)
+    return (lo, hi)
+
+
+class Channel(_Item):
     """Channel ``index`` of a renderer's medium: its ``name``, ``tf`` (a
     :class:`TransferFunction` over ``window``, or in data units), ``window`` (the data
     values the TF's 0–1 spans), ``data_window`` (the values at the channel's density 0
@@ -16,6 +21,7 @@ class Channel:
     edit the next render re-traces, as a TF edit (``ValueError`` names a bad value)."""
 
     _FIELDS = ("name", "tf", "window", "data_window", "colour", "visible")
+    _SETTABLE = ("tf", "window", "colour", "visible")
 
     def __init__(self, native, index):
         object.__setattr__(self, "_native", native)
@@ -24,9 +30,18 @@ class Channel:
     def _get(self):
         return self._native.channels()[self._index]
 
-    @property
-    def name(self) -> str:
-        return self._get()["name"]
+    def _edit(self, **change):
+        self._native.edit_channel(self._index, **change)
+
+    def _what(self):
+        return f"channel {self._index}"
+
+    name = item_field("name")
+    window = item_field("window", lambda w: _pair(w), tuple)
+    data_window = item_field("data_window", read=tuple)
+    colour = item_field("colour", _rgb, tuple)
+    color = colour
+    visible = item_field("visible", bool)
 
     @property
     def tf(self) -> TransferFunction:
@@ -35,49 +50,7 @@ class Channel:
 
     @tf.setter
     def tf(self, tf):
-        self._native.edit_channel(self._index, tf=TransferFunction.coerce(tf).to_dict())
-
-    @property
-    def window(self) -> tuple:
-        return tuple(self._get()["window"])
-
-    @window.setter
-    def window(self, w):
-        lo, hi = (float(x) for x in w)
-        self._native.edit_channel(self._index, window=(lo, hi))
-
-    @property
-    def data_window(self) -> tuple:
-        return tuple(self._get()["data_window"])
-
-    @property
-    def colour(self) -> tuple:
-        return tuple(self._get()["colour"])
-
-    @colour.setter
-    def colour(self, c):
-        r, g, b = (float(x) for x in c)
-        self._native.edit_channel(self._index, colour=(r, g, b))
-
-    color = colour
-
-    @property
-    def visible(self) -> bool:
-        return self._get()["visible"]
-
-    @visible.setter
-    def visible(self, v):
-        self._native.edit_channel(self._index, visible=bool(v))
-
-    def __setattr__(self, name, value):
-        if name == "color":
-            name = "colour"
-        if name not in ("tf", "window", "colour", "visible"):
-            raise FieldError(
-                f"channel {self._index} has no settable field {name!r} (fields: {', '.join(Channel._FIELDS)}; "
-                "name and data_window are read-only)"
-            )
-        object.__setattr__(self, name, value)
+        self._edit(tf=TransferFunction.coerce(tf).to_dict())
 
     def __repr__(self):
         d = self._get()

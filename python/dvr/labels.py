@@ -1,12 +1,12 @@
 """The labels of a renderer's label map as it shows them: a mapping from label value to
 a live view whose fields are edits (``r.labels[3].visible = False``)."""
 
-from .live import FieldError
+from .live import _Item, _rgb, item_field
 
 __all__ = ["Label", "Labels"]
 
 
-class Label:
+class Label(_Item):
     """Label ``value`` of a renderer's label map: its ``name``, ``colour`` (RGB in [0, 1]:
     the tint of the intensity TF inside it, or its colour as solid tissue), ``opacity``
     (in [0, 1], scaling the medium's extinction inside it) and ``visible`` (a hidden
@@ -15,6 +15,7 @@ class Label:
     value)."""
 
     _FIELDS = ("value", "name", "colour", "opacity", "visible")
+    _SETTABLE = ("colour", "opacity", "visible")
 
     def __init__(self, native, value):
         object.__setattr__(self, "_native", native)
@@ -26,50 +27,21 @@ class Label:
                 return d
         raise KeyError(self._value)
 
+    def _edit(self, **change):
+        self._native.edit_label(self._value, **change)
+
+    def _what(self):
+        return f"label {self._value}"
+
     @property
     def value(self) -> int:
         return self._value
 
-    @property
-    def name(self) -> str:
-        return self._get()["name"]
-
-    @property
-    def colour(self) -> tuple:
-        return tuple(self._get()["colour"])
-
-    @colour.setter
-    def colour(self, c):
-        r, g, b = (float(x) for x in c)
-        self._native.edit_label(self._value, colour=(r, g, b))
-
+    name = item_field("name")
+    colour = item_field("colour", _rgb, tuple)
     color = colour
-
-    @property
-    def opacity(self) -> float:
-        return self._get()["opacity"]
-
-    @opacity.setter
-    def opacity(self, o):
-        self._native.edit_label(self._value, opacity=float(o))
-
-    @property
-    def visible(self) -> bool:
-        return self._get()["visible"]
-
-    @visible.setter
-    def visible(self, v):
-        self._native.edit_label(self._value, visible=bool(v))
-
-    def __setattr__(self, name, value):
-        if name == "color":
-            name = "colour"
-        if name not in ("colour", "opacity", "visible"):
-            raise FieldError(
-                f"label {self._value} has no settable field {name!r} (fields: {', '.join(Label._FIELDS)}; "
-                "value and name are read-only)"
-            )
-        object.__setattr__(self, name, value)
+    opacity = item_field("opacity", float)
+    visible = item_field("visible", bool)
 
     def __repr__(self):
         d = self._get()

@@ -57,6 +57,55 @@ def _as_dict(obj, what):
     raise TypeError(f"{what}: expected a {what} object or a dict, got {type(obj).__name__}")
 
 
+def _rgb(c):
+    r, g, b = (float(x) for x in c)
+    return (r, g, b)
+
+
+class _Item:
+    """A live view of one item a renderer lists (a channel, a label): fields read from
+    ``self._get()`` (the item's dict in the renderer's current view) and assigned through
+    ``self._edit(field=value)`` (one edit). Subclasses name their settable ``_SETTABLE``
+    and all their ``_FIELDS``; ``color`` is ``colour``."""
+
+    _FIELDS: tuple = ()
+    _SETTABLE: tuple = ()
+
+    def _get(self) -> dict:
+        raise NotImplementedError
+
+    def _edit(self, **change):
+        raise NotImplementedError
+
+    def __setattr__(self, name, value):
+        if name == "color":
+            name = "colour"
+        if name not in self._SETTABLE:
+            fixed = [f for f in self._FIELDS if f not in self._SETTABLE]
+            raise FieldError(
+                f"{self._what()} has no settable field {name!r} (fields: {', '.join(self._FIELDS)}; "
+                f"{' and '.join(fixed)} {'is' if len(fixed) == 1 else 'are'} read-only)"
+            )
+        object.__setattr__(self, name, value)
+
+    def _what(self) -> str:
+        raise NotImplementedError
+
+
+def item_field(name, coerce=None, read=None, doc=None):
+    """A field of an :class:`_Item`: read from its dict (through ``read``), assigned as an
+    edit of ``coerce(value)``; read-only without ``coerce``."""
+
+    def get(self):
+        v = self._get()[name]
+        return read(v) if read else v
+
+    def put(self, value):
+        self._edit(**{name: coerce(value)})
+
+    return property(get, put if coerce else None, doc=doc)
+
+
 class _Section:
     """A dict-valued section behind a getter and a setter; attribute writes replace one
     key and hand the whole section to the setter (which checks it)."""

@@ -11,6 +11,23 @@ import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
+# The phantom at 48³ with its own segmentation (scalp, skull, brain, ventricles,
+# vessels): the label tests' scene, in `mode` ("tint" or "solid").
+LABELLED_PHANTOM = """
+name = "labelled"
+[volume]
+builtin = "phantom"
+size = 48
+[transfer]
+a = "ct-bone"
+[labels]
+builtin = "phantom"
+mode = "{mode}"
+[[light]]
+kind = "environment"
+intensity = 1.0
+"""
+
 
 @pytest.fixture(scope="session")
 def root():

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import dvr
+from conftest import LABELLED_PHANTOM
 
 SCENES = os.path.join(os.path.dirname(__file__), "..", "..", "assets", "scenes", "development")
 
@@ -17,30 +18,14 @@ def scene(name):
     return dvr.Scene.load(os.path.join(SCENES, name))
 
 
-SCENE = """
-name = "labelled"
-[volume]
-builtin = "phantom"
-size = 48
-[transfer]
-a = "ct-bone"
-[labels]
-builtin = "phantom"
-mode = "{mode}"
-[[light]]
-kind = "environment"
-intensity = 1.0
-[animation]
-frames = 3
-"""
 
 
 def test_a_label_edited_by_hand_renders_what_the_keyframes_render(tmp_path):
     for mode in ("tint", "solid"):
         plain = tmp_path / f"plain-{mode}.toml"
-        plain.write_text(SCENE.format(mode=mode))
+        plain.write_text(LABELLED_PHANTOM.format(mode=mode) + "[animation]\nframes = 3\n")
         keyed = tmp_path / f"keyed-{mode}.toml"
-        keyed.write_text(SCENE.format(mode=mode) + "[[animation.label]]\nvalue = 2\nframe = 1\nvisible = false\n")
+        keyed.write_text(LABELLED_PHANTOM.format(mode=mode) + "[animation]\nframes = 3\n[[animation.label]]\nvalue = 2\nframe = 1\nvisible = false\n")
         a, b, c = (dvr.Renderer(dvr.Scene.load(p), size=(24, 24), denoisers=["ours"]) for p in (keyed, plain, plain))
         shown = []
         for f in range(3):

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from nbclient import NotebookClient
 
+from conftest import LABELLED_PHANTOM
 from lab import Notebook, decode_png, ffprobe_frames, image_stats, write_notebook
 
 EXAMPLES = pathlib.Path(__file__).resolve().parents[1] / "examples"
@@ -280,20 +281,6 @@ def test_the_channels_panel_and_the_time_slider(lab, browser, series_file):
     page.close()
 
 
-LABELLED = """
-name = "labelled"
-[volume]
-builtin = "phantom"
-size = 48
-[transfer]
-a = "ct-bone"
-[labels]
-builtin = "phantom"
-mode = "solid"
-[[light]]
-kind = "environment"
-intensity = 1.0
-"""
 
 
 def test_the_labels_panel_and_picking(lab, browser):
@@ -302,7 +289,7 @@ def test_the_labels_panel_and_picking(lab, browser):
     and one shown again from the panel, each reaching the kernel's renderer; a click in
     the image picks the label under it (the page pixel mapped to the rendered pixel), a
     drag still orbits without picking. (The same server as the tests above.)"""
-    (lab.root / "labelled.toml").write_text(LABELLED)
+    (lab.root / "labelled.toml").write_text(LABELLED_PHANTOM.format(mode="solid"))
     write_notebook(
         lab.root / "labels.ipynb",
         [

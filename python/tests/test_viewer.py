@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import dvr
+from conftest import LABELLED_PHANTOM
 from dvr import viewer as viewer_module
 
 
@@ -614,20 +615,6 @@ def test_a_volume_of_one_field_shows_neither_panel(viewer):
 
 # Label maps: the labels panel and picking.
 
-LABELLED = """
-name = "labelled"
-[volume]
-builtin = "phantom"
-size = 48
-[transfer]
-a = "ct-bone"
-[labels]
-builtin = "phantom"
-mode = "solid"
-[[light]]
-kind = "environment"
-intensity = 1.0
-"""
 
 
 @pytest.fixture
@@ -638,7 +625,7 @@ def label_viewer(monkeypatch, tmp_path):
     monkeypatch.setattr(dvr.Viewer, "send", lambda self, content, buffers=None: sent(content, buffers))
     monkeypatch.setattr(dvr.Viewer, "send_state", lambda self, key=None: resent.append(key))
     path = tmp_path / "labelled.toml"
-    path.write_text(LABELLED)
+    path.write_text(LABELLED_PHANTOM.format(mode="solid"))
     v = dvr.Viewer(dvr.Scene.load(path), size=(33, 33), denoisers=["ours"])
     yield v, sent, resent
     v.close()
