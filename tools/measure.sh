@@ -221,25 +221,31 @@ EOF2
       meta labels "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
     labels-cost)
-      # The MNI head under the opaque TF without a label map, with its segmentation
-      # shown (tint) and with the grey matter hidden, profiled alternately (two runs
-      # each), so the machine's drift falls on all three.
+      # Two heads under opaque TFs: the phantom, whose labels cover every tissue (label
+      # 0 is air), and the MNI head, whose white and grey matter leave unlabelled rims
+      # (CSF, partial volumes) shown. Each without a label map, with its labels shown
+      # (tint), with an outer label hidden (the phantom's scalp and skull, the MNI
+      # head's grey matter: what lies beneath shows) and with every label hidden,
+      # profiled alternately (two runs each), so the machine's drift falls on all.
       mkdir -p "$out"
-      "$dvr" scenes --dump mri/point-light > "$out/none.toml"
-      { cat "$out/none.toml"; printf '
-[labels]
-builtin = "mri"
-'; } > "$out/shown.toml"
-      { cat "$out/shown.toml"; printf '
-[[label]]
-value = 2
-visible = false
-'; } > "$out/hidden.toml"
       t0=$(date +%s.%N)
-      for run in 1 2; do
-        for labels in none shown hidden; do
-          "$dvr" profile --scene "$out/$labels.toml" --frames 20 --size 256x256 --denoiser ours \
-            --json "$out/$labels-$run.json" >/dev/null
+      for scene in phantom/orbit mri/point-light; do
+        name=${scene%%/*}
+        "$dvr" scenes --dump "$scene" > "$out/$name-none.toml"
+        { cat "$out/$name-none.toml"; printf '\n[labels]\nbuiltin = "%s"\n' "$name"; } > "$out/$name-shown.toml"
+        case $name in
+          phantom) outer='1 2'; all='1 2 3 4 5' ;;
+          mri) outer='2'; all='1 2' ;;
+        esac
+        for set_ in outer all; do
+          cp "$out/$name-shown.toml" "$out/$name-$set_.toml"
+          for v in ${!set_}; do printf '\n[[label]]\nvalue = %s\nvisible = false\n' "$v" >> "$out/$name-$set_.toml"; done
+        done
+        for run in 1 2; do
+          for labels in none shown outer all; do
+            "$dvr" profile --scene "$out/$name-$labels.toml" --frames 20 --size 256x256 --denoiser ours \
+              --json "$out/$name-$labels-$run.json" >/dev/null
+          done
         done
       done
       secs=$(echo "$(date +%s.%N) - $t0" | bc)
@@ -249,13 +255,16 @@ out = sys.argv[1]
 with open("assets/results/labels-cost/profile.csv", "w", newline="") as f:
     w = csv.writer(f)
     w.writerow(["scene", "labels", "run", "path_trace_ms", "frame_ms"])
-    for run in (1, 2):
-        for labels, what in (("none", "no label map"), ("shown", "shown (tint)"), ("hidden", "grey matter hidden")):
-            p = json.load(open(f"{out}/{labels}-{run}.json"))
-            pt = next(x["median_ms"] for x in p["passes"] if x["pass"] == "path_trace")
-            w.writerow(["mri/point-light", what, run, f"{pt:.3f}", f"{p['total']['median_ms']:.3f}"])
+    for scene, outer in (("phantom/orbit", "scalp and skull hidden"), ("mri/point-light", "grey matter hidden")):
+        name = scene.split("/")[0]
+        for run in (1, 2):
+            for labels, what in (("none", "no label map"), ("shown", "shown (tint)"), ("outer", outer),
+                                 ("all", "every label hidden")):
+                p = json.load(open(f"{out}/{name}-{labels}-{run}.json"))
+                pt = next(x["median_ms"] for x in p["passes"] if x["pass"] == "path_trace")
+                w.writerow([scene, what, run, f"{pt:.3f}", f"{p['total']['median_ms']:.3f}"])
 EOF2
-      meta labels-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = mri/point-light without a label map, with [labels] builtin = \"mri\" shown, and with label 2 hidden, alternating, two runs each"
+      meta labels-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit and mri/point-light without a label map, with [labels] builtin = the dataset shown, with an outer label hidden and with every label hidden, alternating, two runs each"
       ;;
     *)
       echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost labels labels-cost)" >&2

@@ -195,11 +195,24 @@ pub fn create<'f>(
         lut_size,
         labels,
     } = *desc;
-    let format = volume.vk_format();
-    // Dense: the volume itself, and 1×1×1 pool and table no shader reads. Pooled: the
+    let mask = super::packing::mask_in_volume(volume, labels);
+    let format = if mask {
+        volume.format.vk_components(2)
+    } else {
+        volume.vk_format()
+    };
+    // Dense: the volume itself (with the label mask beside each density, all shown until
+    // the first frame's look), and 1×1×1 pool and table no shader reads. Pooled: the
     // coarse copy, the pool (slots are written as the TF makes their bricks visible, and
     // read only through the table, which starts with no slot) and the table.
     let (volume_dims, volume_bytes, pool_extent, grid, no_slot) = match path {
+        VolumePath::Dense if mask => (
+            volume.dims,
+            Cow::Owned(super::packing::with_mask(volume, None)),
+            [1; 3],
+            [1; 3],
+            0.0,
+        ),
         VolumePath::Dense => (volume.dims, volume.dense_bytes(), [1; 3], [1; 3], 0.0),
         VolumePath::Pool(layout) => (
             layout.coarse_dims,

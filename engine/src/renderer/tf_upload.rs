@@ -48,6 +48,19 @@ impl Renderer {
         let labels_changed = self.current_labels != inputs.labels;
         if labels_changed {
             if let Some(look) = &inputs.labels {
+                if super::packing::mask_in_volume(&self.volume, true) {
+                    let bytes = super::packing::with_mask(&self.volume, Some(&look.0.rgba));
+                    let (ctx, graph, image) = (&self.ctx, &mut self.graph, self.scene.volume);
+                    scene_gpu::add_frame_upload(
+                        ctx,
+                        graph,
+                        frame,
+                        "upload_volume",
+                        slot,
+                        image,
+                        &bytes,
+                    )?;
+                }
                 let (ctx, graph) = (&self.ctx, &mut self.graph);
                 let rgba = bytemuck::cast_slice(&look.0.rgba);
                 for (name, image, bytes) in [
@@ -167,15 +180,13 @@ impl Renderer {
         }
         let (ctx, graph) = (&self.ctx, &mut self.graph);
         let image = self.scene.volume;
-        scene_gpu::add_frame_upload(
-            ctx,
-            graph,
-            frame,
-            "upload_volume",
-            slot,
-            image,
-            &volume.bytes,
-        )?;
+        let bytes = match &self.current_labels {
+            Some(look) if super::packing::mask_in_volume(&volume, true) => {
+                std::borrow::Cow::Owned(super::packing::with_mask(&volume, Some(&look.0.rgba)))
+            }
+            _ => std::borrow::Cow::Borrowed(&volume.bytes[..]),
+        };
+        scene_gpu::add_frame_upload(ctx, graph, frame, "upload_volume", slot, image, &bytes)?;
         self.bricks = volume.bricks.clone();
         self.volume = volume;
         // The majorants follow the new bricks' ranges.

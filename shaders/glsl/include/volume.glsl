@@ -122,9 +122,19 @@ vec3 label_gradient(vec3 p) {
 // the cut's.
 const float LABEL_EDGE = 0.05;
 
+// With a label map and one channel, the mask rides in the volume texture's second
+// component (engine/src/renderer/packing.rs, with_mask): the extinction, evaluated at
+// every step of delta tracking, takes one fetch for density and mask.
+bool mask_in_volume() { return LABELS != LABELS_NONE && CHANNELS == 1; }
+
 // Extinction coefficient at p (per world unit): with several channels, the sum of theirs;
 // with a label map, times its mask (solid: the mask alone).
 float extinction_at(vec3 p) {
+    if (mask_in_volume()) {
+        vec2 dm = texture(volume_density, to_uvw(p)).rg;
+        float o = LABELS == LABELS_SOLID ? 1.0 : tf_albedo_opacity(dm.r).a;
+        return o * dm.g * frame.box_min.w;
+    }
     if (LABELS == LABELS_SOLID) return label_look_at(p).a * frame.box_min.w;
     float opacity;
     if (CHANNELS > 1) {
