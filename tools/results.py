@@ -61,9 +61,14 @@ def b_headline():
     methods = present(rows, ["ours", "svgf", "taa", "rae", "oidn-aux", "oidn"])
     n = len(scenes_of(rows))
     others = [sc for sc in validation_scenes() if sc not in scenes_of(rows)]
-    media = scenes_of(read_csv("media", "summary.csv")) if others else []
-    where = ("in [the channel and time run](docs/src/results.md#channels-and-time)"
-             if all(sc in media for sc in others) else "in no run of it yet")
+    runs = [("media", "the channel and time run", "channels-and-time"),
+            ("labels", "the label-map run", "label-maps")]
+    held = {name: scenes_of(read_csv(name, "summary.csv")) if others else [] for name, _, _ in runs}
+    places = [f"[{what}](docs/src/results.md#{anchor})" for name, what, anchor in runs
+              if any(sc in held[name] for sc in others)]
+    unrun = [sc for sc in others if not any(sc in held[name] for name, _, _ in runs)]
+    where = ("in " + " and ".join(places) + (f" ({len(unrun)} in no run yet)" if unrun else "")
+             if places else "in no run of it yet")
     also = f"; its other {len(others)} scenes are {where}" if others else ""
     return "\n".join([
         means_table("validation", rows, methods),
@@ -650,6 +655,37 @@ def b_media_line():
     return set_line("media", "the channel and time scenes") + "; source: `assets/results/media/`."
 
 
+def b_labels():
+    """The label-map scenes: segmentations hidden, faded and shown as solid tissue."""
+    return set_table("labels")
+
+
+def b_labels_line():
+    return set_line("labels", "the label-map scenes") + "; source: `assets/results/labels/`."
+
+
+def b_labels_cost():
+    """The path tracer's cost with a label map shown and with a label hidden, against the
+    same view without one, run by run."""
+    rows = read_csv("labels-cost", "profile.csv")
+    base = {(r["scene"], r["run"]): num(r["path_trace_ms"]) for r in rows
+            if r["labels"] == "no label map"}
+    body = [[r["scene"], r["labels"], r["run"], fmt(num(r["path_trace_ms"]), 1),
+             f"{num(r['path_trace_ms']) / base[(r['scene'], r['run'])]:.2f}×",
+             fmt(num(r["frame_ms"]), 1)]
+            for r in rows]
+    return "\n".join([
+        "Median GPU ms per frame of the path-tracing pass and of the whole frame at 256×256, "
+        "the same view without a label map, with its labels shown, with an outer label hidden "
+        "and with every label hidden, runs alternating (× is to the same scene's run without "
+        "a label map):",
+        "",
+        table(["scene", "labels", "run", "`path_trace`", "× none", "frame"], body),
+        "",
+        source("labels-cost", ["profile.csv"]),
+    ])
+
+
 def b_cut_cost():
     rows = read_csv("cut-cost", "profile.csv")
     body = [[r["scene"], r["cut"], r["run"], fmt(num(r["path_trace_ms"]), 1),
@@ -740,7 +776,8 @@ def b_experiments_strata():
 
 BLOCKS = {
     "headline": (b_headline, ["validation/summary.csv", "validation/meta.json",
-                              "media/summary.csv", "../scenes/validation/*.toml"]),
+                              "media/summary.csv", "labels/summary.csv",
+                              "../scenes/validation/*.toml"]),
     "suite-means": (b_suite_means, ["suite/summary.csv"]),
     "suite-scenes": (b_suite_scenes, ["suite/summary.csv"]),
     "ablations": (b_ablations, ["validation/summary.csv"]),
@@ -767,6 +804,10 @@ BLOCKS = {
     "cuts-line": (b_cuts_line, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json",
                                 "validation/summary.csv"]),
     "cut-cost": (b_cut_cost, ["cut-cost/profile.csv"]),
+    "labels": (b_labels, ["labels/summary.csv", "labels/metrics.csv", "labels/meta.json"]),
+    "labels-line": (b_labels_line, ["labels/summary.csv", "labels/metrics.csv",
+                                    "labels/meta.json"]),
+    "labels-cost": (b_labels_cost, ["labels-cost/profile.csv"]),
     "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv",
                                                 "validation/metrics.csv"]),
     "experiments-strata": (b_experiments_strata, ["experiments-strata/*.csv",

@@ -218,7 +218,12 @@ pub fn volume_zarr(bytes: &[u8], scratch: &Path) {
     // `image-label` colours and names.
     if let Ok((map, _table)) = LabelMap::load_with_table(&open) {
         let voxels: u64 = map.dims.iter().map(|&d| u64::from(d)).product();
-        assert_eq!(map.values.len() as u64, voxels, "label map dims {:?}", map.dims);
+        assert_eq!(
+            map.values.len() as u64,
+            voxels,
+            "label map dims {:?}",
+            map.dims
+        );
     }
 }
 
