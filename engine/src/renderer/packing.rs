@@ -115,6 +115,32 @@ pub fn channel_bricks(v: &VolumeUpload) -> Vec<&BrickRanges> {
         .collect()
 }
 
+/// Whether the label mask rides in the volume texture's second component: for a
+/// one-channel medium with a label map, so the extinction (evaluated at every step of
+/// delta tracking) takes one fetch for density and mask (include/volume.glsl).
+pub fn mask_in_volume(volume: &VolumeUpload, labels: bool) -> bool {
+    labels && volume.channels() == 1
+}
+
+/// The volume's texels with the label mask beside each density (RG in the volume's
+/// sample type; `mask` the label look's texels, whose alpha is the mask; `None`: all
+/// shown), for [`mask_in_volume`].
+pub fn with_mask(volume: &VolumeUpload, mask: Option<&[[u8; 4]]>) -> Vec<u8> {
+    let bpp = volume.format.bytes();
+    let texels = volume.bytes.len() / bpp;
+    let mut out = Vec::with_capacity(texels * 2 * bpp);
+    for (i, d) in volume.bytes.chunks_exact(bpp).enumerate() {
+        out.extend_from_slice(d);
+        let m = mask.and_then(|m| m.get(i)).map_or(255, |t| t[3]);
+        match volume.format {
+            VolumeFormat::R8 => out.push(m),
+            VolumeFormat::R16 => out.extend_from_slice(&(u16::from(m) * 257).to_le_bytes()),
+            VolumeFormat::R32F => out.extend_from_slice(&(f32::from(m) / 255.0).to_le_bytes()),
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,30 +195,4 @@ mod tests {
             "{msg}"
         );
     }
-}
-
-/// Whether the label mask rides in the volume texture's second component: for a
-/// one-channel medium with a label map, so the extinction (evaluated at every step of
-/// delta tracking) takes one fetch for density and mask (include/volume.glsl).
-pub fn mask_in_volume(volume: &VolumeUpload, labels: bool) -> bool {
-    labels && volume.channels() == 1
-}
-
-/// The volume's texels with the label mask beside each density (RG in the volume's
-/// sample type; `mask` the label look's texels, whose alpha is the mask; `None`: all
-/// shown), for [`mask_in_volume`].
-pub fn with_mask(volume: &VolumeUpload, mask: Option<&[[u8; 4]]>) -> Vec<u8> {
-    let bpp = volume.format.bytes();
-    let texels = volume.bytes.len() / bpp;
-    let mut out = Vec::with_capacity(texels * 2 * bpp);
-    for (i, d) in volume.bytes.chunks_exact(bpp).enumerate() {
-        out.extend_from_slice(d);
-        let m = mask.and_then(|m| m.get(i)).map_or(255, |t| t[3]);
-        match volume.format {
-            VolumeFormat::R8 => out.push(m),
-            VolumeFormat::R16 => out.extend_from_slice(&(u16::from(m) * 257).to_le_bytes()),
-            VolumeFormat::R32F => out.extend_from_slice(&(f32::from(m) / 255.0).to_le_bytes()),
-        }
-    }
-    out
 }
