@@ -151,13 +151,7 @@ impl Explorer {
             }
         }
         if let Some(rec) = self.recorder.as_mut() {
-            rec.push(
-                view.camera,
-                &view.lights,
-                &view.cut,
-                &view.tf.a,
-                &self.model.left,
-            )?;
+            rec.push(&view, &self.model.left)?;
         }
         self.last_view = Some(view);
         self.frame += 1;

@@ -3,21 +3,23 @@
 //! Writes `DIR/frames/NNNN.png` (the displayed denoiser's frame, tone-mapped like
 //! `dvr capture`'s PNGs), `DIR/state.jsonl` (one line per frame: camera, lights, the TF
 //! file in effect, the denoiser shown), every distinct TF as `DIR/tf/NNN.toml`, and
-//! `DIR/session.toml`, a scene whose animation replays the camera and lights frame by
-//! frame (step keyframes at each change, so values are exact), which
+//! `DIR/session.toml`, a scene whose animation replays the camera, lights, cut, a
+//! series' time point and the labels' looks frame by frame (step keyframes at each
+//! change, so values are exact), which
 //! `dvr capture --scene DIR/session.toml --size WxH` renders again.
 //!
 //! What a scene file cannot animate is replayed approximately and said so in the
 //! scene's comment: TF edits become one blend from the first TF to the last, spread
 //! over the frames between the first and the last edit (exact for a single edit); light
 //! kinds and counts are locked while recording; area-light sizes and gradient
-//! environment colours keep their first-frame values; render settings are the last ones.
+//! environment colours keep their first-frame values; render settings are the last ones;
+//! channel edits are not recorded.
 
 use anyhow::{Context, Result};
 use dvr_engine::files::{write_atomic, Durability::Renamed};
 use dvr_engine::scene::{
-    self, BuiltinVolume, CameraKey, CameraSpec, ClipKey, CropKey, Cut, Interpolation, Light,
-    LightKey, Scene, TfKey, TransferSpec, VolumeSource,
+    self, BuiltinVolume, CameraKey, CameraSpec, ClipKey, CropKey, Cut, Interpolation, LabelKey,
+    LabelView, Light, LightKey, Scene, TfKey, TimeKey, TransferSpec, View, VolumeSource,
 };
 use dvr_engine::transfer::TransferFunction;
 use std::io::Write;
@@ -31,6 +33,10 @@ pub struct FrameState {
     pub cut: Cut,
     /// Index into the recorder's distinct TFs.
     pub tf: usize,
+    /// A series' time point.
+    pub time: f64,
+    /// The labels' looks (empty without a label map).
+    pub labels: Vec<LabelView>,
 }
 
 pub struct Recorder {
@@ -66,15 +72,10 @@ impl Recorder {
         format!("tf/{i:03}.toml")
     }
 
-    /// Records the state of the next frame.
-    pub fn push(
-        &mut self,
-        camera: CameraSpec,
-        lights: &[Light],
-        cut: &Cut,
-        tf: &TransferFunction,
-        denoiser: &str,
-    ) -> Result<()> {
+    /// Records the state of the next frame: `view` (the TF in effect is its `tf.a`) with
+    /// `denoiser` shown.
+    pub fn push(&mut self, view: &View, denoiser: &str) -> Result<()> {
+        let (camera, lights, cut, tf) = (view.camera, &view.lights, &view.cut, &view.tf.a);
         if self.tfs.last() != Some(tf) {
             let path = self.dir.join(Self::tf_name(self.tfs.len()));
             write_atomic(&path, tf.to_toml().as_bytes(), Renamed)
@@ -115,6 +116,13 @@ impl Recorder {
             })),
             "tf": Self::tf_name(tf_index),
             "denoiser": denoiser,
+            "time": view.time,
+            "labels": view.labels.iter().map(|l| serde_json::json!({
+                "value": l.value,
+                "colour": l.colour,
+                "opacity": l.opacity,
+                "visible": l.visible,
+            })).collect::<Vec<_>>(),
         });
         writeln!(self.log, "{line}").context("writing state.jsonl")?;
         self.frames.push(FrameState {
@@ -122,6 +130,8 @@ impl Recorder {
             lights: lights.to_vec(),
             cut: cut.clone(),
             tf: tf_index,
+            time: view.time,
+            labels: view.labels.clone(),
         });
         Ok(())
     }
@@ -139,9 +149,9 @@ impl Recorder {
         let scene = session_scene(base, &self.frames, &self.tfs, Self::tf_name, volume_size)?;
         let path = self.dir.join("session.toml");
         let text = scene.to_toml().context("writing the session scene")?;
-        let note = "# Recorded by `dvr explore --record`: camera and light keyframes replay the \
-                    session exactly;\n# TF edits are one blend from the first TF to the last \
-                    (see src/explore/record.rs).\n";
+        let note = "# Recorded by `dvr explore --record`: camera, light, cut, time and label \
+                    keyframes replay the\n# session exactly; TF edits are one blend from the \
+                    first TF to the last (see src/explore/record.rs).\n";
         write_atomic(&path, format!("{note}{text}").as_bytes(), Renamed)
             .with_context(|| format!("writing {}", path.display()))?;
         Ok(Some(path))
@@ -225,6 +235,24 @@ pub fn session_scene(
             interpolation: step,
         });
     }
+    if frames.iter().any(|f| f.time != 0.0) {
+        animation.time.push(TimeKey {
+            frame: 0,
+            time: first.time,
+            interpolation: step,
+        });
+    }
+    let label_key = |frame: u32, l: &LabelView| LabelKey {
+        value: l.value,
+        frame,
+        visible: Some(l.visible),
+        opacity: Some(f64::from(l.opacity)),
+        colour: Some(glam::Vec3::from(l.colour).as_dvec3()),
+        interpolation: step,
+    };
+    animation
+        .label
+        .extend(first.labels.iter().map(|l| label_key(0, l)));
     for (index, l) in first.lights.iter().enumerate() {
         animation.light.push(LightKey {
             index,
@@ -272,6 +300,18 @@ pub fn session_scene(
                     enabled: Some(b.enabled),
                     interpolation: step,
                 });
+            }
+        }
+        if cur.time != prev.time {
+            animation.time.push(TimeKey {
+                frame,
+                time: cur.time,
+                interpolation: step,
+            });
+        }
+        for (a, b) in prev.labels.iter().zip(&cur.labels) {
+            if a != b {
+                animation.label.push(label_key(frame, b));
             }
         }
         if let (Some(b), true) = (cur.cut.crop, prev.cut.crop != cur.cut.crop) {
@@ -361,6 +401,8 @@ mod tests {
                 lights: lights.clone(),
                 cut: cut.clone(),
                 tf: 0,
+                time: 0.0,
+                labels: Vec::new(),
             });
         }
         let s = session_scene(
@@ -397,9 +439,13 @@ mod tests {
         edited.points[1].opacity = 0.05;
         let mut rec = Recorder::new(dir.path()).expect("recorder");
         for f in 0..6 {
-            let tf = if f < 4 { &b.tf_a } else { &edited };
-            rec.push(b.camera, &b.lights, &b.cut, tf, "ours")
-                .expect("push");
+            let mut view = b.view_at(0);
+            view.tf = scene::TfState::single(if f < 4 {
+                b.tf_a.clone()
+            } else {
+                edited.clone()
+            });
+            rec.push(&view, "ours").expect("push");
         }
         let path = rec.finish(&b, 64).expect("finish").expect("a scene");
         let loaded = Scene::load(&path).expect("session.toml loads");
@@ -414,5 +460,43 @@ mod tests {
             serde_json::from_str(lines.lines().last().expect("a line")).expect("json");
         assert_eq!(last["tf"], "tf/001.toml");
         assert_eq!(last["denoiser"], "ours");
+    }
+
+    #[test]
+    fn label_and_time_edits_replay_exactly_at_every_frame() {
+        let text = "[volume]\nbuiltin = \"phantom\"\nsize = 16\n[transfer]\na = \"ct-bone\"\n\
+                    [labels]\nbuiltin = \"phantom\"\n[[light]]\nkind = \"environment\"\nintensity = 1.0\n";
+        let mut b = Scene::from_toml_str(text, "labels.toml").expect("scene");
+        b.label_views = (1..=3)
+            .map(|value| LabelView {
+                value,
+                name: format!("label {value}"),
+                colour: [0.5, 0.5, 0.5],
+                opacity: 1.0,
+                visible: true,
+            })
+            .collect();
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut rec = Recorder::new(dir.path()).expect("recorder");
+        let mut want = Vec::new();
+        for f in 0..8 {
+            let mut view = b.view_at(0);
+            if f >= 3 {
+                view.labels[1].visible = false;
+            }
+            if f >= 5 {
+                view.labels[2].colour = [1.0, 0.0, 0.0];
+                view.labels[0].opacity = 0.25;
+            }
+            // A series' time point scrubbed and held.
+            view.time = [0.0, 0.0, 1.5, 1.5, 1.5, 3.25, 3.25, 0.5][f];
+            rec.push(&view, "ours").expect("push");
+            want.push((view.labels, view.time));
+        }
+        let s = session_scene(&b, &rec.frames, &rec.tfs, Recorder::tf_name, 16).expect("scene");
+        for (f, (labels, time)) in want.iter().enumerate() {
+            assert_eq!(&s.labels_at(f as u32), labels, "labels at frame {f}");
+            assert_eq!(s.time_at(f as u32), *time, "time at frame {f}");
+        }
     }
 }
