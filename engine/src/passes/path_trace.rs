@@ -8,7 +8,8 @@ use crate::gpu_block;
 use crate::graph::{Extent, Frame, History, ImageHandle, RenderGraph};
 use crate::scene::{Estimator, LabelMode, Phase, PipelineKey};
 use crate::shaders::frame::{
-    ESTIMATOR_DELTA, ESTIMATOR_RAY_MARCH, PHASE_HG, PHASE_HYBRID, PHASE_ISOTROPIC,
+    ESTIMATOR_DELTA, ESTIMATOR_RAY_MARCH, LABELS_NONE, LABELS_SOLID, LABELS_TINT, PHASE_HG,
+    PHASE_HYBRID, PHASE_ISOTROPIC,
 };
 use ash::vk;
 
@@ -68,11 +69,10 @@ impl PathTraceFeatures {
 
 /// The specialisation of a pipeline that reads the volume (include/volume.glsl).
 pub fn volume_specialization(volume: VolumeLayout) -> [(&'static str, SpecValue); 3] {
-    // LABELS_* in include/specialization.glsl.
     let labels = match volume.labels {
-        None => 0,
-        Some(LabelMode::Tint) => 1,
-        Some(LabelMode::Solid) => 2,
+        None => LABELS_NONE,
+        Some(LabelMode::Tint) => LABELS_TINT,
+        Some(LabelMode::Solid) => LABELS_SOLID,
     };
     [
         ("POOLED_VOLUME", SpecValue::Bool(volume.pooled)),

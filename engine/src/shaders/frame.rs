@@ -44,6 +44,10 @@ glsl_defines! {
         PHASE_ISOTROPIC: i32 = 0,
         PHASE_HG: i32 = 1,
         PHASE_HYBRID: i32 = 2,
+        /// Values of the `LABELS` specialisation constant.
+        LABELS_NONE: i32 = 0,
+        LABELS_TINT: i32 = 1,
+        LABELS_SOLID: i32 = 2,
     }
 }
 
