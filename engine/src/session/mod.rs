@@ -8,7 +8,7 @@
 //! file's field is checked (an edit that fails leaves the state as it was), keeps the
 //! current [`View`] (camera, lights, TF state), the render settings and the denoisers,
 //! and [`Session::frame`] makes the next frame's inputs from them through the one path
-//! scripted frames take too ([`inputs_for_view`]). The renderer derives the change flags
+//! scripted frames take too ([`SceneSetup::inputs`]). The renderer derives the change flags
 //! and motion from consecutive inputs, so an edit is reprojected by the temporal
 //! denoisers like a scripted change, never restarted, unless [`Edit::Restart`] says so.
 //!
