@@ -171,6 +171,18 @@ fn explore_shot(x: &Xvfb, dir: &Path, name: &str, extra: &[&str]) -> Shot {
 }
 
 fn explore_scene_shot(x: &Xvfb, dir: &Path, name: &str, scene: &str, extra: &[&str]) -> Shot {
+    explore_run(x, dir, name, scene, "30", extra).0
+}
+
+/// `dvr explore` of `scene` for `frames` frames, its screenshot `name` and its stdout.
+fn explore_run(
+    x: &Xvfb,
+    dir: &Path,
+    name: &str,
+    scene: &str,
+    frames: &str,
+    extra: &[&str],
+) -> (Shot, String) {
     let shot = dir.join(name);
     let size = format!("{SIZE}x{SIZE}");
     let mut args = vec![
@@ -180,19 +192,19 @@ fn explore_scene_shot(x: &Xvfb, dir: &Path, name: &str, scene: &str, extra: &[&s
         "--size",
         &size,
         "--frames",
-        "30",
+        frames,
         "--screenshot",
         shot.to_str().expect("utf-8 path"),
     ];
     args.extend_from_slice(extra);
     let out = dvr(Some(&x.display), &args, dir);
     assert_clean(&out);
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(
         stdout.contains("ms/frame"),
         "no frame-rate summary:\n{stdout}"
     );
-    Shot::open(&shot)
+    (Shot::open(&shot), stdout)
 }
 
 #[test]
@@ -548,28 +560,12 @@ fn labels_hide_and_take_a_colour_and_a_click_picks_the_label_under_it() {
         "/assets/scenes/development/phantom-labels-skull-orbit.toml"
     );
     let run = |name: &str, script: &str| {
-        let shot = dir.path().join(name);
-        let size = format!("{SIZE}x{SIZE}");
-        let mut args = vec![
-            "explore",
-            "--scene",
-            scene,
-            "--size",
-            &size,
-            "--frames",
-            "20",
-            "--screenshot",
-            shot.to_str().expect("utf-8 path"),
-        ];
-        if !script.is_empty() {
-            args.extend(["--script", script]);
-        }
-        let out = dvr(Some(&x.display), &args, dir.path());
-        assert_clean(&out);
-        (
-            Shot::open(&shot),
-            String::from_utf8_lossy(&out.stdout).into_owned(),
-        )
+        let extra: Vec<&str> = if script.is_empty() {
+            vec![]
+        } else {
+            vec!["--script", script]
+        };
+        explore_run(&x, dir.path(), name, scene, "20", &extra)
     };
     let (all, _) = run("all.png", "");
     // The scalp and skull hidden, the vessels green, then a click at the view's centre.

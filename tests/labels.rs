@@ -469,3 +469,44 @@ fn bad_label_sections_and_maps_are_errors_naming_them() {
         "{e}"
     );
 }
+
+/// A label map whose file runs along −x (its affine flips the axis) lands on the volume's
+/// grid the right way round: what lies on the patient's left in the file lies there on
+/// the volume's grid.
+#[test]
+fn a_flipped_label_map_is_placed_by_its_affine() {
+    use dvr_engine::scene::Scene;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let nrrd = |name: &str, directions: &str, origin: &str, bytes: Vec<u8>| {
+        let path = dir.path().join(name);
+        let mut b = format!(
+            "NRRD0004\ntype: uint8\ndimension: 3\nspace: right-anterior-superior\nsizes: 8 8 8\n\
+             space directions: {directions}\nspace origin: {origin}\nencoding: raw\n\n"
+        )
+        .into_bytes();
+        b.extend(bytes);
+        std::fs::write(&path, b).expect("write");
+        path
+    };
+    let volume = nrrd("vol.nrrd", "(1,0,0) (0,1,0) (0,0,1)", "(0,0,0)", vec![100; 512]);
+    // Label 1 in the file's first four x indices, which its flipped x axis puts at
+    // patient x 7..4: the volume's x indices 4..7.
+    let seg: Vec<u8> = (0..512).map(|i| u8::from(i % 8 < 4)).collect();
+    let labels = nrrd("seg.nrrd", "(-1,0,0) (0,1,0) (0,0,1)", "(7,0,0)", seg);
+    let text = format!(
+        "[volume]\nfile = {:?}\n[transfer]\na = \"ct-bone\"\n[labels]\nfile = {:?}\n\
+         [[light]]\nkind = \"environment\"\nintensity = 1.0\n",
+        volume.display().to_string(),
+        labels.display().to_string()
+    );
+    let scene = Scene::from_toml_str(&text, "flip.toml").expect("scene");
+    let size = dvr_engine::graph::Extent {
+        width: 8,
+        height: 8,
+    };
+    let setup = SceneSetup::new(scene, size, Some(1), 8).expect("setup");
+    let map = &setup.labels.as_ref().expect("labels").map;
+    for x in 0..8 {
+        assert_eq!(map.at(x, 3, 3), u16::from(x >= 4), "volume x index {x}");
+    }
+}
