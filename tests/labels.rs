@@ -488,7 +488,12 @@ fn a_flipped_label_map_is_placed_by_its_affine() {
         std::fs::write(&path, b).expect("write");
         path
     };
-    let volume = nrrd("vol.nrrd", "(1,0,0) (0,1,0) (0,0,1)", "(0,0,0)", vec![100; 512]);
+    let volume = nrrd(
+        "vol.nrrd",
+        "(1,0,0) (0,1,0) (0,0,1)",
+        "(0,0,0)",
+        vec![100; 512],
+    );
     // Label 1 in the file's first four x indices, which its flipped x axis puts at
     // patient x 7..4: the volume's x indices 4..7.
     let seg: Vec<u8> = (0..512).map(|i| u8::from(i % 8 < 4)).collect();
