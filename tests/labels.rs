@@ -515,3 +515,44 @@ fn a_flipped_label_map_is_placed_by_its_affine() {
         assert_eq!(map.at(x, 3, 3), u16::from(x >= 4), "volume x index {x}");
     }
 }
+
+/// A colour or opacity edit keeps the filtered shape (only visibility changes it): the
+/// look made from the last one's shape equals one made from scratch.
+#[test]
+fn an_opacity_edit_reuses_the_shape_and_looks_as_one_made_afresh() {
+    let setup = {
+        let scene = dvr_engine::scene::Scene::from_toml_str(
+            "[volume]\nbuiltin = \"phantom\"\nsize = 24\n[transfer]\na = \"ct-bone\"\n[labels]\n\
+             builtin = \"phantom\"\n[[light]]\nkind = \"environment\"\nintensity = 1.0\n",
+            "reuse.toml",
+        )
+        .expect("scene");
+        let size = dvr_engine::graph::Extent {
+            width: 8,
+            height: 8,
+        };
+        SceneSetup::new(scene, size, Some(1), 24).expect("setup")
+    };
+    let labels = setup.labels.clone().expect("labels");
+    let mut views = setup.scene.label_views.clone();
+    let first = labels.look(&views);
+    views[2].opacity = 0.3;
+    views[4].colour = [0.0, 1.0, 0.0];
+    let edited = labels.look(&views);
+    assert!(
+        Arc::ptr_eq(&first.shape, &edited.shape),
+        "the shape is kept"
+    );
+    let mode = labels.mode;
+    let v = views.clone();
+    let afresh = LabelLook::new(
+        &labels.map,
+        |value| dvr_engine::scene::labels::look_of(&v, mode, value),
+        setup.volume.bricks.brick,
+        setup.volume.bricks.grid,
+    );
+    assert_eq!(*edited, afresh);
+    views[1].visible = false;
+    let hidden = labels.look(&views);
+    assert!(!Arc::ptr_eq(&edited.shape, &hidden.shape) && edited.shape != hidden.shape);
+}

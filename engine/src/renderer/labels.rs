@@ -198,12 +198,20 @@ impl SceneLabels {
             }
         }
         let mode = self.mode;
-        let look = Arc::new(LabelLook::new(
-            &self.map,
-            |value| look_of(views, mode, value),
-            self.brick,
-            self.grid,
-        ));
+        let of = |value| look_of(views, mode, value);
+        // The shape follows visibility alone: a colour or opacity edit keeps it.
+        let same_shown = cache.as_ref().is_some_and(|(v, _)| {
+            v.len() == views.len()
+                && v.iter()
+                    .zip(views)
+                    .all(|(a, b)| (a.value, a.visible) == (b.value, b.visible))
+        });
+        let look = Arc::new(match cache.as_ref() {
+            Some((_, last)) if same_shown => {
+                LabelLook::with_shape(&self.map, of, self.brick, self.grid, last.shape.clone())
+            }
+            _ => LabelLook::new(&self.map, of, self.brick, self.grid),
+        });
         *cache = Some((views.to_vec(), look.clone()));
         look
     }

@@ -61,16 +61,22 @@ impl Renderer {
                         &bytes,
                     )?;
                 }
+                // The shape on the device stays where the edit kept it (see
+                // `SceneLabels::look`).
+                let same_shape = self
+                    .current_labels
+                    .as_ref()
+                    .is_some_and(|c| std::sync::Arc::ptr_eq(&c.0.shape, &look.0.shape));
                 let (ctx, graph) = (&self.ctx, &mut self.graph);
                 let rgba = bytemuck::cast_slice(&look.0.rgba);
-                for (name, image, bytes) in [
-                    ("upload_labels", self.scene.labels, rgba),
-                    (
-                        "upload_label_shape",
-                        self.scene.label_shape,
-                        &look.0.shape[..],
-                    ),
-                ] {
+                let shape = (!same_shape).then_some((
+                    "upload_label_shape",
+                    self.scene.label_shape,
+                    &look.0.shape[..],
+                ));
+                for (name, image, bytes) in
+                    std::iter::once(("upload_labels", self.scene.labels, rgba)).chain(shape)
+                {
                     scene_gpu::add_frame_upload(ctx, graph, frame, name, slot, image, bytes)?;
                 }
             }

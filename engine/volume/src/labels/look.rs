@@ -15,6 +15,7 @@
 
 use super::LabelMap;
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// Standard deviation of the shape's filter, in voxels: enough for normals within 10°
 /// on a voxelised sphere of radius 20 (the labels test).
@@ -37,8 +38,9 @@ pub struct LabelLook {
     pub dims: [u32; 3],
     /// RGBA8 per voxel, x fastest: the label's tint and mask (opacity where shown).
     pub rgba: Vec<[u8; 4]>,
-    /// R8 per voxel: the shown labels' indicator, filtered.
-    pub shape: Vec<u8>,
+    /// R8 per voxel: the shown labels' indicator, filtered (shared by the looks that
+    /// show the same labels: only visibility changes it).
+    pub shape: Arc<Vec<u8>>,
     pub brick: u32,
     pub grid: [u32; 3],
     pub brick_max: Vec<f32>,
@@ -97,26 +99,31 @@ impl LabelLook {
         grid: [u32; 3],
         sigma: f32,
     ) -> Self {
+        let shape = Arc::new(shape(map, &look, sigma));
+        Self::with_shape(map, look, brick, grid, shape)
+    }
+
+    /// [`LabelLook::new`] that takes `shape` as it is: the shape of a look that shows the
+    /// same labels (a colour or opacity edit leaves it, and filtering is most of the
+    /// work).
+    pub fn with_shape(
+        map: &LabelMap,
+        look: impl Fn(u16) -> Look,
+        brick: u32,
+        grid: [u32; 3],
+        shape: Arc<Vec<u8>>,
+    ) -> Self {
         let mut table = vec![None; super::MAX_LABEL as usize + 1];
-        let mut look_at = |v: u16| *table[usize::from(v)].get_or_insert_with(|| look(v));
-        let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
-        let mut rgba = Vec::with_capacity(map.values.len());
-        let mut field = Vec::with_capacity(map.values.len());
-        for &v in &map.values {
-            let l = look_at(v);
-            let [r, g, b] = l.colour;
-            let mask = if l.visible { l.opacity } else { 0.0 };
-            rgba.push([unorm(r), unorm(g), unorm(b), unorm(mask)]);
-            field.push(if l.visible { 1.0f32 } else { 0.0 });
-        }
-        let dims = map.dims.map(|d| d as usize);
-        let uniform = field.windows(2).all(|w| w[0] == w[1]);
-        if !uniform && sigma > 0.0 {
-            for axis in 0..3 {
-                field = filter_axis(&field, dims, axis, sigma);
-            }
-        }
-        let shape: Vec<u8> = field.iter().map(|&x| unorm(x)).collect();
+        let rgba: Vec<[u8; 4]> = map
+            .values
+            .iter()
+            .map(|&v| {
+                let l: Look = *table[usize::from(v)].get_or_insert_with(|| look(v));
+                let [r, g, b] = l.colour;
+                let mask = if l.visible { l.opacity } else { 0.0 };
+                [unorm(r), unorm(g), unorm(b), unorm(mask)]
+            })
+            .collect();
         let brick_max = brick_maxima(&rgba, map.dims, brick, grid);
         Self {
             dims: map.dims,
@@ -127,6 +134,31 @@ impl LabelLook {
             brick_max,
         }
     }
+}
+
+fn unorm(x: f32) -> u8 {
+    (x.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// The shown labels' indicator filtered by a Gaussian of `sigma` voxels, R8.
+fn shape(map: &LabelMap, look: impl Fn(u16) -> Look, sigma: f32) -> Vec<u8> {
+    let mut table = vec![None; super::MAX_LABEL as usize + 1];
+    let mut field: Vec<f32> = map
+        .values
+        .iter()
+        .map(|&v| {
+            let shown = *table[usize::from(v)].get_or_insert_with(|| look(v).visible);
+            f32::from(u8::from(shown))
+        })
+        .collect();
+    let dims = map.dims.map(|d| d as usize);
+    let uniform = field.windows(2).all(|w| w[0] == w[1]);
+    if !uniform && sigma > 0.0 {
+        for axis in 0..3 {
+            field = filter_axis(&field, dims, axis, sigma);
+        }
+    }
+    field.iter().map(|&x| unorm(x)).collect()
 }
 
 /// The largest mask over each brick widened by one voxel (a trilinear read inside the
