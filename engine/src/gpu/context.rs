@@ -12,6 +12,18 @@ use std::sync::Mutex;
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
+/// Held while a context is created or destroyed. Loading and unloading the layers and
+/// the driver (lavapipe's LLVM set-up among them) from several threads at once is not
+/// safe on every stack: a test binary whose tests each make a context crashed in it.
+/// Rendering itself runs in parallel; only these few milliseconds are serial.
+static LIFECYCLE: Mutex<()> = Mutex::new(());
+
+fn lifecycle() -> std::sync::MutexGuard<'static, ()> {
+    LIFECYCLE
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
 /// What the rest of the engine needs to know about the chosen device.
 #[derive(Clone, Debug)]
 pub struct DeviceInfo {
@@ -108,6 +120,7 @@ fn device_rank(t: vk::PhysicalDeviceType) -> u32 {
 
 impl GpuContext {
     pub fn new(options: ContextOptions) -> Result<Self> {
+        let _serial = lifecycle();
         // SAFETY: loading the Vulkan loader library; failure is reported, not unwrapped.
         let entry =
             unsafe { ash::Entry::load() }.map_err(|e| EngineError::NoLoader(e.to_string()))?;
@@ -315,6 +328,7 @@ impl Drop for GpuContext {
     fn drop(&mut self) {
         unsafe {
             let _ = self.device.device_wait_idle();
+            let _serial = lifecycle();
             let pipelines = std::mem::take(&mut self.pipelines);
             pipelines.destroy(self);
             self.device.destroy_command_pool(self.one_shot_pool, None);
