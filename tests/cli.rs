@@ -806,7 +806,10 @@ fn info_lists_a_label_maps_labels_named_by_its_table() {
     let info: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     let labels = info["labels"].as_array().expect("labels");
     let names: Vec<&str> = labels.iter().filter_map(|l| l["name"].as_str()).collect();
-    assert_eq!(names, vec!["White matter", "Grey matter"]);
+    assert_eq!(
+        names,
+        vec!["White matter", "Grey matter", "Rest of the brain"]
+    );
     assert_eq!(labels[0]["colour"], "F5F0E1");
     assert!(labels.iter().all(|l| l["voxels"].as_u64() > Some(100_000)));
     // Without a table, palette colours and numbered names.

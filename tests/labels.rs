@@ -72,6 +72,68 @@ fn hidden_slab_transmittance(estimator: Estimator) -> f64 {
     mean_rgb(&img)[0]
 }
 
+/// A ball of density 1 (radius 10 voxels of 32) in empty space, its voxels one hidden
+/// label, the empty space unlabelled and shown: with the empty voxels taking their
+/// tissue neighbours' mask nothing is left to see, every camera ray reaches the
+/// environment; without, the product of the density's and the mask's ramps leaves a
+/// skin at the ball's outline. Returns (the darkest pixel, its count below 1).
+fn hidden_ball(fit_to_medium: bool) -> (f32, usize) {
+    let n = 32u32;
+    let inside = |x: u32, y: u32, z: u32| {
+        let c = |i: u32| i as f32 + 0.5 - n as f32 / 2.0;
+        c(x).powi(2) + c(y).powi(2) + c(z).powi(2) <= 100.0
+    };
+    let mut volume = constant_volume(n, 1.0);
+    let ball = map([n; 3], |x, y, z| u16::from(inside(x, y, z)));
+    volume.bytes = ball
+        .values
+        .iter()
+        .map(|&v| if v == 1 { 255 } else { 0 })
+        .collect();
+    volume.bricks.min = vec![0.0];
+    let mut s = settings(32, 1);
+    s.config.density_scale = 40.0;
+    s.config.labels = Some(LabelMode::Tint);
+    s.settings.set_filter_sigma(0.0).expect("pinhole");
+    let of = |v: u16| if v == 1 { HIDDEN } else { SHOWN };
+    let zero = volume.zero_voxels().expect("dense");
+    let shape = LabelLook::shape_of(&ball, of);
+    let empty = fit_to_medium.then_some(zero.as_slice());
+    let labels = LabelLookRef(Arc::new(LabelLook::with_shape(
+        &ball, of, n, [1; 3], shape, empty,
+    )));
+    let mut r = renderer(context(), s, &volume, &["none"]);
+    let i = dvr_engine::renderer::FrameInputs {
+        labels: Some(labels),
+        ..inputs(
+            front_camera(3.0, 25.0),
+            vec![environment(1.0)],
+            constant_lut(1.0, 0.0),
+        )
+    };
+    let img = r.reference(&i, 64, 64).expect("reference render");
+    let darkest = img.iter().map(|p| p[0]).fold(f32::INFINITY, f32::min);
+    (darkest, img.iter().filter(|p| p[0] < 1.0).count())
+}
+
+#[test]
+fn hiding_every_tissue_label_leaves_no_skin_where_tissue_meets_empty_space() {
+    let (darkest, dimmed) = hidden_ball(true);
+    assert_eq!(
+        (darkest, dimmed),
+        (1.0, 0),
+        "the hidden ball left medium in front of the environment"
+    );
+    // The same look without fitting the empty voxels' masks does leave a skin: the test
+    // sees the difference it is named for.
+    let (darkest, dimmed) = hidden_ball(false);
+    assert!(
+        darkest < 0.99 && dimmed > 20,
+        "no skin without the fit: darkest {darkest}, {dimmed} pixels below 1"
+    );
+    assert_validation_clean();
+}
+
 #[test]
 fn a_hidden_label_is_empty_medium_to_delta_tracking_and_ray_marching() {
     let expected = (-1.5f64 * 0.75).exp();
@@ -122,8 +184,30 @@ fn a_map_of_one_visible_label_with_a_unit_tint_renders_the_frames_of_no_map() {
         let m = map(v.dims, |_, _, _| 7);
         Some(look(&m, v.bricks.brick, v.bricks.grid, |_| SHOWN))
     });
+    // The same with the empty voxels' masks fitted to their neighbours' (as a scene's
+    // look under a TF transparent at 0 is): the air next to tissue keeps the mask 1.
+    let fitted = phantom_frames(Some(LabelMode::Tint), |s| {
+        let v = &s.volume;
+        let m = map(v.dims, |_, _, _| 7);
+        let zero = v.zero_voxels().expect("dense");
+        let shape = LabelLook::shape_of(&m, |_| SHOWN);
+        let l = LabelLook::with_shape(
+            &m,
+            |_| SHOWN,
+            v.bricks.brick,
+            v.bricks.grid,
+            shape,
+            Some(&zero),
+        );
+        Some(LabelLookRef(Arc::new(l)))
+    });
     assert_eq!(none.len(), 3);
-    for (f, (a, b)) in none.iter().zip(&one).enumerate() {
+    for (f, (a, b)) in none
+        .iter()
+        .zip(&one)
+        .chain(none.iter().zip(&fitted))
+        .enumerate()
+    {
         for ((name, x), (_, y)) in a.iter().zip(b) {
             let same = x
                 .iter()
@@ -535,24 +619,31 @@ fn an_opacity_edit_reuses_the_shape_and_looks_as_one_made_afresh() {
     };
     let labels = setup.labels.clone().expect("labels");
     let mut views = setup.scene.label_views.clone();
-    let first = labels.look(&views);
+    let lut = setup.scene.tf_a.lut();
+    let first = labels.look(&views, &lut);
     views[2].opacity = 0.3;
     views[4].colour = [0.0, 1.0, 0.0];
-    let edited = labels.look(&views);
+    let edited = labels.look(&views, &lut);
     assert!(
         Arc::ptr_eq(&first.shape, &edited.shape),
         "the shape is kept"
     );
     let mode = labels.mode;
     let v = views.clone();
-    let afresh = LabelLook::new(
+    let of = |value| dvr_engine::scene::labels::look_of(&v, mode, value);
+    // ct-bone is transparent at 0, so the phantom's empty voxels are fitted.
+    assert!(lut.transparent_at_zero(1));
+    let zero = setup.volume.zero_voxels().expect("dense");
+    let afresh = LabelLook::with_shape(
         &labels.map,
-        |value| dvr_engine::scene::labels::look_of(&v, mode, value),
+        of,
         setup.volume.bricks.brick,
         setup.volume.bricks.grid,
+        LabelLook::shape_of(&labels.map, of),
+        Some(&zero),
     );
     assert_eq!(*edited, afresh);
     views[1].visible = false;
-    let hidden = labels.look(&views);
+    let hidden = labels.look(&views, &lut);
     assert!(!Arc::ptr_eq(&edited.shape, &hidden.shape) && edited.shape != hidden.shape);
 }

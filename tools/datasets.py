@@ -9,8 +9,8 @@ nilearn wheel, byte for byte. `microscopy` is a synthetic 3-channel fluorescence
 (nuclei, membranes, a sparse marker) with photon noise, as OME-Zarr and OME-TIFF.
 `beating-shell` is a 4D NIfTI of a heart-like shell beating once over 24 time points,
 with vessels on its wall that move with it. `mni-labels` segments the MNI152 template
-into white and grey matter from its own tissue probability maps (in nilearn's wheel), as
-a NIfTI label map with an ITK-SNAP label file.
+into white matter, grey matter and the rest of the brain from its own tissue probability
+maps (in nilearn's wheel), as a NIfTI label map with an ITK-SNAP label file.
 
 Everything is made from fixed seeds and closed-form shapes, so a run writes the same
 voxels as the files committed under `assets/volumes/` (the tests regenerate and compare).
@@ -250,21 +250,30 @@ def beating_shell_frame(t: int) -> np.ndarray:
     return density
 
 
-# The MNI152 segmentation: (value, name, ITK-SNAP RGB) of each label, made from the
-# template's own tissue probability maps in nilearn's wheel.
-TISSUES = [(1, "White matter", (245, 240, 225)), (2, "Grey matter", (205, 110, 95))]
+# The MNI152 segmentation: (value, name, ITK-SNAP RGB, visible) of each label, made from
+# the template's own tissue probability maps in nilearn's wheel. The rest of the brain
+# (CSF, ventricles, partial volumes: the masked T1's other voxels) is a label of its own,
+# hidden by default, so a view can hide every tissue and a view of the white and grey
+# matter is what it was.
+TISSUES = [
+    (1, "White matter", (245, 240, 225), 1),
+    (2, "Grey matter", (205, 110, 95), 1),
+    (3, "Rest of the brain", (120, 160, 210), 0),
+]
 
 
 def write_mni_labels(out: pathlib.Path) -> list:
     """White matter where its probability passes one half, grey matter where its does
-    (and white matter's does not), on the T1's grid; with an ITK-SNAP label file."""
+    (and white matter's does not), the rest of the brain where the brain-masked T1 is
+    not zero; on the T1's grid, with an ITK-SNAP label file."""
     import nibabel as nib
 
     base = statmap_source().parent
-    prob = {n: nib.load(base / f"mni_icbm152_{n}_tal_nlin_sym_09a_converted.nii.gz") for n in ("wm", "gm")}
+    prob = {n: nib.load(base / f"mni_icbm152_{n}_tal_nlin_sym_09a_converted.nii.gz") for n in ("wm", "gm", "t1")}
     wm = prob["wm"].get_fdata() > 127.5
     gm = (prob["gm"].get_fdata() > 127.5) & ~wm
-    labels = np.where(wm, 1, np.where(gm, 2, 0)).astype(np.uint8)
+    rest = (prob["t1"].get_fdata() > 0) & ~wm & ~gm
+    labels = np.select([wm, gm, rest], [1, 2, 3], 0).astype(np.uint8)
     img = nib.Nifti1Image(labels, prob["wm"].affine)
     img.header.set_xyzt_units("mm")
     img.header.set_qform(prob["wm"].affine, code=1)
@@ -279,7 +288,7 @@ def write_mni_labels(out: pathlib.Path) -> list:
         "################################################",
         '    0     0    0    0        0  0  0    "Clear Label"',
     ]
-    lines += [f'{v:5d} {r:5d}{g:5d}{b:5d}        1  1  1    "{name}"' for v, name, (r, g, b) in TISSUES]
+    lines += [f'{v:5d} {r:5d}{g:5d}{b:5d}        1  {vis}  1    "{name}"' for v, name, (r, g, b), vis in TISSUES]
     table.write_text("\n".join(lines) + "\n")
     return [path, table]
 

@@ -221,30 +221,42 @@ EOF2
       meta labels "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
     labels-cost)
-      # Two heads under opaque TFs: the phantom, whose labels cover every tissue (label
-      # 0 is air), and the MNI head, whose white and grey matter leave unlabelled rims
-      # (CSF, partial volumes) shown. Each without a label map, with its labels shown
-      # (tint), with an outer label hidden (the phantom's scalp and skull, the MNI
-      # head's grey matter: what lies beneath shows) and with every label hidden,
-      # profiled alternately (two runs each), so the machine's drift falls on all.
+      # Two heads under opaque TFs, each labelled everywhere it has tissue (label 0 is
+      # air): the phantom (scalp, skull, brain, ventricles, vessels) and the MNI head
+      # (white matter, grey matter, the rest of the brain). Each view without a label
+      # map, with every label shown (tint), and with labels hidden from the outside in
+      # (what lies beneath shows) until every one is; profiled alternately (two runs
+      # each), so the machine's drift falls on all. A view is `key|hidden values|what`.
       mkdir -p "$out"
       t0=$(date +%s.%N)
+      views_phantom=("outer|1 2|scalp and skull hidden" "all|1 2 3 4 5|every label hidden")
+      views_mri=("rest|3|rest of the brain hidden" "outer|2 3|grey matter and the rest hidden"
+        "all|1 2 3|every label hidden")
+      : > "$out/views.tsv"
       for scene in phantom/orbit mri/point-light; do
         name=${scene%%/*}
         "$dvr" scenes --dump "$scene" > "$out/$name-none.toml"
+        # Shown: every label of the built-in table visible, whatever its default.
         { cat "$out/$name-none.toml"; printf '\n[labels]\nbuiltin = "%s"\n' "$name"; } > "$out/$name-shown.toml"
-        case $name in
-          phantom) outer='1 2'; all='1 2 3 4 5' ;;
-          mri) outer='2'; all='1 2' ;;
-        esac
-        for set_ in outer all; do
-          cp "$out/$name-shown.toml" "$out/$name-$set_.toml"
-          for v in ${!set_}; do printf '\n[[label]]\nvalue = %s\nvisible = false\n' "$v" >> "$out/$name-$set_.toml"; done
+        [ "$name" = mri ] && printf '\n[[label]]\nvalue = 3\nvisible = true\n' >> "$out/$name-shown.toml"
+        printf '%s\tnone\tno label map\n%s\tshown\tevery label shown (tint)\n' "$scene" "$scene" >> "$out/views.tsv"
+        views="views_$name[@]"
+        keys=(none shown)
+        for view in "${!views}"; do
+          IFS='|' read -r key hidden what <<< "$view"
+          keys+=("$key")
+          { cat "$out/$name-none.toml"; printf '\n[labels]\nbuiltin = "%s"\n' "$name"; } > "$out/$name-$key.toml"
+          for v in 1 2 3 4 5; do
+            case " $hidden " in *" $v "*) shown=false ;; *) shown=true ;; esac
+            [ "$name" = mri ] && [ "$v" -gt 3 ] && continue
+            printf '\n[[label]]\nvalue = %s\nvisible = %s\n' "$v" "$shown" >> "$out/$name-$key.toml"
+          done
+          printf '%s\t%s\t%s\n' "$scene" "$key" "$what" >> "$out/views.tsv"
         done
         for run in 1 2; do
-          for labels in none shown outer all; do
-            "$dvr" profile --scene "$out/$name-$labels.toml" --frames 20 --size 256x256 --denoiser ours \
-              --json "$out/$name-$labels-$run.json" >/dev/null
+          for key in "${keys[@]}"; do
+            "$dvr" profile --scene "$out/$name-$key.toml" --frames 20 --size 256x256 --denoiser ours \
+              --json "$out/$name-$key-$run.json" >/dev/null
           done
         done
       done
@@ -252,19 +264,19 @@ EOF2
       python3 - "$out" <<'EOF2'
 import csv, json, sys
 out = sys.argv[1]
+views = [line.rstrip("\n").split("\t") for line in open(f"{out}/views.tsv")]
 with open("assets/results/labels-cost/profile.csv", "w", newline="") as f:
     w = csv.writer(f)
     w.writerow(["scene", "labels", "run", "path_trace_ms", "frame_ms"])
-    for scene, outer in (("phantom/orbit", "scalp and skull hidden"), ("mri/point-light", "grey matter hidden")):
+    for scene in dict.fromkeys(v[0] for v in views):
         name = scene.split("/")[0]
         for run in (1, 2):
-            for labels, what in (("none", "no label map"), ("shown", "shown (tint)"), ("outer", outer),
-                                 ("all", "every label hidden")):
-                p = json.load(open(f"{out}/{name}-{labels}-{run}.json"))
+            for _, key, what in (v for v in views if v[0] == scene):
+                p = json.load(open(f"{out}/{name}-{key}-{run}.json"))
                 pt = next(x["median_ms"] for x in p["passes"] if x["pass"] == "path_trace")
                 w.writerow([scene, what, run, f"{pt:.3f}", f"{p['total']['median_ms']:.3f}"])
 EOF2
-      meta labels-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit and mri/point-light without a label map, with [labels] builtin = the dataset shown, with an outer label hidden and with every label hidden, alternating, two runs each"
+      meta labels-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit and mri/point-light without a label map, with [labels] builtin = the dataset and every label shown, and with labels hidden from the outside in until every one is, alternating, two runs each"
       ;;
     *)
       echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost labels labels-cost)" >&2

@@ -668,19 +668,26 @@ def b_labels_cost():
     """The path tracer's cost with a label map shown and with a label hidden, against the
     same view without one, run by run."""
     rows = read_csv("labels-cost", "profile.csv")
-    base = {(r["scene"], r["run"]): num(r["path_trace_ms"]) for r in rows
-            if r["labels"] == "no label map"}
+    def by_run(labels):
+        return {(r["scene"], r["run"]): num(r["path_trace_ms"]) for r in rows
+                if r["labels"] == labels}
+
+    base, shown = by_run("no label map"), by_run("every label shown (tint)")
+
+    def ratio(r, to):
+        return f"{num(r['path_trace_ms']) / to[(r['scene'], r['run'])]:.2f}×"
+
     body = [[r["scene"], r["labels"], r["run"], fmt(num(r["path_trace_ms"]), 1),
-             f"{num(r['path_trace_ms']) / base[(r['scene'], r['run'])]:.2f}×",
+             ratio(r, base), ratio(r, shown) if r["labels"] != "no label map" else "",
              fmt(num(r["frame_ms"]), 1)]
             for r in rows]
     return "\n".join([
         "Median GPU ms per frame of the path-tracing pass and of the whole frame at 256×256, "
-        "the same view without a label map, with its labels shown, with an outer label hidden "
-        "and with every label hidden, runs alternating (× is to the same scene's run without "
-        "a label map):",
+        "the same view without a label map, with every label shown, and with labels hidden "
+        "from the outside in until every one is, runs alternating (× is to the same scene's "
+        "run without a label map, or with every label shown):",
         "",
-        table(["scene", "labels", "run", "`path_trace`", "× none", "frame"], body),
+        table(["scene", "labels", "run", "`path_trace`", "× none", "× shown", "frame"], body),
         "",
         source("labels-cost", ["profile.csv"]),
     ])

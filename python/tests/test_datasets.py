@@ -181,8 +181,11 @@ def test_the_mni_labels_lie_on_the_t1_grid_and_follow_the_tissue_maps():
     t1 = nib.load(VOLUMES / "mni152_t1.nii.gz")
     assert labels.shape == t1.shape and np.allclose(labels.affine, t1.affine)
     a = np.asarray(labels.dataobj)
-    assert a.dtype == np.uint8 and set(np.unique(a)) == {0, 1, 2}
+    assert a.dtype == np.uint8 and set(np.unique(a)) == {0, 1, 2, 3}
     # White matter is brighter than grey matter in a T1: the labels agree with the image.
     t = t1.get_fdata()
     assert t[a == 1].mean() > t[a == 2].mean() + 20
     assert 0.05 < (a == 1).mean() < 0.2 and 0.05 < (a == 2).mean() < 0.2
+    # The rest of the brain is the masked T1's other voxels: every voxel of the brain has
+    # a label, and no label lies outside it.
+    assert np.array_equal(a > 0, t > 0) and 0.005 < (a == 3).mean() < 0.05

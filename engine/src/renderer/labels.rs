@@ -1,11 +1,13 @@
 //! A scene's label map on the renderer's side: loaded from `[labels]`, put on the
 //! volume's grid, its labels' views made from the table and the `[[label]]` sections,
 //! and the filtered look ([`LabelLook`]) the renderer uploads, made again only when a
-//! label's look changes. Picking reads the map and the volume under a world point.
+//! label's look changes (or whether the TF leaves a zero voxel empty). Picking reads the
+//! map and the volume under a world point.
 
 use super::uploads::VolumeUpload;
 use crate::scene::labels::{look_of, unlabelled};
 use crate::scene::{LabelMode, LabelView, Scene};
+use crate::transfer::TfLut;
 use crate::volume::labels::{LabelLook, LabelMap, LabelTable};
 use crate::volume::{PatientTransform, VolumeError};
 use glam::Vec3;
@@ -17,8 +19,15 @@ pub struct SceneLabels {
     pub mode: LabelMode,
     brick: u32,
     grid: [u32; 3],
-    cache: Mutex<Option<(Vec<LabelView>, Arc<LabelLook>)>>,
+    /// Tint mode: the voxels whose fields are all 0 (the first time point's, for a
+    /// series), which hold no medium under a TF transparent at 0.
+    zero: Option<Vec<bool>>,
+    channels: usize,
+    cache: Mutex<Option<(LookKey, Arc<LabelLook>)>>,
 }
+
+/// What a look is made from: the labels' views and whether zero voxels are empty.
+type LookKey = (Vec<LabelView>, bool);
 
 impl std::fmt::Debug for SceneLabels {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -132,6 +141,11 @@ pub fn load(
         mode: spec.mode,
         brick: volume.bricks.brick,
         grid: volume.bricks.grid,
+        zero: match spec.mode {
+            LabelMode::Tint => volume.zero_voxels(),
+            LabelMode::Solid => None,
+        },
+        channels: volume.channels() as usize,
         cache: Mutex::new(None),
     };
     Ok(Some((labels, views)))
@@ -189,30 +203,34 @@ fn list(values: &[u16]) -> String {
 }
 
 impl SceneLabels {
-    /// The look of the map under `views` (the last one again when they have not changed).
-    pub fn look(&self, views: &[LabelView]) -> Arc<LabelLook> {
+    /// The look of the map under `views` with the TF's `lut` (the last one again when
+    /// neither the views nor whether the LUT is transparent at 0 have changed).
+    pub fn look(&self, views: &[LabelView], lut: &TfLut) -> Arc<LabelLook> {
+        let zero_is_empty = self.zero.is_some() && lut.transparent_at_zero(self.channels);
         let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((v, look)) = cache.as_ref() {
-            if v == views {
+        if let Some(((v, z), look)) = cache.as_ref() {
+            if v == views && *z == zero_is_empty {
                 return look.clone();
             }
         }
         let mode = self.mode;
         let of = |value| look_of(views, mode, value);
         // The shape follows visibility alone: a colour or opacity edit keeps it.
-        let same_shown = cache.as_ref().is_some_and(|(v, _)| {
+        let same_shown = cache.as_ref().is_some_and(|((v, _), _)| {
             v.len() == views.len()
                 && v.iter()
                     .zip(views)
                     .all(|(a, b)| (a.value, a.visible) == (b.value, b.visible))
         });
-        let look = Arc::new(match cache.as_ref() {
-            Some((_, last)) if same_shown => {
-                LabelLook::with_shape(&self.map, of, self.brick, self.grid, last.shape.clone())
-            }
-            _ => LabelLook::new(&self.map, of, self.brick, self.grid),
-        });
-        *cache = Some((views.to_vec(), look.clone()));
+        let shape = match cache.as_ref() {
+            Some((_, last)) if same_shown => last.shape.clone(),
+            _ => LabelLook::shape_of(&self.map, of),
+        };
+        let empty = self.zero.as_deref().filter(|_| zero_is_empty);
+        let look = Arc::new(LabelLook::with_shape(
+            &self.map, of, self.brick, self.grid, shape, empty,
+        ));
+        *cache = Some(((views.to_vec(), zero_is_empty), look.clone()));
         look
     }
 

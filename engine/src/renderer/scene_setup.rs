@@ -187,7 +187,7 @@ impl SceneSetup {
             labels: self
                 .labels
                 .as_ref()
-                .map(|l| super::LabelLookRef(l.look(&view.labels))),
+                .map(|l| super::LabelLookRef(l.look(&view.labels, lut))),
             ..inputs_for_view(view, aspect, lut)
         }
     }

@@ -126,6 +126,21 @@ impl VolumeUpload {
         Some(lo + d * (hi - lo))
     }
 
+    /// Per voxel, whether every field is 0 there (`None` for a volume made on demand):
+    /// where a TF transparent at 0 puts no medium.
+    pub fn zero_voxels(&self) -> Option<Vec<bool>> {
+        if self.blocks.is_some() {
+            return None;
+        }
+        let texel = self.texel_bytes();
+        Some(
+            self.bytes
+                .chunks_exact(texel)
+                .map(|t| t.iter().all(|&b| b == 0))
+                .collect(),
+        )
+    }
+
     /// Bytes of one texel.
     pub fn texel_bytes(&self) -> usize {
         self.format.bytes() * super::packing::components(self.channels()) as usize

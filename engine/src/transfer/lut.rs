@@ -64,6 +64,16 @@ impl TfLut {
         ]
     }
 
+    /// Whether density 0 is empty medium in every one of `channels` rows laid end to end
+    /// (the first entry of each has opacity 0): then a voxel whose fields are all 0 holds
+    /// nothing, whatever mask a label map gives it.
+    pub fn transparent_at_zero(&self, channels: usize) -> bool {
+        let n = self.len() / channels.max(1);
+        n > 0
+            && (0..channels.max(1))
+                .all(|c| self.diffuse_opacity.get(c * n).is_some_and(|e| e[3] == 0.0))
+    }
+
     /// The largest opacity in the table (what a majorant must bound).
     pub fn max_opacity(&self) -> f32 {
         self.diffuse_opacity

@@ -38,7 +38,7 @@ pub fn mri_volume() -> PathBuf {
     assets_dir().join("volumes/mni152_t1.nii.gz")
 }
 
-/// The segmentation of the MNI152 head (white matter, grey matter) and its ITK-SNAP
+/// The segmentation of the MNI152 head (white matter, grey matter, the rest) and its ITK-SNAP
 /// label file: the `mri` dataset's built-in labels.
 pub fn mri_labels() -> (PathBuf, PathBuf) {
     let dir = assets_dir().join("volumes");

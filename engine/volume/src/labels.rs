@@ -63,8 +63,8 @@ impl LabelMap {
 
     /// A built-in dataset's segmentation on the grid of `dims` voxels placed by
     /// `to_patient` (the dataset's own volume), with its table: `phantom` (scalp, skull,
-    /// brain, ventricles, vessels; made at the volume's size) or `mri` (white and grey
-    /// matter of the MNI152 head, read from the assets).
+    /// brain, ventricles, vessels; made at the volume's size) or `mri` (white matter, grey
+    /// matter and the rest of the brain of the MNI152 head, read from the assets).
     pub fn builtin(
         name: &str,
         dims: [u32; 3],

@@ -12,6 +12,13 @@
 //! facet's (a sphere's normals stray by tens of degrees); filtering the mask itself
 //! would smooth the normals too, but leaves a ghost of a hidden label's outer layer and
 //! erases structures under two voxels across.
+//!
+//! Where the medium is empty (the volume 0 under a TF transparent there), a voxel's mask
+//! matters only through the cells it shares with tissue, so it takes the lowest mask of
+//! its non-empty neighbours (0 when it has none): a hidden label next to air leaves no
+//! skin (the product of two ramps, density falling and mask rising, would), a shown
+//! label's outer half-voxel keeps its own opacity, and the bricks of air around hidden
+//! tissue hold no mask, so the majorant skips them.
 
 use super::LabelMap;
 use rayon::prelude::*;
@@ -100,18 +107,24 @@ impl LabelLook {
         sigma: f32,
     ) -> Self {
         let shape = Arc::new(shape(map, &look, sigma));
-        Self::with_shape(map, look, brick, grid, shape)
+        Self::with_shape(map, look, brick, grid, shape, None)
+    }
+
+    /// The shape [`LabelLook::new`] makes: the shown labels' indicator filtered.
+    pub fn shape_of(map: &LabelMap, look: impl Fn(u16) -> Look) -> Arc<Vec<u8>> {
+        Arc::new(shape(map, look, SMOOTHING_SIGMA))
     }
 
     /// [`LabelLook::new`] that takes `shape` as it is: the shape of a look that shows the
     /// same labels (a colour or opacity edit leaves it, and filtering is most of the
-    /// work).
+    /// work). `empty` marks the voxels that hold no medium (see the module's notes).
     pub fn with_shape(
         map: &LabelMap,
         look: impl Fn(u16) -> Look,
         brick: u32,
         grid: [u32; 3],
         shape: Arc<Vec<u8>>,
+        empty: Option<&[bool]>,
     ) -> Self {
         let mut table = vec![None; super::MAX_LABEL as usize + 1];
         let rgba: Vec<[u8; 4]> = map
@@ -124,6 +137,10 @@ impl LabelLook {
                 [unorm(r), unorm(g), unorm(b), unorm(mask)]
             })
             .collect();
+        let rgba = match empty {
+            Some(empty) if empty.len() == rgba.len() => fit_to_medium(rgba, empty, map.dims),
+            _ => rgba,
+        };
         let brick_max = brick_maxima(&rgba, map.dims, brick, grid);
         Self {
             dims: map.dims,
@@ -134,6 +151,38 @@ impl LabelLook {
             brick_max,
         }
     }
+}
+
+/// Each empty voxel's mask becomes the lowest of its non-empty 26 neighbours' (0 with
+/// none): the only cells it shares are with them.
+fn fit_to_medium(mut rgba: Vec<[u8; 4]>, empty: &[bool], dims: [u32; 3]) -> Vec<[u8; 4]> {
+    let [nx, ny, nz] = dims.map(|d| d as usize);
+    let mask: Vec<u8> = rgba.iter().map(|t| t[3]).collect();
+    let slice = nx * ny;
+    rgba.par_chunks_mut(slice)
+        .enumerate()
+        .for_each(|(z, plane)| {
+            for (o, texel) in plane.iter_mut().enumerate() {
+                let i = z * slice + o;
+                if !empty[i] {
+                    continue;
+                }
+                let (x, y) = (o % nx, o / nx);
+                let mut lowest: Option<u8> = None;
+                for zz in z.saturating_sub(1)..(z + 2).min(nz) {
+                    for yy in y.saturating_sub(1)..(y + 2).min(ny) {
+                        for xx in x.saturating_sub(1)..(x + 2).min(nx) {
+                            let j = zz * slice + yy * nx + xx;
+                            if !empty[j] {
+                                lowest = Some(lowest.map_or(mask[j], |m| m.min(mask[j])));
+                            }
+                        }
+                    }
+                }
+                texel[3] = lowest.unwrap_or(0);
+            }
+        });
+    rgba
 }
 
 fn unorm(x: f32) -> u8 {

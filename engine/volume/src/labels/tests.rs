@@ -174,14 +174,25 @@ fn the_mni_segmentation_and_its_itksnap_table_load_on_the_t1_grid() {
     let map = LabelMap::load(&volumes.join("mni152_labels.nii.gz")).expect("label map");
     let t1 = Volume::load(&volumes.join("mni152_t1.nii.gz"), None).expect("t1");
     assert_eq!((map.dims, map.to_patient), (t1.dims, t1.to_patient));
-    assert_eq!(map.present(), vec![1, 2]);
+    assert_eq!(map.present(), vec![1, 2, 3]);
     let mut table = LabelTable::load(&volumes.join("mni152_labels.label")).expect("table");
     assert!(
         table.complete(&map.present()).is_empty(),
         "the table names every label"
     );
     let names: Vec<&str> = table.labels.iter().map(|l| l.name.as_str()).collect();
-    assert_eq!(names, vec!["Clear Label", "White matter", "Grey matter"]);
+    assert_eq!(
+        names,
+        vec![
+            "Clear Label",
+            "White matter",
+            "Grey matter",
+            "Rest of the brain"
+        ]
+    );
+    // The rest of the brain is hidden until shown.
+    let shown: Vec<bool> = table.labels.iter().map(|l| l.visible).collect();
+    assert_eq!(shown, vec![false, true, true, false]);
     // White matter is brighter than grey matter in the T1 it was made from.
     let mean = |label: u16| {
         let (sum, n) = map
