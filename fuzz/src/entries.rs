@@ -55,10 +55,18 @@ fn load_file(scratch: &Path, file_name: &str, bytes: &[u8], raw: Option<&RawPara
     std::fs::write(&path, bytes).expect("write input");
     let _ = Volume::load(&path, raw);
     if raw.is_none() {
-        // The same bytes as a series: its header's channels and time points, and its
-        // last time point (the read furthest into the data).
-        if let Ok(series) = Series::open(&path, None) {
-            let _ = series.read(series.info().times - 1);
+        read_as_series(&path);
+    }
+}
+
+/// The same input as a series: its header's channels and time points, and its last time
+/// point (the read furthest into the data), which must be what the limits allow.
+fn read_as_series(path: &Path) {
+    if let Ok(series) = Series::open(path, None) {
+        if let Ok(channels) = series.read(series.info().times - 1) {
+            for c in channels {
+                check_loaded(Ok(c));
+            }
         }
     }
 }
@@ -214,6 +222,7 @@ pub fn volume_zarr(bytes: &[u8], scratch: &Path) {
         let _ = std::fs::write(&path, data);
     }
     check_loaded(Volume::load_within(&open, None, budget));
+    read_as_series(&open);
     // The same store as a label map: an image's `labels/` group, a label image's
     // `image-label` colours and names.
     if let Ok((map, _table)) = LabelMap::load_with_table(&open) {
@@ -317,11 +326,12 @@ fn too_large_for_fuzzing(rel: &Path, data: &[u8]) -> bool {
 }
 
 /// An OME-TIFF (or plain TIFF stack): the input is the file, `in.ome.tif`, loaded as
-/// `dvr --volume in.ome.tif` does.
+/// `dvr --volume in.ome.tif` does, and as a series (its C and T axes).
 pub fn volume_ome_tiff(bytes: &[u8], scratch: &Path) {
     let path = folder(scratch, "tiff").join("in.ome.tif");
     std::fs::write(&path, bytes).expect("write input");
     check_loaded(Volume::load(&path, None));
+    read_as_series(&path);
 }
 
 /// Scene text (relative paths resolve against the working folder).
