@@ -4,8 +4,8 @@
 //! `dvr capture`'s PNGs), `DIR/state.jsonl` (one line per frame: camera, lights, the TF
 //! file in effect, the denoiser shown), every distinct TF as `DIR/tf/NNN.toml`, and
 //! `DIR/session.toml`, a scene whose animation replays the camera, lights, cut, a
-//! series' time point and the labels' looks frame by frame (step keyframes at each
-//! change, so values are exact), which
+//! series' time point, the channels' visibility and colour and the labels' looks frame
+//! by frame (step keyframes at each change, so values are exact), which
 //! `dvr capture --scene DIR/session.toml --size WxH` renders again.
 //!
 //! What a scene file cannot animate is replayed approximately and said so in the
@@ -13,13 +13,14 @@
 //! over the frames between the first and the last edit (exact for a single edit); light
 //! kinds and counts are locked while recording; area-light sizes and gradient
 //! environment colours keep their first-frame values; render settings are the last ones;
-//! channel edits are not recorded.
+//! a channel's TF and window keep the scene's (`state.jsonl` has each frame's window).
 
 use anyhow::{Context, Result};
 use dvr_engine::files::{write_atomic, Durability::Renamed};
 use dvr_engine::scene::{
-    self, BuiltinVolume, CameraKey, CameraSpec, ClipKey, CropKey, Cut, Interpolation, LabelKey,
-    LabelView, Light, LightKey, Scene, TfKey, TimeKey, TransferSpec, View, VolumeSource,
+    self, BuiltinVolume, CameraKey, CameraSpec, ChannelKey, ChannelView, ClipKey, CropKey, Cut,
+    Interpolation, LabelKey, LabelView, Light, LightKey, Scene, TfKey, TimeKey, TransferSpec, View,
+    VolumeSource,
 };
 use dvr_engine::transfer::TransferFunction;
 use std::io::Write;
@@ -37,6 +38,8 @@ pub struct FrameState {
     pub time: f64,
     /// The labels' looks (empty without a label map).
     pub labels: Vec<LabelView>,
+    /// The channels of a multi-channel medium (empty for one field).
+    pub channels: Vec<ChannelView>,
 }
 
 pub struct Recorder {
@@ -117,6 +120,11 @@ impl Recorder {
             "tf": Self::tf_name(tf_index),
             "denoiser": denoiser,
             "time": view.time,
+            "channels": view.channels.iter().map(|c| serde_json::json!({
+                "visible": c.visible,
+                "colour": c.colour,
+                "window": c.window,
+            })).collect::<Vec<_>>(),
             "labels": view.labels.iter().map(|l| serde_json::json!({
                 "value": l.value,
                 "colour": l.colour,
@@ -132,6 +140,7 @@ impl Recorder {
             tf: tf_index,
             time: view.time,
             labels: view.labels.clone(),
+            channels: view.channels.clone(),
         });
         Ok(())
     }
@@ -149,9 +158,9 @@ impl Recorder {
         let scene = session_scene(base, &self.frames, &self.tfs, Self::tf_name, volume_size)?;
         let path = self.dir.join("session.toml");
         let text = scene.to_toml().context("writing the session scene")?;
-        let note = "# Recorded by `dvr explore --record`: camera, light, cut, time and label \
-                    keyframes replay the\n# session exactly; TF edits are one blend from the \
-                    first TF to the last (see src/explore/record.rs).\n";
+        let note = "# Recorded by `dvr explore --record`: camera, light, cut, time, channel and \
+                    label keyframes\n# replay the session exactly; TF edits are one blend from \
+                    the first TF to the last (see src/explore/record.rs).\n";
         write_atomic(&path, format!("{note}{text}").as_bytes(), Renamed)
             .with_context(|| format!("writing {}", path.display()))?;
         Ok(Some(path))
@@ -253,6 +262,20 @@ pub fn session_scene(
     animation
         .label
         .extend(first.labels.iter().map(|l| label_key(0, l)));
+    let channel_key = |frame: u32, index: usize, c: &ChannelView| ChannelKey {
+        index,
+        frame,
+        visible: Some(c.visible),
+        colour: Some(glam::Vec3::from(c.colour).as_dvec3()),
+        interpolation: step,
+    };
+    animation.channel.extend(
+        first
+            .channels
+            .iter()
+            .enumerate()
+            .map(|(i, c)| channel_key(0, i, c)),
+    );
     for (index, l) in first.lights.iter().enumerate() {
         animation.light.push(LightKey {
             index,
@@ -312,6 +335,11 @@ pub fn session_scene(
         for (a, b) in prev.labels.iter().zip(&cur.labels) {
             if a != b {
                 animation.label.push(label_key(frame, b));
+            }
+        }
+        for (index, (a, b)) in prev.channels.iter().zip(&cur.channels).enumerate() {
+            if (a.visible, a.colour) != (b.visible, b.colour) {
+                animation.channel.push(channel_key(frame, index, b));
             }
         }
         if let (Some(b), true) = (cur.cut.crop, prev.cut.crop != cur.cut.crop) {
@@ -403,6 +431,7 @@ mod tests {
                 tf: 0,
                 time: 0.0,
                 labels: Vec::new(),
+                channels: Vec::new(),
             });
         }
         let s = session_scene(
@@ -498,5 +527,53 @@ mod tests {
             assert_eq!(&s.labels_at(f as u32), labels, "labels at frame {f}");
             assert_eq!(s.time_at(f as u32), *time, "time at frame {f}");
         }
+    }
+
+    #[test]
+    fn channel_edits_replay_exactly_at_every_frame() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/assets/scenes/development/microscopy-orbit.toml"
+        );
+        let mut b = Scene::load(std::path::Path::new(path)).expect("scene");
+        b.animation.channel.clear();
+        b.channel_views = ["nuclei", "membranes", "marker"]
+            .iter()
+            .map(|name| ChannelView {
+                name: name.to_string(),
+                tf: b.tf_a.clone(),
+                window: [0.0, 1.0],
+                data_window: [0.0, 1.0],
+                colour: [0.2, 0.8, 0.4],
+                visible: true,
+            })
+            .collect();
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut rec = Recorder::new(dir.path()).expect("recorder");
+        let mut want = Vec::new();
+        for f in 0..7 {
+            let mut view = b.view_at(0);
+            if (2..5).contains(&f) {
+                view.channels[1].visible = false;
+            }
+            if f >= 4 {
+                view.channels[2].colour = [1.0, 0.1, 0.3];
+            }
+            rec.push(&view, "ours").expect("push");
+            want.push(view.channels);
+        }
+        let s = session_scene(&b, &rec.frames, &rec.tfs, Recorder::tf_name, 16).expect("scene");
+        assert_eq!(
+            s.animation.channel.len(),
+            3 + 3,
+            "frame 0 and three changes"
+        );
+        for (f, channels) in want.iter().enumerate() {
+            assert_eq!(&s.channels_at(f as u32), channels, "channels at frame {f}");
+        }
+        let lines = std::fs::read_to_string(dir.path().join("state.jsonl")).expect("log");
+        let third: serde_json::Value =
+            serde_json::from_str(lines.lines().nth(2).expect("a line")).expect("json");
+        assert_eq!(third["channels"][1]["visible"], false);
     }
 }
