@@ -3,6 +3,7 @@
 //! known optics, and the validation check every GPU test ends with.
 #![allow(dead_code)]
 
+pub mod cli;
 pub mod eval;
 
 use dvr_engine::gpu::{validation, GpuContext};
