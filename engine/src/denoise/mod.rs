@@ -22,10 +22,11 @@ pub use taa::Taa;
 pub use wrls_paper::{Wrls, WrlsVariant};
 
 use crate::error::{EngineError, Result};
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, ImageDesc};
 use crate::graph::{Bindings, BufferHandle, Extent, Frame, History, ImageHandle, RenderGraph};
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::SceneBindings;
+use ash::vk;
 
 /// One overridable parameter of a denoiser: its name, the range it takes, and where it
 /// goes.
@@ -223,6 +224,16 @@ pub struct Retrace {
 }
 
 impl DenoiseInputs {
+    /// An RGBA32F image of the frame's size: what every denoiser's output is, and most of
+    /// its histories and intermediate images.
+    pub fn rgba32f(&self) -> ImageDesc {
+        ImageDesc::d2(
+            self.size.width,
+            self.size.height,
+            vk::Format::R32G32B32A32_SFLOAT,
+        )
+    }
+
     /// The surface features, or an error naming the denoiser that forgot to ask for them.
     pub fn features(&self, denoiser: &str) -> Result<FeatureImages> {
         self.features.ok_or_else(|| EngineError::Pass {

@@ -29,11 +29,10 @@
 
 use super::{DenoiseInputs, Denoiser, MotionSource};
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::gpu_block;
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::surface_features::STEP_VOXELS;
-use ash::vk;
 use glam::Vec4;
 
 gpu_block! {
@@ -204,7 +203,7 @@ impl Denoiser for Svgf {
         input: &DenoiseInputs,
     ) -> Result<ImageHandle> {
         let size = input.size;
-        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let desc = input.rgba32f();
         let n = self.name;
         let color = graph.history(ctx, &format!("{n}.color"), desc)?;
         let moments = graph.history(ctx, &format!("{n}.moments"), desc)?;

@@ -43,10 +43,9 @@ mod update;
 use super::variance_atrous::{self, VarianceAtrousPush};
 use super::{DenoiseInputs, Denoiser, MotionSource, Overridable};
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::path_trace::{self, PathTraceFeatures};
-use ash::vk;
 use gradient::OursGradientPush;
 use gradient_pool::OursGradientPoolPush;
 use lag::OursLagPush;
@@ -226,11 +225,7 @@ impl Denoiser for Ours {
         frame: &mut Frame<'f>,
         input: &DenoiseInputs,
     ) -> Result<ImageHandle> {
-        let desc = ImageDesc::d2(
-            input.size.width,
-            input.size.height,
-            vk::Format::R32G32B32A32_SFLOAT,
-        );
+        let desc = input.rgba32f();
         let n = &self.name;
         let lag = lag::LagImages {
             residual: graph.history(ctx, &format!("{n}.residual"), desc)?,
