@@ -113,6 +113,20 @@ pub fn with_overrides<P>(
     Ok(params)
 }
 
+/// Fails unless `with_overrides` refuses every `(spec, says)` of `cases` with an error
+/// naming `variable` and saying `says`: the overrides' tests of every denoiser.
+#[cfg(test)]
+pub(crate) fn assert_overrides_refused<P: std::fmt::Debug>(
+    with_overrides: impl Fn(Option<&str>) -> Result<P>,
+    variable: &str,
+    cases: &[(&str, &str)],
+) {
+    for &(spec, says) in cases {
+        let e = with_overrides(Some(spec)).expect_err(spec).to_string();
+        assert!(e.contains(variable) && e.contains(says), "{spec}: {e}");
+    }
+}
+
 /// Disocclusion tolerance of the shared reprojection (include/reproject.glsl): how far,
 /// in pixels, last frame's surface may land from this pixel when projected back.
 pub const REPROJECTION_TOLERANCE_PX: f32 = 1.5;

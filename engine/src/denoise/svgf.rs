@@ -511,18 +511,16 @@ mod tests {
             (p.color_alpha, p.sigma_l, p.iterations, p.feedback),
             (0.05, 10.0, 4, 1)
         );
-        for (spec, says) in [
-            ("color_alpha=2", "color_alpha must be in"),
-            ("iterations=0", "iterations must be in"),
-            ("feedback=4", "before the last"),
-            ("iterations=1", "before the last"),
-            ("alpha=0.1", "parameters: color_alpha"),
-        ] {
-            let e = SvgfParams::default()
-                .with_overrides(Some(spec))
-                .expect_err(spec)
-                .to_string();
-            assert!(e.contains("DVR_SVGF") && e.contains(says), "{spec}: {e}");
-        }
+        crate::denoise::assert_overrides_refused(
+            |spec| SvgfParams::default().with_overrides(spec),
+            "DVR_SVGF",
+            &[
+                ("color_alpha=2", "color_alpha must be in"),
+                ("iterations=0", "iterations must be in"),
+                ("feedback=4", "before the last"),
+                ("iterations=1", "before the last"),
+                ("alpha=0.1", "parameters: color_alpha"),
+            ],
+        );
     }
 }

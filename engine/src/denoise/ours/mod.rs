@@ -261,21 +261,19 @@ mod tests {
             OursParams::default().with_overrides(None).ok(),
             Some(OursParams::default())
         );
-        for (spec, says) in [
-            ("shrink=nan", "shrink must be in"),
-            ("keep=1e30", "keep must be in"),
-            ("outlier_z=0.1", "outlier_z must be in"),
-            ("lambda=0.9", "parameters: stratum"),
-            ("keep", "name=value"),
-            ("keep=x", "a number"),
-            ("kappa=3", "parameters: stratum"),
-        ] {
-            let e = OursParams::default()
-                .with_overrides(Some(spec))
-                .expect_err(spec)
-                .to_string();
-            assert!(e.contains("DVR_OURS") && e.contains(says), "{spec}: {e}");
-        }
+        crate::denoise::assert_overrides_refused(
+            |spec| OursParams::default().with_overrides(spec),
+            "DVR_OURS",
+            &[
+                ("shrink=nan", "shrink must be in"),
+                ("keep=1e30", "keep must be in"),
+                ("outlier_z=0.1", "outlier_z must be in"),
+                ("lambda=0.9", "parameters: stratum"),
+                ("keep", "name=value"),
+                ("keep=x", "a number"),
+                ("kappa=3", "parameters: stratum"),
+            ],
+        );
         // Inclusive bounds hold for the value as given.
         assert!(OursParams::default().with_overrides(Some("keep=1")).is_ok());
     }
