@@ -52,10 +52,8 @@ fn a_clip_plane_leaves_the_slab_it_keeps_for_camera_rays() {
     for (normal, depth) in [(1.0, 0.4), (-1.0, 0.6)] {
         let t = render(&plane(0.1, normal), vec![environment(1.0)], 0.0, 1);
         let expected = (-MU_T * depth).exp();
-        assert!(
-            ((t - expected) / expected).abs() < 0.01,
-            "normal {normal}: T = {t}, exp(-{MU_T} * {depth}) = {expected}"
-        );
+        let what = format!("normal {normal}: T against exp(-{MU_T} * {depth})");
+        assert_relative(t, expected, 0.01, &what);
     }
     assert_validation_clean();
 }
@@ -100,10 +98,8 @@ fn light_enters_through_the_cut_for_shadow_rays() {
     for (cut, z0) in [(Cut::default(), -0.5), (plane(0.1, 1.0), 0.1)] {
         let got = render(&cut, light.clone(), albedo as f32, 0);
         let want = single_scattering(z0, albedo, intensity);
-        assert!(
-            ((got - want) / want).abs() < 0.02,
-            "kept from z = {z0}: L = {got}, single scattering {want}"
-        );
+        let what = format!("kept from z = {z0}: L against single scattering");
+        assert_relative(got, want, 0.02, &what);
     }
     assert_validation_clean();
 }

@@ -11,10 +11,13 @@
    (its full path, or its path from the folder its section or table row stands in; see
    `named_files`), so the walk through the code stays whole.
 4. README.md stays the front door: at most 200 lines.
+5. The code stays in pieces one can read whole: no tracked source file (`*.rs`, `*.py`,
+   `*.sh`, `*.glsl`) over 800 lines, and no cell of an OVERVIEW.md table over 600
+   characters (a longer one becomes rows of its own).
 
     tools/check_docs.py [--book docs/book] [--no-book]
 
-Exits 1 naming every broken link, missing anchor and unnamed file.
+Exits 1 naming every broken link, missing anchor, unnamed file, long file and long cell.
 """
 
 import argparse
@@ -34,6 +37,9 @@ SOURCE_DIRS = ["src", "engine/src", "engine/volume/src", "engine/metrics/src", "
                "python/examples", "fuzz/src"]
 SOURCE_EXCLUDE = ["tests/fixtures/"]
 README_LINES = 200
+SOURCE_SUFFIXES = (".rs", ".py", ".sh", ".glsl")
+SOURCE_LINES = 800
+CELL_CHARS = 600
 
 
 class Links(html.parser.HTMLParser):
@@ -226,6 +232,30 @@ def check_overview():
     return [f"OVERVIEW.md: does not name {f}" for f in missing]
 
 
+def check_sizes(tracked):
+    """Every tracked source file within SOURCE_LINES lines, every OVERVIEW.md table cell
+    within CELL_CHARS characters."""
+    errors = []
+    for f in sorted(tracked or ()):
+        full = os.path.join(ROOT, f)
+        if not f.endswith(SOURCE_SUFFIXES) or os.path.islink(full) or not os.path.isfile(full):
+            continue
+        with open(full, encoding="utf-8", errors="replace") as fh:
+            lines = len(fh.read().splitlines())
+        if lines > SOURCE_LINES:
+            errors.append(f"{f}: {lines} lines, over {SOURCE_LINES}: split it into modules "
+                          "named for what they hold")
+    with open(os.path.join(ROOT, "OVERVIEW.md"), encoding="utf-8") as fh:
+        for n, line in enumerate(fh.read().splitlines(), 1):
+            if not line.startswith("|"):
+                continue
+            for i, cell in enumerate(re.split(r"(?<!\\)\|", line)[1:-1], 1):
+                if len(cell.strip()) > CELL_CHARS:
+                    errors.append(f"OVERVIEW.md:{n}: column {i} is {len(cell.strip())} characters, "
+                                  f"over {CELL_CHARS}: give its parts rows of their own")
+    return errors
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--book", default=os.path.join(ROOT, "docs", "book"))
@@ -235,6 +265,7 @@ def main():
     for rel in MARKDOWN:
         errors += check_markdown(rel)
     errors += check_overview()
+    errors += check_sizes(tracked_files())
     with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:
         lines = len(f.read().splitlines())
     if lines > README_LINES:
@@ -243,7 +274,8 @@ def main():
         print(f"check_docs: {e}", file=sys.stderr)
     if errors:
         return 1
-    print("check_docs: links, anchors, OVERVIEW.md's file list and README's length are fine")
+    print("check_docs: links, anchors, OVERVIEW.md's file list, README's length and the "
+          "sizes of source files and OVERVIEW.md's cells are fine")
     return 0
 
 

@@ -162,3 +162,44 @@ def per_scene_table(rows, methods, metric="psnr", label="scene"):
 def present(rows, methods):
     have = {r["method"] for r in rows}
     return [m for m in methods if m in have]
+
+
+# ------------------------------------------------------------- frame by frame
+
+
+def frames_by_scene(metrics):
+    """{scene: {frame: {method: psnr}}} of a metrics.csv."""
+    by = {}
+    for r in metrics:
+        by.setdefault(r["scene"], {}).setdefault(int(r["frame"]), {})[r["method"]] = num(r["psnr"])
+    return by
+
+
+def worst_margin(frames, rivals, after=4):
+    """The frame after `after` where ours is lowest against the best of `rivals` present:
+    (margin dB, frame), or None."""
+    worst = None
+    for f, v in sorted(frames.items()):
+        have = [v[x] for x in rivals if v.get(x) is not None]
+        if f <= after or v.get("ours") is None or not have:
+            continue
+        margin = v["ours"] - max(have)
+        if worst is None or margin < worst[0]:
+            worst = (margin, f)
+    return worst
+
+
+SINGLE_FRAME = ("oidn", "oidn-aux", "rae")
+
+
+def below_best(frames, rivals, by=1.0, after=4):
+    """(frames after `after` more than `by` dB below the best of `rivals` present, frames
+    compared) of one scene's {frame: {method: psnr}}."""
+    n = below = 0
+    for f, v in frames.items():
+        have = [v[x] for x in rivals if v.get(x) is not None]
+        if f <= after or v.get("ours") is None or not have:
+            continue
+        n += 1
+        below += v["ours"] < max(have) - by
+    return below, n

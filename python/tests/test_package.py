@@ -76,7 +76,13 @@ def test_the_built_book_shows_every_section_of_the_package_readme(root):
 def _copy_docs(root, dest):
     import shutil
 
-    for rel in ("tools/results.py", "tools/results_io.py", "README.md"):
+    for rel in (
+        "tools/results.py",
+        "tools/results_io.py",
+        "tools/results_sets.py",
+        "tools/results_experiments.py",
+        "README.md",
+    ):
         (dest / rel).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy(root / rel, dest / rel)
     for rel in ("docs/src", "assets/results", "assets/rae", "assets/scenes/validation"):

@@ -3,6 +3,7 @@
 //! known optics, and the validation check every GPU test ends with.
 #![allow(dead_code)]
 
+pub mod cli;
 pub mod eval;
 
 use dvr_engine::gpu::{validation, GpuContext};
@@ -198,6 +199,15 @@ pub fn read_image(
     ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
         .expect("submit");
     bytemuck::cast_slice::<u8, [f32; 4]>(graph.buffer_ref(buf).mapped().expect("mapped")).to_vec()
+}
+
+/// Fails unless `got` is within `tolerance` of `want`, relative to `want`; the message
+/// names what was measured (`what`) and both values.
+pub fn assert_relative(got: f64, want: f64, tolerance: f64, what: &str) {
+    assert!(
+        ((got - want) / want).abs() < tolerance,
+        "{what}: {got}, expected {want} (within {tolerance} of it)"
+    );
 }
 
 /// Fails the test if the validation layer reported anything in this process.

@@ -22,10 +22,11 @@ pub use taa::Taa;
 pub use wrls_paper::{Wrls, WrlsVariant};
 
 use crate::error::{EngineError, Result};
-use crate::gpu::GpuContext;
+use crate::gpu::{GpuContext, ImageDesc};
 use crate::graph::{Bindings, BufferHandle, Extent, Frame, History, ImageHandle, RenderGraph};
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::SceneBindings;
+use ash::vk;
 
 /// One overridable parameter of a denoiser: its name, the range it takes, and where it
 /// goes.
@@ -110,6 +111,20 @@ pub fn with_overrides<P>(
         set(&mut params, v as f32);
     }
     Ok(params)
+}
+
+/// Fails unless `with_overrides` refuses every `(spec, says)` of `cases` with an error
+/// naming `variable` and saying `says`: the overrides' tests of every denoiser.
+#[cfg(test)]
+pub(crate) fn assert_overrides_refused<P: std::fmt::Debug>(
+    with_overrides: impl Fn(Option<&str>) -> Result<P>,
+    variable: &str,
+    cases: &[(&str, &str)],
+) {
+    for &(spec, says) in cases {
+        let e = with_overrides(Some(spec)).expect_err(spec).to_string();
+        assert!(e.contains(variable) && e.contains(says), "{spec}: {e}");
+    }
 }
 
 /// Disocclusion tolerance of the shared reprojection (include/reproject.glsl): how far,
@@ -223,6 +238,16 @@ pub struct Retrace {
 }
 
 impl DenoiseInputs {
+    /// An RGBA32F image of the frame's size: what every denoiser's output is, and most of
+    /// its histories and intermediate images.
+    pub fn rgba32f(&self) -> ImageDesc {
+        ImageDesc::d2(
+            self.size.width,
+            self.size.height,
+            vk::Format::R32G32B32A32_SFLOAT,
+        )
+    }
+
     /// The surface features, or an error naming the denoiser that forgot to ask for them.
     pub fn features(&self, denoiser: &str) -> Result<FeatureImages> {
         self.features.ok_or_else(|| EngineError::Pass {

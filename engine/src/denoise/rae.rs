@@ -557,11 +557,7 @@ impl Denoiser for Rae {
             });
         }
 
-        let out = graph.image(
-            ctx,
-            &format!("{n}.out"),
-            ImageDesc::d2(fw, fh, vk::Format::R32G32B32A32_SFLOAT),
-        )?;
+        let out = graph.image(ctx, &format!("{n}.out"), input.rgba32f())?;
         add_io_pass(
             frame,
             format!("{n}.output"),

@@ -29,11 +29,10 @@
 
 use super::{DenoiseInputs, Denoiser, MotionSource};
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::gpu_block;
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::surface_features::STEP_VOXELS;
-use ash::vk;
 use glam::Vec4;
 
 gpu_block! {
@@ -204,7 +203,7 @@ impl Denoiser for Svgf {
         input: &DenoiseInputs,
     ) -> Result<ImageHandle> {
         let size = input.size;
-        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let desc = input.rgba32f();
         let n = self.name;
         let color = graph.history(ctx, &format!("{n}.color"), desc)?;
         let moments = graph.history(ctx, &format!("{n}.moments"), desc)?;
@@ -512,18 +511,16 @@ mod tests {
             (p.color_alpha, p.sigma_l, p.iterations, p.feedback),
             (0.05, 10.0, 4, 1)
         );
-        for (spec, says) in [
-            ("color_alpha=2", "color_alpha must be in"),
-            ("iterations=0", "iterations must be in"),
-            ("feedback=4", "before the last"),
-            ("iterations=1", "before the last"),
-            ("alpha=0.1", "parameters: color_alpha"),
-        ] {
-            let e = SvgfParams::default()
-                .with_overrides(Some(spec))
-                .expect_err(spec)
-                .to_string();
-            assert!(e.contains("DVR_SVGF") && e.contains(says), "{spec}: {e}");
-        }
+        crate::denoise::assert_overrides_refused(
+            |spec| SvgfParams::default().with_overrides(spec),
+            "DVR_SVGF",
+            &[
+                ("color_alpha=2", "color_alpha must be in"),
+                ("iterations=0", "iterations must be in"),
+                ("feedback=4", "before the last"),
+                ("iterations=1", "before the last"),
+                ("alpha=0.1", "parameters: color_alpha"),
+            ],
+        );
     }
 }

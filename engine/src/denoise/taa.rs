@@ -7,10 +7,9 @@
 
 use super::{DenoiseInputs, Denoiser, MotionSource};
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::gpu_block;
 use crate::graph::{Frame, ImageHandle, RenderGraph};
-use ash::vk;
 use glam::Vec4;
 
 gpu_block! {
@@ -81,7 +80,7 @@ impl Denoiser for Taa {
         input: &DenoiseInputs,
     ) -> Result<ImageHandle> {
         let size = input.size;
-        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let desc = input.rgba32f();
         let color = graph.history(ctx, &format!("{}.color", self.name), desc)?;
         let reproj = input.reprojection(self.name(), self.motion)?;
         let valid = color.valid && reproj.valid;

@@ -15,6 +15,7 @@ pub mod scene_setup;
 mod submit;
 mod tf_upload;
 pub mod timeline;
+mod uniforms;
 pub mod uploads;
 
 pub use inputs::{
@@ -37,13 +38,11 @@ use crate::passes::motion::Motion;
 use crate::passes::path_trace::{PathTrace, PathTraceFeatures, VolumeLayout};
 use crate::passes::present::Present;
 use crate::passes::surface_features::{FeatureImages, SurfaceFeatures};
-use crate::passes::SceneBindings;
 use crate::scene::RenderSettings;
-use crate::shaders::frame::{FrameBlock, FrameParams, SampleStream, MAX_LIGHTS};
+use crate::shaders::frame::{FrameBlock, SampleStream};
 use ash::vk;
 pub use brick_pool::VolumeResidency;
 use brick_pool::{Residency, VolumePath};
-use glam::{Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 pub use present::{Overlay, PresentTarget, Screenshot};
 use scene_gpu::SceneImages;
@@ -419,46 +418,6 @@ impl Renderer {
         Ok(done)
     }
 
-    /// This frame's uniform block, drawing random numbers from `stream`.
-    fn frame_block(
-        &self,
-        inputs: &FrameInputs,
-        majorant_max: f32,
-        stream: SampleStream,
-    ) -> FrameBlock {
-        let s = &self.settings;
-        let view_proj = inputs.camera.proj * inputs.camera.view;
-        let prev_view_proj = self
-            .last_inputs
-            .as_ref()
-            .map(|p| p.camera.proj * p.camera.view)
-            .unwrap_or(view_proj);
-        let world = Vec3::from(self.world_size);
-        let voxel = (world / Vec3::from(self.volume_dims.map(|d| d as f32))).min_element();
-        let (crop, clip) = cut_uniforms(&inputs.cut, world, self.volume_dims);
-        FrameBlock::new(&FrameParams {
-            view_proj,
-            prev_view_proj,
-            camera: inputs.camera.position,
-            half_size: world * 0.5,
-            density_scale: self.config.density_scale,
-            majorant_max,
-            volume_dims: self.volume_dims,
-            brick: self.bricks.brick,
-            lights: &inputs.lights,
-            stream,
-            max_bounces: s.max_bounces(),
-            rr_depth: s.russian_roulette_depth(),
-            step: voxel * s.step_size() as f32,
-            hg_g: s.hg_g() as f32,
-            feature_threshold: s.feature_threshold() as f32,
-            filter_sigma: s.filter_sigma() as f32,
-            seed: s.seed(),
-            crop,
-            clip: &clip,
-        })
-    }
-
     /// Renders one frame of the animation: the noisy path-traced frame once, then every
     /// denoiser on that same input. Returns the results of the frame that last used this
     /// slot (two frames ago), if any.
@@ -479,7 +438,7 @@ impl Renderer {
         request: &FrameRequest,
         present: Option<&PresentTarget<'_>>,
     ) -> Result<Option<FrameResult>> {
-        check_light_count(inputs)?;
+        uniforms::check_light_count(inputs)?;
         let slot = (self.frame_index % SLOTS as u64) as usize;
         let completed = self.wait_slot(slot)?;
         if present.is_some() && self.passes.present.is_none() {
@@ -640,27 +599,6 @@ impl Renderer {
         Ok(completed)
     }
 
-    /// Writes `uniforms` into slot `slot`'s uniform buffer; returns the scene bindings.
-    fn write_uniforms(&mut self, slot: usize, uniforms: &FrameBlock) -> Result<SceneBindings> {
-        let ubo = self.slots[slot].uniforms;
-        self.graph
-            .buffer_mut(ubo)
-            .write(bytemuck::bytes_of(uniforms))?;
-        Ok(SceneBindings {
-            uniforms: ubo,
-            volume: self.scene.volume,
-            tf_diffuse_opacity: self.scene.tf[0],
-            tf_specular_roughness: self.scene.tf[1],
-            tf_emissive: self.scene.tf[2],
-            majorant: self.scene.majorant,
-            environment: self.scene.environment,
-            brick_pool: self.scene.pool,
-            brick_table: self.scene.brick_table,
-            labels: self.scene.labels,
-            label_shape: self.scene.label_shape,
-        })
-    }
-
     fn changes(&self, inputs: &FrameInputs, reset: bool) -> Changes {
         match &self.last_inputs {
             None => Changes {
@@ -723,30 +661,6 @@ impl Renderer {
     }
 }
 
-/// The frame block's cut: the crop box in world space, clamped to the volume's box
-/// (which it is when nothing is cropped), and the enabled clip planes as (unit normal,
-/// offset). A crop box equal to the volume's bounds gives the box's own numbers.
-fn cut_uniforms(cut: &crate::scene::Cut, world: Vec3, dims: [u32; 3]) -> ((Vec3, Vec3), Vec<Vec4>) {
-    let half = world * 0.5;
-    let (mut lo, mut hi) = (-half, half);
-    if let Some(c) = cut.crop.filter(|c| c.enabled) {
-        let (min, max) = c.in_box_frame(dims);
-        let w = world.as_dvec3();
-        lo = lo.max((min * w).as_vec3());
-        hi = hi.min((max * w).as_vec3());
-    }
-    let planes = cut
-        .planes
-        .iter()
-        .filter(|p| p.enabled)
-        .map(|p| {
-            let (n, w) = p.equation();
-            n.as_vec3().extend(w as f32)
-        })
-        .collect();
-    ((lo, hi), planes)
-}
-
 /// Samples per pixel one frame of `size` may take on this device: at least 1 (the
 /// settings' own check), at most [`samples_per_dispatch`].
 fn check_spp(ctx: &GpuContext, spp: u32, size: Extent) -> Result<()> {
@@ -763,19 +677,6 @@ fn check_spp(ctx: &GpuContext, spp: u32, size: Extent) -> Result<()> {
             ctx.info.name
         ),
     })
-}
-
-/// The frame block's light array holds [`MAX_LIGHTS`]: more is an error, never a
-/// silent drop (scenes are checked against the same limit when loaded).
-fn check_light_count(inputs: &FrameInputs) -> Result<()> {
-    if inputs.lights.len() > MAX_LIGHTS {
-        return Err(EngineError::InvalidSetting {
-            name: "lights",
-            value: inputs.lights.len().to_string(),
-            allowed: format!("the path tracer takes at most {MAX_LIGHTS}"),
-        });
-    }
-    Ok(())
 }
 
 /// Builds the denoisers called `names` for a renderer built for `config` whose path

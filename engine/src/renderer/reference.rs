@@ -1,7 +1,8 @@
 //! High-sample references: accumulated in as few path-tracing dispatches as the device
 //! takes, from a sample stream of their own.
 
-use super::{add_readbacks, check_light_count, read_pixels, FrameInputs, Renderer};
+use super::uniforms::check_light_count;
+use super::{add_readbacks, read_pixels, FrameInputs, Renderer};
 use crate::error::{EngineError, Result};
 use crate::graph::Frame;
 use crate::shaders::frame::SampleStream;

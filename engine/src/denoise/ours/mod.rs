@@ -43,10 +43,9 @@ mod update;
 use super::variance_atrous::{self, VarianceAtrousPush};
 use super::{DenoiseInputs, Denoiser, MotionSource, Overridable};
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::graph::{Frame, ImageHandle, RenderGraph};
 use crate::passes::path_trace::{self, PathTraceFeatures};
-use ash::vk;
 use gradient::OursGradientPush;
 use gradient_pool::OursGradientPoolPush;
 use lag::OursLagPush;
@@ -226,11 +225,7 @@ impl Denoiser for Ours {
         frame: &mut Frame<'f>,
         input: &DenoiseInputs,
     ) -> Result<ImageHandle> {
-        let desc = ImageDesc::d2(
-            input.size.width,
-            input.size.height,
-            vk::Format::R32G32B32A32_SFLOAT,
-        );
+        let desc = input.rgba32f();
         let n = &self.name;
         let lag = lag::LagImages {
             residual: graph.history(ctx, &format!("{n}.residual"), desc)?,
@@ -266,21 +261,19 @@ mod tests {
             OursParams::default().with_overrides(None).ok(),
             Some(OursParams::default())
         );
-        for (spec, says) in [
-            ("shrink=nan", "shrink must be in"),
-            ("keep=1e30", "keep must be in"),
-            ("outlier_z=0.1", "outlier_z must be in"),
-            ("lambda=0.9", "parameters: stratum"),
-            ("keep", "name=value"),
-            ("keep=x", "a number"),
-            ("kappa=3", "parameters: stratum"),
-        ] {
-            let e = OursParams::default()
-                .with_overrides(Some(spec))
-                .expect_err(spec)
-                .to_string();
-            assert!(e.contains("DVR_OURS") && e.contains(says), "{spec}: {e}");
-        }
+        crate::denoise::assert_overrides_refused(
+            |spec| OursParams::default().with_overrides(spec),
+            "DVR_OURS",
+            &[
+                ("shrink=nan", "shrink must be in"),
+                ("keep=1e30", "keep must be in"),
+                ("outlier_z=0.1", "outlier_z must be in"),
+                ("lambda=0.9", "parameters: stratum"),
+                ("keep", "name=value"),
+                ("keep=x", "a number"),
+                ("kappa=3", "parameters: stratum"),
+            ],
+        );
         // Inclusive bounds hold for the value as given.
         assert!(OursParams::default().with_overrides(Some("keep=1")).is_ok());
     }

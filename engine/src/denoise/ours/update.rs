@@ -62,7 +62,7 @@ impl Ours {
         lag: &LagImages,
     ) -> Result<ImageHandle> {
         let size = input.size;
-        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        let desc = input.rgba32f();
         let n = &self.name;
         let model = graph.history(ctx, &format!("{n}.model"), desc)?;
         // The noise state: R, and D, the part of P that process noise put there.

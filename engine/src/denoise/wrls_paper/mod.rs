@@ -18,9 +18,8 @@ mod update;
 use super::variance_atrous::{self, VarianceAtrousPush};
 use super::{DenoiseInputs, Denoiser, MotionSource, Overridable};
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
+use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::graph::{Frame, ImageHandle, RenderGraph};
-use ash::vk;
 use spatial::WrlsSpatialPush;
 use update::{WrlsConstantPush, WrlsUpdatePush};
 
@@ -191,11 +190,7 @@ impl Denoiser for Wrls {
         frame: &mut Frame<'f>,
         input: &DenoiseInputs,
     ) -> Result<ImageHandle> {
-        let desc = ImageDesc::d2(
-            input.size.width,
-            input.size.height,
-            vk::Format::R32G32B32A32_SFLOAT,
-        );
+        let desc = input.rgba32f();
         let n = &self.name;
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
         let prediction = graph.image(ctx, &format!("{n}.prediction"), desc)?;

@@ -62,14 +62,6 @@ pub(super) struct FeatureModels {
 }
 
 impl Wrls {
-    fn state_desc(input: &DenoiseInputs) -> ImageDesc {
-        ImageDesc::d2(
-            input.size.width,
-            input.size.height,
-            vk::Format::R32G32B32A32_SFLOAT,
-        )
-    }
-
     /// The constant model: `model` (rgb β, a P) and `stats` (running noise level, frames
     /// in a row with a far residual); writes its prediction with its variance.
     #[allow(clippy::too_many_arguments)]
@@ -82,7 +74,7 @@ impl Wrls {
         input: &DenoiseInputs,
         prediction: ImageHandle,
     ) -> Result<()> {
-        let desc = Self::state_desc(input);
+        let desc = input.rgba32f();
         let n = &self.name;
         let model = graph.history(ctx, &format!("{n}.model"), desc)?;
         // Two channels are all the stats need: half the bytes of an rgba32f image.
@@ -135,7 +127,7 @@ impl Wrls {
         input: &DenoiseInputs,
         prediction: ImageHandle,
     ) -> Result<FeatureModels> {
-        let desc = Self::state_desc(input);
+        let desc = input.rgba32f();
         let n = &self.name;
         let history =
             |graph: &mut RenderGraph, what: &str| graph.history(ctx, &format!("{n}.{what}"), desc);

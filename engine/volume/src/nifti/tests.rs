@@ -4,6 +4,18 @@ use super::*;
 use crate::write::{self, NiftiData};
 use crate::VolumeData;
 
+/// Writes `data` as a 5×4×3 NIfTI at `path`, unit spacing, no scaling.
+fn nifti_5x4x3(path: &Path, data: NiftiData) {
+    write::nifti(path, [5, 4, 3], [1.0; 3], &data, None);
+}
+
+/// A 5×4×3 NIfTI of uint8 sevens written at `path`, and its bytes: the file the header
+/// tests edit.
+fn sevens(path: &Path) -> Vec<u8> {
+    nifti_5x4x3(path, NiftiData::U8(vec![7; 60]));
+    std::fs::read(path).expect("read")
+}
+
 #[test]
 fn nii_and_nii_gz_round_trip() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -47,7 +59,7 @@ fn scaling_int16_uint16_and_float() {
 
     let path = dir.path().join("u.nii");
     let u: Vec<u16> = (0..60).map(|x| x * 1000).collect();
-    write::nifti(&path, [5, 4, 3], [1.0; 3], &NiftiData::U16(u.clone()), None);
+    nifti_5x4x3(&path, NiftiData::U16(u.clone()));
     assert_eq!(
         Volume::load(&path, None).expect("u16").data,
         VolumeData::U16(u)
@@ -55,13 +67,7 @@ fn scaling_int16_uint16_and_float() {
 
     let path = dir.path().join("f.nii");
     let fl: Vec<f32> = (0..60).map(|x| x as f32 / 59.0).collect();
-    write::nifti(
-        &path,
-        [5, 4, 3],
-        [1.0; 3],
-        &NiftiData::F32(fl.clone()),
-        None,
-    );
+    nifti_5x4x3(&path, NiftiData::F32(fl.clone()));
     assert_eq!(
         Volume::load(&path, None).expect("f32").data,
         VolumeData::F32(fl)
@@ -72,14 +78,7 @@ fn scaling_int16_uint16_and_float() {
 fn bad_files_are_rejected_by_name() {
     let dir = tempfile::tempdir().expect("tempdir");
     let good = dir.path().join("good.nii");
-    write::nifti(
-        &good,
-        [5, 4, 3],
-        [1.0; 3],
-        &NiftiData::U8(vec![7; 60]),
-        None,
-    );
-    let bytes = std::fs::read(&good).expect("read");
+    let bytes = sevens(&good);
     let variant = |name: &str, edit: &dyn Fn(&mut Vec<u8>)| {
         let mut b = bytes.clone();
         edit(&mut b);
@@ -141,14 +140,7 @@ fn bad_files_are_rejected_by_name() {
 fn header_is_checked_before_the_data_is_read() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("t4.nii");
-    write::nifti(
-        &path,
-        [5, 4, 3],
-        [1.0; 3],
-        &NiftiData::U8(vec![7; 60]),
-        None,
-    );
-    let mut b = std::fs::read(&path).expect("read");
+    let mut b = sevens(&path);
     b[40..42].copy_from_slice(&4i16.to_le_bytes());
     b[48..50].copy_from_slice(&20i16.to_le_bytes());
     write::bytes(&path, &b);
@@ -169,14 +161,7 @@ fn clear_messages_for_vox_offset_pixdim_and_trailing_gzip_bytes() {
     for name in ["off.nii", "off.nii.gz"] {
         let path = dir.path().join(name);
         let plain = dir.path().join("plain.nii");
-        write::nifti(
-            &plain,
-            [5, 4, 3],
-            [1.0; 3],
-            &NiftiData::U8(vec![7; 60]),
-            None,
-        );
-        let mut b = std::fs::read(&plain).expect("read");
+        let mut b = sevens(&plain);
         b[108..112].copy_from_slice(&1000f32.to_le_bytes());
         if name.ends_with(".gz") {
             let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
@@ -207,14 +192,7 @@ fn clear_messages_for_vox_offset_pixdim_and_trailing_gzip_bytes() {
 
     // Valid gzip followed by other bytes used to fail with "invalid gzip header".
     let path = dir.path().join("tail.nii.gz");
-    write::nifti(
-        &path,
-        [5, 4, 3],
-        [1.0; 3],
-        &NiftiData::U8(vec![7; 60]),
-        None,
-    );
-    let mut b = std::fs::read(&path).expect("read");
+    let mut b = sevens(&path);
     b.extend_from_slice(&[0; 100]);
     write::bytes(&path, &b);
     let v = Volume::load(&path, None).expect("complete data with trailing zeros");
@@ -227,7 +205,7 @@ fn nan_in_float_nifti_is_rejected() {
     let path = dir.path().join("nan.nii.gz");
     let mut f = vec![0.5f32; 60];
     f[17] = f32::NAN;
-    write::nifti(&path, [5, 4, 3], [1.0; 3], &NiftiData::F32(f), None);
+    nifti_5x4x3(&path, NiftiData::F32(f));
     let err = Volume::load(&path, None).unwrap_err();
     // voxel 17 = (2, 3, 0) in a 5x4 slice.
     assert!(

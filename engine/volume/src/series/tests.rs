@@ -16,6 +16,12 @@ fn block(base: u8) -> Vec<u8> {
     (0..8u8).map(|i| base + i * 30).collect()
 }
 
+/// Writes `data` as a NIfTI of 2×2×2 volumes, `extra = [time points, channels]` of them
+/// (the data holds them time fastest, then channel), unit spacing, no scaling or sform.
+fn nifti_2x2x2(path: &Path, extra: [u32; 2], data: NiftiData) {
+    write::nifti_series(path, [2, 2, 2], extra, [1.0; 3], &data, None, None);
+}
+
 #[test]
 fn a_series_is_send_and_sync() {
     fn check<T: Send + Sync>() {}
@@ -91,15 +97,7 @@ fn nifti_time_points_and_channels_are_read_one_time_point_at_a_time() {
             data.extend(block(c * 3 + t));
         }
     }
-    write::nifti_series(
-        &p,
-        [2, 2, 2],
-        [3, 2],
-        [1.0; 3],
-        &NiftiData::U8(data),
-        None,
-        None,
-    );
+    nifti_2x2x2(&p, [3, 2], NiftiData::U8(data));
     let s = Series::open(&p, None).unwrap();
     assert_eq!(s.info().times, 3);
     let names: Vec<&str> = s.info().channels.iter().map(|c| c.name.as_str()).collect();
@@ -142,15 +140,7 @@ fn later_time_points_keep_the_first_ones_window() {
     let t0: Vec<f32> = (0..8).map(|i| i as f32 * 2.0 / 7.0).collect();
     let t1: Vec<f32> = t0.iter().map(|x| x * 2.0).collect();
     let data = [t0, t1].concat();
-    write::nifti_series(
-        &p,
-        [2, 2, 2],
-        [2, 1],
-        [1.0; 3],
-        &NiftiData::F32(data),
-        None,
-        None,
-    );
+    nifti_2x2x2(&p, [2, 1], NiftiData::F32(data));
     let s = Series::open(&p, None).unwrap();
     assert_eq!(s.info().channels[0].window, [0.0, 2.0]);
     let v = s.read(1).unwrap();
@@ -475,7 +465,7 @@ fn time_points_from_a_list_or_a_glob() {
     let dir = tempfile::tempdir().unwrap();
     for t in 0..3u8 {
         let p = dir.path().join(format!("vol_{t:03}.nii"));
-        write::nifti(&p, [2, 2, 2], [1.0; 3], &NiftiData::U8(block(t)), None);
+        nifti_2x2x2(&p, [1, 1], NiftiData::U8(block(t)));
     }
     let s = Series::open_glob(&dir.path().join("vol_*.nii"), None).unwrap();
     assert_eq!(s.info().times, 3);
@@ -501,15 +491,7 @@ fn bad_selections_times_and_channel_counts_are_errors_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("five.nii");
     let data: Vec<u8> = (0..5).flat_map(block).collect();
-    write::nifti_series(
-        &p,
-        [2, 2, 2],
-        [1, 5],
-        [1.0; 3],
-        &NiftiData::U8(data),
-        None,
-        None,
-    );
+    nifti_2x2x2(&p, [1, 5], NiftiData::U8(data));
     let e = Series::open(&p, None).unwrap_err().to_string();
     assert!(
         e.contains("five.nii") && e.contains("5 channels") && e.contains("channels = [0, 2]"),
@@ -548,30 +530,14 @@ fn bad_selections_times_and_channel_counts_are_errors_naming_the_file() {
     let p = dir.path().join("nan.nii");
     let mut data = vec![0.5f32; 16];
     data[9] = f32::NAN;
-    write::nifti_series(
-        &p,
-        [2, 2, 2],
-        [2, 1],
-        [1.0; 3],
-        &NiftiData::F32(data),
-        None,
-        None,
-    );
+    nifti_2x2x2(&p, [2, 1], NiftiData::F32(data));
     let s = Series::open(&p, None).unwrap();
     let e = s.read(1).unwrap_err().to_string();
     assert!(e.contains("nan.nii") && e.contains("NaN"), "{e}");
     // A truncated 4D file: the read is bounded by the header and says so.
     let p = dir.path().join("short.nii");
     let data: Vec<u8> = (0..3).flat_map(block).collect();
-    write::nifti_series(
-        &p,
-        [2, 2, 2],
-        [3, 1],
-        [1.0; 3],
-        &NiftiData::U8(data),
-        None,
-        None,
-    );
+    nifti_2x2x2(&p, [3, 1], NiftiData::U8(data));
     let b = std::fs::read(&p).unwrap();
     write::bytes(&p, &b[..b.len() - 4]);
     let e = Series::open(&p, None).unwrap_err().to_string();
@@ -612,26 +578,10 @@ fn lists_of_channel_files_must_agree_on_time_points_and_hold_one_channel_each() 
     let a = dir.path().join("a.nii");
     let b = dir.path().join("b.nii");
     let two = dir.path().join("two.nii");
-    write::nifti(&a, [2, 2, 2], [1.0; 3], &NiftiData::U8(block(0)), None);
+    nifti_2x2x2(&a, [1, 1], NiftiData::U8(block(0)));
     let data: Vec<u8> = (0..2).flat_map(block).collect();
-    write::nifti_series(
-        &b,
-        [2, 2, 2],
-        [2, 1],
-        [1.0; 3],
-        &NiftiData::U8(data.clone()),
-        None,
-        None,
-    );
-    write::nifti_series(
-        &two,
-        [2, 2, 2],
-        [1, 2],
-        [1.0; 3],
-        &NiftiData::U8(data),
-        None,
-        None,
-    );
+    nifti_2x2x2(&b, [2, 1], NiftiData::U8(data.clone()));
+    nifti_2x2x2(&two, [1, 2], NiftiData::U8(data));
     let e = Series::open_channels(&[a.clone(), b.clone()], None)
         .unwrap_err()
         .to_string();
@@ -645,7 +595,7 @@ fn lists_of_channel_files_must_agree_on_time_points_and_hold_one_channel_each() 
     assert!(e.contains("two.nii") && e.contains("holds 2"), "{e}");
     // An explicit list of time points; a 2-time-point file in it is refused.
     let c = dir.path().join("c.nii");
-    write::nifti(&c, [2, 2, 2], [1.0; 3], &NiftiData::U8(block(7)), None);
+    nifti_2x2x2(&c, [1, 1], NiftiData::U8(block(7)));
     let s = Series::open_times(&[a.clone(), c.clone()], None).unwrap();
     assert_eq!(u8s(&s.read(1).unwrap()[0]), block(7));
     let e = Series::open_times(&[a, b], None).unwrap_err().to_string();

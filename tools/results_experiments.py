@@ -1,0 +1,89 @@
+"""The results blocks of the experiments on ours' variants: each run's scores against
+the single-frame methods, and the profiles of the strata (`tools/results.py` lists every
+block)."""
+
+from results_io import (
+    read_csv,
+    read_json,
+    num,
+    fmt,
+    mean,
+    table,
+    frames_by_scene,
+    below_best,
+    SINGLE_FRAME,
+)
+
+
+def experiment_runs(folder):
+    """The table of an experiments section's runs of ours' variants: each run's mean PSNR
+    and FLIP and its frames more than 1 dB below the best single-frame method.
+    `folder/runs.csv` names each run (run, set, build, change, and optionally file: a CSV
+    under assets/results another section keeps, such as a base run on the same code);
+    the validation set's base is ours' rows of the results' own validation run."""
+    rivals = {"development": read_csv("experiments-prior", "rivals-development.csv"),
+              "validation": [r for r in read_csv("validation", "metrics.csv")
+                             if r["method"] in SINGLE_FRAME]}
+    base_val = [r for r in read_csv("validation", "metrics.csv") if r["method"] == "ours"]
+    runs = [("ours as on main", "validation", "main (2cb97d6 code)", base_val)]
+    runs += [(r["change"], r["set"], r["build"],
+              read_csv(*(r.get("file") or f"{folder}/{r['run']}-{r['set']}.csv").split("/")))
+             for r in read_csv(folder, "runs.csv")]
+    body = []
+    for change, set_, build, rows in sorted(runs, key=lambda r: r[1]):
+        by_scene = {}
+        for r in rows:
+            by_scene.setdefault(r["scene"], []).append(num(r["psnr"]))
+        frames = frames_by_scene(rows + rivals[set_])
+        below = sum(below_best(f, SINGLE_FRAME)[0] for f in frames.values())
+        body.append([change, set_, build,
+                     fmt(mean(mean(v) for v in by_scene.values()), 3),
+                     fmt(mean(num(r["flip"]) for r in rows), 4), str(below)])
+    return table(["change", "set", "build", "PSNR", "FLIP", "frames > 1 dB below"], body)
+
+
+def b_experiments_prior():
+    """The prior's features, the gradient pools and the seed reuse (at 08369ce)."""
+    meta = read_json("experiments-prior", "meta.json")
+    return "\n".join([
+        experiment_runs("experiments-prior"),
+        "",
+        f"Source: `assets/results/experiments-prior/` (`runs.csv`, each run's CSV) and "
+        f"`assets/results/validation/metrics.csv`, made by `{meta['command']}` from "
+        f"commit {meta['commit']} ({meta['date']}) on {meta['machine']}.",
+    ])
+
+
+def b_experiments_strata():
+    """The gradients' strata at full density (`DVR_OURS=stratum=1`) against the stratum
+    on main: the runs' scores, then the profiles (two runs of each, alternated): ours'
+    cost with its features, svgf's, their ratio, the gradient pass and ours' bytes per
+    pixel per frame, each the mean of the runs."""
+    def method(d, m):
+        return next(x for x in d["methods"] if x["method"] == m)
+
+    def gradient(d):
+        return next(x["mean_ms"] for x in d["passes"] if x["pass"] == "ours.gradient")
+
+    body = []
+    for r in read_csv("experiments-strata", "profiles.csv"):
+        runs = [read_json("experiments-strata", f) for f in r["files"].split()]
+        ours = mean(method(d, "ours")["cost_ms"] for d in runs)
+        svgf = mean(method(d, "svgf")["cost_ms"] for d in runs)
+        body.append([r["change"], runs[0]["scene"], str(len(runs)),
+                     fmt(mean(gradient(d) for d in runs), 1), fmt(ours, 1), fmt(svgf, 1),
+                     fmt(ours / svgf, 2),
+                     fmt(mean(method(d, "ours")["bytes_per_pixel"] for d in runs), 0)])
+    meta = read_json("experiments-strata", "meta.json")
+    return "\n".join([
+        experiment_runs("experiments-strata"),
+        "",
+        table(["change", "scene", "runs", "`ours.gradient` ms", "ours ms (features counted)",
+               "svgf ms", "ours / svgf", "ours bytes per pixel"], body),
+        "",
+        f"Source: `assets/results/experiments-strata/` (`runs.csv` and each run's CSV, "
+        f"`profiles.csv` and the profiles it names), `assets/results/experiments-prior/` "
+        f"(the development set's base run and its rivals) and "
+        f"`assets/results/validation/metrics.csv`, made by `{meta['command']}` from commit "
+        f"{meta['commit']} ({meta['date']}) on {meta['machine']}.",
+    ])

@@ -1,0 +1,167 @@
+"""The results blocks of the eval sets beside the validation set (the cut scenes, the
+channel and time scenes, the label-map scenes) and of what a cut or a label map costs
+(`tools/results.py` lists every block)."""
+
+from results_io import (
+    read_csv,
+    read_json,
+    num,
+    fmt,
+    scenes_of,
+    best,
+    table,
+    bold_if,
+    source,
+    present,
+    frames_by_scene,
+    worst_margin,
+)
+
+
+def cut_frames(metrics):
+    """Per scene: the closest frame after frame 4 of ours to the better of svgf and taa,
+    as (margin dB, frame)."""
+    return {sc: worst_margin(frames, ["svgf", "taa"]) for sc, frames in frames_by_scene(metrics).items()}
+
+
+def set_table(folder, skip=()):
+    """Mean PSNR per scene of an eval set run at 128×128 over 48 frames with 256-spp
+    references, with ours' closest frame after frame 4 to the better of svgf and taa, and
+    ours against oidn-aux on the mean; its source line. Scenes in `skip` are left out."""
+    rows = [r for r in read_csv(folder, "summary.csv") if r["scene"] not in skip]
+    metrics = read_csv(folder, "metrics.csv")
+    methods = present(rows, ["none", "taa", "svgf", "oidn", "oidn-aux", "ours"])
+    worst = cut_frames(metrics)
+    body = []
+    for sc in scenes_of(rows):
+        v = {r["method"]: r for r in rows if r["scene"] == sc}
+        bp = best({x: num(v[x]["psnr"]) for x in methods if x in v}, True)
+        cells = [sc] + [bold_if(fmt(num(v[x]["psnr"]), 2), fmt(num(v[x]["psnr"]), 2) == fmt(bp, 2))
+                        for x in methods]
+        w = worst.get(sc)
+        cells.append(f"{w[0]:+.2f} (frame {w[1]})" if w else "")
+        if "oidn-aux" in v:
+            cells.append(f"{num(v['ours']['psnr']) - num(v['oidn-aux']['psnr']):+.2f}")
+        body.append(cells)
+    header = ["scene"] + [f"`{x}`" for x in methods] + [
+        "ours − max(svgf, taa), closest frame after 4", "ours − oidn-aux, mean"]
+    return "\n".join([
+        "Mean PSNR (dB) per scene, 128×128, 48 frames, 256-spp references:",
+        "",
+        table(header, body),
+        "",
+        source(folder, ["summary.csv", "metrics.csv"]),
+    ])
+
+
+def in_validation_run(folder):
+    """The scenes of a set's run that the validation set's run also holds: each scene's
+    figures come from one run, the validation set's."""
+    val = set(scenes_of(read_csv("validation", "summary.csv")))
+    return [sc for sc in scenes_of(read_csv(folder, "summary.csv")) if sc in val]
+
+
+def b_cuts():
+    shared = in_validation_run("cuts")
+    return "\n".join([set_table("cuts", shared), "", validation_run_note("cuts", shared)])
+
+
+def b_media():
+    """The channel and time scenes: several fields in one medium, 4D series played."""
+    return set_table("media")
+
+
+def validation_run_note(folder, shared):
+    """Where the table leaves out a scene the validation set's run holds: where its
+    figures are, and that the images below are this run's."""
+    if not shared:
+        return ""
+    val = read_json("validation", "meta.json")
+    names = ", ".join(f"`{sc}`" for sc in shared)
+    return (f"{names}, a validation scene, is in [the validation set's table](#the-validation-set) "
+            f"(commit {val['commit']}) and not repeated here; the frames and the per-frame chart "
+            f"below are this run's (commit {read_json(folder, 'meta.json')['commit']}).")
+
+
+def set_line(folder, what, skip=()):
+    """README's sentence on an eval set: ours against oidn-aux per scene, and its closest
+    frame to the better of svgf and taa after frame 4. Scenes in `skip` are left out."""
+    rows = [r for r in read_csv(folder, "summary.csv") if r["scene"] not in skip]
+    worst = cut_frames([r for r in read_csv(folder, "metrics.csv") if r["scene"] not in skip])
+    psnr = {(r["scene"], r["method"]): num(r["psnr"]) for r in rows}
+    scenes = scenes_of(rows)
+    pairs = ", ".join(f"`{sc}` {fmt(psnr[(sc, 'ours')], 2)} / {fmt(psnr.get((sc, 'oidn-aux')), 2)}"
+                      for sc in scenes)
+    closest = min((w for w in worst.values() if w), key=lambda w: w[0])
+    meta = read_json(folder, "meta.json")
+    versus = (f"is above the better of `svgf` and `taa` on every frame (closest {closest[0]:+.2f} dB)"
+              if closest[0] >= 0 else
+              f"falls below the better of `svgf` and `taa` (at worst {closest[0]:+.2f} dB, frame {closest[1]})")
+    return (
+        f"Mean PSNR (dB) of `ours` / `oidn-aux` on {what}, 128×128, 48 frames, 256-spp "
+        f"references: {pairs}. After frame 4, `ours` {versus}. Commit {meta['commit']}"
+    )
+
+
+def b_cuts_line():
+    shared = in_validation_run("cuts")
+    also = (f"; {', '.join(f'`{sc}`' for sc in shared)} is among the validation set's means above "
+            "([per scene](docs/src/results.md#the-validation-set))") if shared else ""
+    return (set_line("cuts", "the development set's cut scenes", shared)
+            + f"; source: `assets/results/cuts/`{also}.")
+
+
+def b_media_line():
+    return set_line("media", "the channel and time scenes") + "; source: `assets/results/media/`."
+
+
+def b_labels():
+    """The label-map scenes: segmentations hidden, faded and shown as solid tissue."""
+    return set_table("labels")
+
+
+def b_labels_line():
+    return set_line("labels", "the label-map scenes") + "; source: `assets/results/labels/`."
+
+
+def b_labels_cost():
+    """The path tracer's cost with a label map shown and with a label hidden, against the
+    same view without one, run by run."""
+    rows = read_csv("labels-cost", "profile.csv")
+    def by_run(labels):
+        return {(r["scene"], r["run"]): num(r["path_trace_ms"]) for r in rows
+                if r["labels"] == labels}
+
+    base, shown = by_run("no label map"), by_run("every label shown (tint)")
+
+    def ratio(r, to):
+        return f"{num(r['path_trace_ms']) / to[(r['scene'], r['run'])]:.2f}×"
+
+    body = [[r["scene"], r["labels"], r["run"], fmt(num(r["path_trace_ms"]), 1),
+             ratio(r, base), ratio(r, shown) if r["labels"] != "no label map" else "",
+             fmt(num(r["frame_ms"]), 1)]
+            for r in rows]
+    return "\n".join([
+        "Median GPU ms per frame of the path-tracing pass and of the whole frame at 256×256, "
+        "the same view without a label map, with every label shown, and with labels hidden "
+        "from the outside in until every one is, runs alternating (× is to the same scene's "
+        "run without a label map, or with every label shown):",
+        "",
+        table(["scene", "labels", "run", "`path_trace`", "× none", "× shown", "frame"], body),
+        "",
+        source("labels-cost", ["profile.csv"]),
+    ])
+
+
+def b_cut_cost():
+    rows = read_csv("cut-cost", "profile.csv")
+    body = [[r["scene"], r["cut"], r["run"], fmt(num(r["path_trace_ms"]), 1),
+             fmt(num(r["frame_ms"]), 1)] for r in rows]
+    return "\n".join([
+        "Median GPU ms per frame of the path-tracing pass and of the whole frame, the same "
+        "view with and without a plane that removes half the volume, runs alternating:",
+        "",
+        table(["scene", "cut", "run", "`path_trace`", "frame"], body),
+        "",
+        source("cut-cost", ["profile.csv"]),
+    ])
