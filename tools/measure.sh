@@ -6,7 +6,7 @@
 #
 #   tools/measure.sh SET [SET ...]     SET: demo static development validation paper
 #                                           suite cost rae cuts cut-cost labels
-#                                           labels-cost
+#                                           labels-cost channels-cost
 #
 # Needs a release build (cargo build --release). The eval sets also add Intel OIDN with
 # tools/oidn_eval.py, which needs a Python with the dvr package, pyoidn, numpy, OpenEXR
@@ -220,6 +220,49 @@ EOF2
       KEEP_METRICS=1 keep labels "$out"
       meta labels "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
+    channels-cost)
+      # What the channels of a medium cost the path tracer: the MNI T1 under the layered
+      # (semi-transparent) TF as one field, and the same file as 2 and 4 channels with
+      # all but the first hidden (the same image, so the difference is the fetches and
+      # LUT reads per channel), profiled alternately (three runs each).
+      mkdir -p "$out"
+      t1="$PWD/assets/volumes/mni152_t1.nii.gz"
+      view='[transfer]\na = "mri-layered"\n\n[camera]\nposition = [0.45, 1.5, 0.35]\n\n[[light]]\nkind = "point"\nposition = [-1.4, 0.0, 0.8]\nintensity = 20.0\n\n[[light]]\nkind = "environment"\nintensity = 0.25\n'
+      for n in 1 2 4; do
+        {
+          if [ "$n" = 1 ]; then
+            printf '[volume]\nfile = "%s"\ndensity_scale = 150.0\n\n' "$t1"
+          else
+            printf '[volume]\nfiles = [%s]\ndensity_scale = 150.0\n\n' "$(for _ in $(seq "$n"); do printf '"%s",' "$t1"; done)"
+            for c in $(seq "$n"); do
+              printf '[[channel]]\nvisible = %s\n\n' "$([ "$c" = 1 ] && echo true || echo false)"
+            done
+          fi
+          printf '%b' "$view"
+        } > "$out/channels-$n.toml"
+      done
+      t0=$(date +%s.%N)
+      for run in 1 2 3; do
+        for n in 1 2 4; do
+          "$dvr" profile --scene "$out/channels-$n.toml" --frames 24 --size 256x256 --denoiser ours \
+            --json "$out/channels-$n-$run.json" >/dev/null
+        done
+      done
+      secs=$(echo "$(date +%s.%N) - $t0" | bc)
+      python3 - "$out" <<'EOF2'
+import csv, json, sys
+out = sys.argv[1]
+with open("assets/results/channels-cost/profile.csv", "w", newline="") as f:
+    w = csv.writer(f)
+    w.writerow(["scene", "channels", "run", "path_trace_ms", "frame_ms"])
+    for run in (1, 2, 3):
+        for n in (1, 2, 4):
+            p = json.load(open(f"{out}/channels-{n}-{run}.json"))
+            pt = next(x["median_ms"] for x in p["passes"] if x["pass"] == "path_trace")
+            w.writerow(["mni152_t1 / mri-layered", n, run, f"{pt:.3f}", f"{p['total']['median_ms']:.3f}"])
+EOF2
+      meta channels-cost "$out" "$secs" "dvr profile --scene S --frames 24 --size 256x256 --denoiser ours, S = the MNI T1 under mri-layered as one field, and as [volume] files = the same file 2 and 4 times with every channel but the first hidden, alternating, three runs each"
+      ;;
     labels-cost)
       # Two heads under opaque TFs, each labelled everywhere it has tissue (label 0 is
       # air): the phantom (scalp, skull, brain, ventricles, vessels) and the MNI head
@@ -279,7 +322,7 @@ EOF2
       meta labels-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit and mri/point-light without a label map, with [labels] builtin = the dataset and every label shown, and with labels hidden from the outside in until every one is, alternating, two runs each"
       ;;
     *)
-      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost labels labels-cost)" >&2
+      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost labels labels-cost channels-cost)" >&2
       exit 2
       ;;
   esac
