@@ -153,6 +153,24 @@ def b_labels_cost():
     ])
 
 
+def b_channels_cost():
+    """The path tracer's cost with 2 and 4 channels against one, run by run."""
+    rows = read_csv("channels-cost", "profile.csv")
+    one = {r["run"]: num(r["path_trace_ms"]) for r in rows if r["channels"] == "1"}
+    body = [[r["scene"], r["channels"], r["run"], fmt(num(r["path_trace_ms"]), 1),
+             f"{num(r['path_trace_ms']) / one[r['run']]:.2f}×", fmt(num(r["frame_ms"]), 1)]
+            for r in rows]
+    return "\n".join([
+        "Median GPU ms per frame of the path-tracing pass and of the whole frame at 256×256, "
+        "the same view as one field and as 2 and 4 channels with every channel but the first "
+        "hidden (the same image), runs alternating (× is to the same run's one channel):",
+        "",
+        table(["scene", "channels", "run", "`path_trace`", "× one", "frame"], body),
+        "",
+        source("channels-cost", ["profile.csv"]),
+    ])
+
+
 def b_cut_cost():
     rows = read_csv("cut-cost", "profile.csv")
     body = [[r["scene"], r["cut"], r["run"], fmt(num(r["path_trace_ms"]), 1),
