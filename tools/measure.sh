@@ -6,7 +6,7 @@
 #
 #   tools/measure.sh SET [SET ...]     SET: demo static development validation paper
 #                                           suite cost rae cuts cut-cost labels
-#                                           labels-cost channels-cost
+#                                           labels-cost channels-cost statmap
 #
 # Needs a release build (cargo build --release). The eval sets also add Intel OIDN with
 # tools/oidn_eval.py, which needs a Python with the dvr package, pyoidn, numpy, OpenEXR
@@ -263,6 +263,16 @@ with open("assets/results/channels-cost/profile.csv", "w", newline="") as f:
 EOF2
       meta channels-cost "$out" "$secs" "dvr profile --scene S --frames 24 --size 256x256 --denoiser ours, S = the MNI T1 under mri-layered as one field, and as [volume] files = the same file 2 and 4 times with every channel but the first hidden, alternating, three runs each"
       ;;
+    statmap)
+      # The development two-channel head (the T1 and a statistical map over it) under a
+      # moving light, at the channel and time sets' size and reference count.
+      args=(--scene assets/scenes/development/mri-statmap-light.toml
+        --size 128x128 --frames 48 --ref-spp 256 --aux --denoiser none,taa,svgf,ours)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      oidn "$out"
+      KEEP_METRICS=1 keep statmap "$out"
+      meta statmap "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
+      ;;
     labels-cost)
       # Two heads under opaque TFs, each labelled everywhere it has tissue (label 0 is
       # air): the phantom (scalp, skull, brain, ventricles, vessels) and the MNI head
@@ -322,7 +332,7 @@ EOF2
       meta labels-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit and mri/point-light without a label map, with [labels] builtin = the dataset and every label shown, and with labels hidden from the outside in until every one is, alternating, two runs each"
       ;;
     *)
-      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost labels labels-cost channels-cost)" >&2
+      echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost labels labels-cost channels-cost statmap)" >&2
       exit 2
       ;;
   esac

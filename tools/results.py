@@ -57,6 +57,7 @@ from results_io import (
 from results_sets import (
     b_cuts,
     b_media,
+    b_statmap,
     b_media_line,
     b_cuts_line,
     b_channels_cost,
@@ -563,6 +564,7 @@ BLOCKS = {
                       "validation/summary.csv", "validation/meta.json"]),
     "media": (b_media, ["media/summary.csv", "media/metrics.csv", "media/meta.json"]),
     "media-line": (b_media_line, ["media/summary.csv", "media/metrics.csv", "media/meta.json"]),
+    "statmap": (b_statmap, ["statmap/summary.csv", "statmap/metrics.csv", "statmap/meta.json"]),
     "cuts-line": (b_cuts_line, ["cuts/summary.csv", "cuts/metrics.csv", "cuts/meta.json",
                                 "validation/summary.csv"]),
     "cut-cost": (b_cut_cost, ["cut-cost/profile.csv"]),

@@ -71,6 +71,11 @@ def b_media():
     return set_table("media")
 
 
+def b_statmap():
+    """The development two-channel head under a moving light, run on its own."""
+    return set_table("statmap")
+
+
 def validation_run_note(folder, shared):
     """Where the table leaves out a scene the validation set's run holds: where its
     figures are, and that the images below are this run's."""
