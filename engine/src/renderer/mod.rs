@@ -39,7 +39,7 @@ use crate::passes::path_trace::{PathTrace, PathTraceFeatures, VolumeLayout};
 use crate::passes::present::Present;
 use crate::passes::surface_features::{FeatureImages, SurfaceFeatures};
 use crate::scene::RenderSettings;
-use crate::shaders::frame::{FrameBlock, SampleStream};
+use crate::shaders::frame::{ChannelOpacity, FrameBlock, SampleStream};
 use ash::vk;
 pub use brick_pool::VolumeResidency;
 use brick_pool::{Residency, VolumePath};
@@ -183,6 +183,8 @@ pub struct Renderer {
     current_labels: Option<LabelLookRef>,
     /// The largest extinction under `current_lut`.
     majorant_max: f32,
+    /// Several channels: their opacity under `current_lut`, for the frame block.
+    channel_opacity: Box<ChannelOpacity>,
     last_inputs: Option<FrameInputs>,
     slots: Vec<Slot>,
     pool: vk::CommandPool,
@@ -216,6 +218,17 @@ impl Renderer {
         // So is a volume not even a brick pool can hold in the budget: found here, the
         // error is not preceded by the allocator's reports of leaked buffers.
         let volume_path = scene_gpu::plan_volume(&ctx, &volume, config.gpu_memory)?;
+        // The frame block holds the channels' opacity rows at the LUTs' own size.
+        if volume.channels() > 1 && lut_size as usize != crate::transfer::LUT_SIZE {
+            return Err(EngineError::Resource {
+                resource: "transfer function".into(),
+                problem: format!(
+                    "a medium of {} channels reads LUTs of {} entries, not {lut_size}",
+                    volume.channels(),
+                    crate::transfer::LUT_SIZE
+                ),
+            });
+        }
         let layout = VolumeLayout {
             pooled: matches!(volume_path, VolumePath::Pool(_)),
             channels: volume.channels(),
@@ -326,6 +339,7 @@ impl Renderer {
             current_cut: None,
             current_labels: None,
             majorant_max: 0.0,
+            channel_opacity: Box::default(),
             last_inputs: None,
             slots,
             pool,

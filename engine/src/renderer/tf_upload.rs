@@ -9,6 +9,7 @@ use super::FrameInputs;
 use super::Renderer;
 use crate::error::{EngineError, Result};
 use crate::graph::Frame;
+use crate::shaders::frame::ChannelOpacity;
 use std::sync::Arc;
 
 impl Renderer {
@@ -104,6 +105,9 @@ impl Renderer {
             }
             scene_gpu::mask_cut(&mut majorants, &self.bricks, dims, world, cut);
             self.majorant_max = majorants.iter().copied().fold(0.0f32, f32::max);
+            if channels > 1 {
+                *self.channel_opacity = ChannelOpacity::from_rows(&opacity);
+            }
             let (ctx, graph) = (&self.ctx, &mut self.graph);
             let [a, b, c] = self.scene.tf;
             for (name, image, bytes) in [

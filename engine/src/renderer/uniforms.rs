@@ -46,6 +46,7 @@ impl Renderer {
             seed: s.seed(),
             crop,
             clip: &clip,
+            channel_opacity: &self.channel_opacity,
         })
     }
 

@@ -27,6 +27,8 @@ glsl_defines! {
         MAX_LIGHTS: usize = 4,
         /// Clip planes the frame block holds.
         MAX_CLIP_PLANES: usize = 6,
+        /// Entries of a channel's opacity row in the frame block: the LUTs' own.
+        LUT_SIZE: usize = crate::transfer::LUT_SIZE,
         /// `GpuLight::position_kind.w`: what the light is.
         LIGHT_POINT: f32 = 0.0,
         LIGHT_AREA: f32 = 1.0,
@@ -86,6 +88,9 @@ gpu_block! {
         pub crop_max: Vec4,
         /// `counts.z` planes: xyz unit normal, w offset (kept where `n·x + w >= 0`).
         pub clip: [Vec4; MAX_CLIP_PLANES],
+        /// Several channels: entry i, lane c is channel c's opacity at density
+        /// `i / (LUT_SIZE − 1)`.
+        pub channel_opacity: ChannelOpacity,
     }
 }
 
@@ -146,6 +151,38 @@ pub struct FrameParams<'a> {
     pub crop: (Vec3, Vec3),
     /// Enabled clip planes (xyz unit normal, w offset), at most [`MAX_CLIP_PLANES`].
     pub clip: &'a [Vec4],
+    /// Several channels: their opacity rows, lane by lane.
+    pub channel_opacity: &'a ChannelOpacity,
+}
+
+/// Most channels one medium holds: a volume texel's four components (and the lanes of
+/// [`ChannelOpacity`]).
+pub const MAX_CHANNELS: usize = 4;
+
+/// The channels' opacity rows interleaved, as the frame block holds them: entry i, lane
+/// c is channel c's opacity at density `i / (LUT_SIZE − 1)`.
+#[repr(transparent)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ChannelOpacity(pub [Vec4; LUT_SIZE]);
+
+impl Default for ChannelOpacity {
+    fn default() -> Self {
+        Self([Vec4::ZERO; LUT_SIZE])
+    }
+}
+
+impl ChannelOpacity {
+    /// From `opacity`, the channels' rows of [`LUT_SIZE`] entries laid end to end (at
+    /// most [`MAX_CHANNELS`]; lanes past them are 0).
+    pub fn from_rows(opacity: &[f32]) -> Self {
+        let mut t = Self::default();
+        for (c, row) in opacity.chunks(LUT_SIZE).take(MAX_CHANNELS).enumerate() {
+            for (entry, &a) in t.0.iter_mut().zip(row) {
+                entry[c] = a;
+            }
+        }
+        t
+    }
 }
 
 impl FrameBlock {
@@ -181,6 +218,7 @@ impl FrameBlock {
             crop_min: p.crop.0.extend(0.0),
             crop_max: p.crop.1.extend(0.0),
             clip,
+            channel_opacity: *p.channel_opacity,
         }
     }
 }
@@ -189,7 +227,7 @@ impl FrameBlock {
 pub const FRAME_BLOCK: &str = "FrameBlock";
 
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 64);
-const _: () = assert!(<FrameBlock as GpuBlock>::FIELDS.len() == 14);
+const _: () = assert!(<FrameBlock as GpuBlock>::FIELDS.len() == 15);
 
 #[cfg(test)]
 mod tests {
@@ -264,6 +302,10 @@ mod tests {
             position_kind: Vec4::new(1.0, 2.0, 3.0, LIGHT_AREA),
             ..Default::default()
         };
+        // Two channels' opacity rows: channel c's entry i holds 1000·c + i.
+        let rows: Vec<f32> = (0..2 * LUT_SIZE)
+            .map(|k| (1000 * (k / LUT_SIZE) + k % LUT_SIZE) as f32)
+            .collect();
         let b = FrameBlock::new(&FrameParams {
             view_proj: Mat4::IDENTITY,
             prev_view_proj: Mat4::IDENTITY,
@@ -284,7 +326,13 @@ mod tests {
             seed: 11,
             crop: (Vec3::splat(-0.25), Vec3::splat(0.5)),
             clip: &[Vec4::new(0.0, 0.0, 1.0, -0.1)],
+            channel_opacity: &ChannelOpacity::from_rows(&rows),
         });
+        assert_eq!(b.channel_opacity.0[3], Vec4::new(3.0, 1003.0, 0.0, 0.0));
+        assert_eq!(
+            b.channel_opacity.0[LUT_SIZE - 1].y,
+            1000.0 + (LUT_SIZE - 1) as f32
+        );
         assert_eq!(b.counts, IVec4::new(1, 5, 1, 6));
         assert_eq!(b.crop_min.truncate(), Vec3::splat(-0.25));
         assert_eq!(b.clip[0], Vec4::new(0.0, 0.0, 1.0, -0.1));

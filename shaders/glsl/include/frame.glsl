@@ -5,6 +5,7 @@
 
 #define MAX_LIGHTS 4
 #define MAX_CLIP_PLANES 6
+#define LUT_SIZE 256
 #define LIGHT_POINT 0
 #define LIGHT_AREA 1
 #define LIGHT_ENV 2
@@ -37,6 +38,11 @@ layout(binding = 0, std140) uniform FrameBlock {
     vec4 crop_min;
     vec4 crop_max;
     vec4 clip[MAX_CLIP_PLANES];
+    // Several channels: entry i, lane c is channel c's opacity at density i/(LUT_SIZE-1)
+    // (its LUT's alpha, 0 where hidden). The extinction reads it rather than the LUT
+    // textures: on lavapipe a sampler call per channel at every delta-tracking step costs
+    // more than two uniform reads (volume.glsl, channel_opacity).
+    vec4 channel_opacity[LUT_SIZE];
 } frame;
 
 #endif

@@ -85,6 +85,14 @@ float channel_lut_coord(float d, int c) {
     return (float(c) * n + clamp(d, 0.0, 1.0) * (n - 1.0) + 0.5) / (n * float(CHANNELS));
 }
 
+// Channel c's opacity at density d, linear between the frame block's entries (what its
+// LUT texture gives, read without a sampler).
+float channel_opacity(float d, int c) {
+    float x = clamp(d, 0.0, 1.0) * float(LUT_SIZE - 1);
+    int i = min(int(x), LUT_SIZE - 2);
+    return mix(frame.channel_opacity[i][c], frame.channel_opacity[i + 1][c], x - float(i));
+}
+
 // The medium's albedo (the channels' albedos weighted by their shares of the extinction)
 // and opacity (their sum), with each channel's share.
 vec4 medium_albedo_opacity(vec4 dens, out vec4 share) {
@@ -141,7 +149,7 @@ float extinction_at(vec3 p) {
         vec4 dens = densities_at(p);
         opacity = 0.0;
         for (int c = 0; c < CHANNELS; ++c) {
-            opacity += texture(tf_diffuse_opacity, channel_lut_coord(dens[c], c)).a;
+            opacity += channel_opacity(dens[c], c);
         }
     } else {
         opacity = tf_albedo_opacity(density_at(p)).a;
