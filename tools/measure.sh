@@ -222,46 +222,66 @@ EOF2
       ;;
     channels-cost)
       # What the channels of a medium cost the path tracer: the MNI T1 under the layered
-      # (semi-transparent) TF as one field, and the same file as 2 and 4 channels with
-      # all but the first hidden (the same image, so the difference is the fetches and
-      # LUT reads per channel), profiled alternately (three runs each).
+      # (semi-transparent) TF as one field, and the same file as 2 and 4 channels in two
+      # layouts, each the same medium as the one field: "hidden", every channel but the
+      # first hidden; "split", every channel shown, white, under the TF with its opacity
+      # divided among them (their extinctions sum to the one field's). Profiled
+      # alternately, three runs each.
       mkdir -p "$out"
       t1="$PWD/assets/volumes/mni152_t1.nii.gz"
       view='[transfer]\na = "mri-layered"\n\n[camera]\nposition = [0.45, 1.5, 0.35]\n\n[[light]]\nkind = "point"\nposition = [-1.4, 0.0, 0.8]\nintensity = 20.0\n\n[[light]]\nkind = "environment"\nintensity = 0.25\n'
-      for n in 1 2 4; do
+      for n in 2 4; do
+        python3 - "$n" > "$out/mri-layered-$n.toml" <<'EOF1'
+import re, sys
+n = int(sys.argv[1])
+tf = open("assets/transfer/mri-layered.toml").read()
+tf = re.sub(r'^name = "mri-layered"', f'name = "mri-layered-{n}th"', tf, flags=re.M)
+print(re.sub(r"^opacity = ([0-9.]+)", lambda m: f"opacity = {float(m[1]) / n!r}", tf, flags=re.M))
+EOF1
+      done
+      files() { for _ in $(seq "$1"); do printf '"%s",' "$t1"; done; }
+      layouts=(1-one 2-hidden 2-split 4-hidden 4-split)
+      for l in "${layouts[@]}"; do
+        n=${l%%-*} layout=${l#*-}
         {
-          if [ "$n" = 1 ]; then
+          if [ "$layout" = one ]; then
             printf '[volume]\nfile = "%s"\ndensity_scale = 150.0\n\n' "$t1"
           else
-            printf '[volume]\nfiles = [%s]\ndensity_scale = 150.0\n\n' "$(for _ in $(seq "$n"); do printf '"%s",' "$t1"; done)"
+            printf '[volume]\nfiles = [%s]\ndensity_scale = 150.0\n\n' "$(files "$n")"
             for c in $(seq "$n"); do
-              printf '[[channel]]\nvisible = %s\n\n' "$([ "$c" = 1 ] && echo true || echo false)"
+              if [ "$layout" = hidden ]; then
+                printf '[[channel]]\nvisible = %s\n\n' "$([ "$c" = 1 ] && echo true || echo false)"
+              else
+                printf '[[channel]]\ntransfer = "mri-layered-%s.toml"\ncolour = [1.0, 1.0, 1.0]\n\n' "$n"
+              fi
             done
           fi
           printf '%b' "$view"
-        } > "$out/channels-$n.toml"
+        } > "$out/channels-$l.toml"
       done
       t0=$(date +%s.%N)
       for run in 1 2 3; do
-        for n in 1 2 4; do
-          "$dvr" profile --scene "$out/channels-$n.toml" --frames 24 --size 256x256 --denoiser ours \
-            --json "$out/channels-$n-$run.json" >/dev/null
+        for l in "${layouts[@]}"; do
+          "$dvr" profile --scene "$out/channels-$l.toml" --frames 24 --size 256x256 --denoiser ours \
+            --json "$out/channels-$l-$run.json" >/dev/null
         done
       done
       secs=$(echo "$(date +%s.%N) - $t0" | bc)
-      python3 - "$out" <<'EOF2'
+      python3 - "$out" "${layouts[@]}" <<'EOF2'
 import csv, json, sys
-out = sys.argv[1]
+out, layouts = sys.argv[1], sys.argv[2:]
 with open("assets/results/channels-cost/profile.csv", "w", newline="") as f:
     w = csv.writer(f)
-    w.writerow(["scene", "channels", "run", "path_trace_ms", "frame_ms"])
+    w.writerow(["scene", "channels", "layout", "run", "path_trace_ms", "frame_ms"])
     for run in (1, 2, 3):
-        for n in (1, 2, 4):
-            p = json.load(open(f"{out}/channels-{n}-{run}.json"))
+        for l in layouts:
+            n, layout = l.split("-")
+            p = json.load(open(f"{out}/channels-{l}-{run}.json"))
             pt = next(x["median_ms"] for x in p["passes"] if x["pass"] == "path_trace")
-            w.writerow(["mni152_t1 / mri-layered", n, run, f"{pt:.3f}", f"{p['total']['median_ms']:.3f}"])
+            w.writerow(["mni152_t1 / mri-layered", n, layout, run, f"{pt:.3f}",
+                        f"{p['total']['median_ms']:.3f}"])
 EOF2
-      meta channels-cost "$out" "$secs" "dvr profile --scene S --frames 24 --size 256x256 --denoiser ours, S = the MNI T1 under mri-layered as one field, and as [volume] files = the same file 2 and 4 times with every channel but the first hidden, alternating, three runs each"
+      meta channels-cost "$out" "$secs" "dvr profile --scene S --frames 24 --size 256x256 --denoiser ours, S = the MNI T1 under mri-layered as one field, and as [volume] files = the same file 2 and 4 times, hidden (every channel but the first hidden) and split (every channel shown, white, under mri-layered with its opacity divided by the channel count), alternating, three runs each"
       ;;
     statmap)
       # The development two-channel head (the T1 and a statistical map over it) under a

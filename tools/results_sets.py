@@ -159,18 +159,28 @@ def b_labels_cost():
 
 
 def b_channels_cost():
-    """The path tracer's cost with 2 and 4 channels against one, run by run."""
+    """The path tracer's cost with 2 and 4 channels against one, run by run, and the
+    mean ratio of each layout over the runs."""
     rows = read_csv("channels-cost", "profile.csv")
     one = {r["run"]: num(r["path_trace_ms"]) for r in rows if r["channels"] == "1"}
-    body = [[r["scene"], r["channels"], r["run"], fmt(num(r["path_trace_ms"]), 1),
-             f"{num(r['path_trace_ms']) / one[r['run']]:.2f}×", fmt(num(r["frame_ms"]), 1)]
-            for r in rows]
+    ratio = lambda r: num(r["path_trace_ms"]) / one[r["run"]]
+    body = [[r["scene"], r["channels"], r["layout"], r["run"], fmt(num(r["path_trace_ms"]), 1),
+             f"{ratio(r):.2f}×", fmt(num(r["frame_ms"]), 1)] for r in rows]
+    layouts = list(dict.fromkeys((r["channels"], r["layout"]) for r in rows if r["channels"] != "1"))
+    means = []
+    for n, layout in layouts:
+        rs = [ratio(r) for r in rows if (r["channels"], r["layout"]) == (n, layout)]
+        means.append([n, layout, f"{sum(rs) / len(rs):.2f}×", f"{max(rs):.2f}×"])
     return "\n".join([
         "Median GPU ms per frame of the path-tracing pass and of the whole frame at 256×256, "
-        "the same view as one field and as 2 and 4 channels with every channel but the first "
-        "hidden (the same image), runs alternating (× is to the same run's one channel):",
+        "the same view as one field and as 2 and 4 channels that make the same medium: "
+        "*hidden*, every channel but the first hidden; *split*, every channel shown under the "
+        "TF with its opacity divided among them. Runs alternate; × is to the same run's one "
+        "channel:",
         "",
-        table(["scene", "channels", "run", "`path_trace`", "× one", "frame"], body),
+        table(["channels", "layout", "mean × one", "largest × one"], means),
+        "",
+        table(["scene", "channels", "layout", "run", "`path_trace`", "× one", "frame"], body),
         "",
         source("channels-cost", ["profile.csv"]),
     ])
