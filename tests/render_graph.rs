@@ -91,6 +91,32 @@ fn history_accumulates_across_frames_and_resets() {
     assert_validation_clean();
 }
 
+/// A history whose first frame writes only its new side (a pass that does not read an
+/// invalid history) is valid on the second frame, though that frame's new side is a
+/// fresh image; a new size makes it invalid again.
+#[test]
+fn a_history_written_once_is_valid_on_the_next_frame() {
+    let ctx = context();
+    let mut graph = RenderGraph::new(&ctx).expect("graph");
+    let desc = ImageDesc::d2(W, H, vk::Format::R32G32B32A32_SFLOAT);
+    let first = graph.history(&ctx, "h", desc).expect("history");
+    assert!(!first.valid, "nothing written yet");
+    let data = vec![[3.0f32, 2.0, 1.0, 1.0]; (W * H) as usize];
+    let mut f = Frame::new();
+    upload(&ctx, &mut graph, &mut f, first.cur, &data);
+    run_frame(&ctx, &mut graph, f);
+    let second = graph.history(&ctx, "h", desc).expect("history");
+    assert!(second.valid, "frame 0 wrote it");
+    assert_eq!(second.prev, first.cur);
+    assert_eq!(read_image(&ctx, &mut graph, second.prev), data);
+    run_frame(&ctx, &mut graph, Frame::new());
+    let bigger = ImageDesc::d2(W * 2, H, vk::Format::R32G32B32A32_SFLOAT);
+    let resized = graph.history(&ctx, "h", bigger).expect("history");
+    assert!(!resized.valid, "a new size holds nothing");
+    graph.destroy(&ctx);
+    assert_validation_clean();
+}
+
 #[test]
 fn undeclared_resources_are_refused_naming_the_pass() {
     let ctx = context();

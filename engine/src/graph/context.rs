@@ -277,6 +277,28 @@ impl<'a> PassContext<'a> {
         Ok(())
     }
 
+    /// Copies all of a declared image (TransferSrc) into a declared image of the same
+    /// shape (TransferDst).
+    pub fn copy_image(&mut self, src: ImageHandle, dst: ImageHandle) -> Result<()> {
+        let (from, to) = (self.image(src)?, self.image(dst)?);
+        let desc = self.graph.image_desc(src);
+        let region = vk::ImageCopy::default()
+            .src_subresource(color_layers())
+            .dst_subresource(color_layers())
+            .extent(extent(desc.extent));
+        unsafe {
+            self.ctx.device.cmd_copy_image(
+                self.cmd,
+                from,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                to,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[region],
+            )
+        };
+        Ok(())
+    }
+
     /// Copies a declared image (TransferSrc) into a declared buffer (TransferDst).
     pub fn copy_image_to_buffer(&mut self, src: ImageHandle, dst: BufferHandle) -> Result<()> {
         let image = self.image(src)?;

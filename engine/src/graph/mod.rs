@@ -153,8 +153,6 @@ impl RenderGraph {
     pub fn history(&mut self, ctx: &GpuContext, name: &str, desc: ImageDesc) -> Result<History> {
         let a = self.image(ctx, &format!("{name}#0"), desc)?;
         let b = self.image(ctx, &format!("{name}#1"), desc)?;
-        let resized =
-            self.images[a.0 as usize].needs_clear || self.images[b.0 as usize].needs_clear;
         let slot = self
             .histories
             .entry(name.to_string())
@@ -164,16 +162,26 @@ impl RenderGraph {
                 valid: false,
                 used: false,
             });
-        if resized {
-            slot.valid = false;
-        }
         slot.used = true;
         let (prev, cur) = if slot.flip { (b, a) } else { (a, b) };
+        // Valid only if `prev` holds what a frame wrote: not a new image (the first
+        // frame, a resize). `cur` is new on the second frame, which is written before
+        // it is read, so it does not matter.
+        if self.images[prev.0 as usize].needs_clear {
+            slot.valid = false;
+        }
         Ok(History {
             prev,
             cur,
             valid: slot.valid,
         })
+    }
+
+    /// Whether `h` holds what an earlier frame wrote: false for an image made (or made
+    /// again at a new size, or after [`RenderGraph::release_unused`]) since.
+    pub fn holds_content(&self, h: ImageHandle) -> bool {
+        let slot = &self.images[h.0 as usize];
+        slot.image.is_allocated() && !slot.needs_clear
     }
 
     /// The image named `name` as this frame writes it: a history's `cur`, or the image of

@@ -54,6 +54,19 @@ impl AuxFeatures {
         })
     }
 
+    /// The guide images the pass writes: (albedo, normal).
+    pub fn images(
+        ctx: &GpuContext,
+        graph: &mut RenderGraph,
+        size: Extent,
+    ) -> Result<(ImageHandle, ImageHandle)> {
+        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
+        Ok((
+            graph.image(ctx, ALBEDO, desc)?,
+            graph.image(ctx, NORMAL, desc)?,
+        ))
+    }
+
     /// Adds the pass; returns (albedo: rgb, a opacity; normal: xyz world, w opacity).
     /// Without `normals` the normal image holds zero and the opacity. The same march
     /// writes the surface features into `features`.
@@ -68,9 +81,7 @@ impl AuxFeatures {
         normals: bool,
         features: FeatureImages,
     ) -> Result<(ImageHandle, ImageHandle)> {
-        let desc = ImageDesc::d2(size.width, size.height, vk::Format::R32G32B32A32_SFLOAT);
-        let albedo = graph.image(ctx, ALBEDO, desc)?;
-        let normal = graph.image(ctx, NORMAL, desc)?;
+        let (albedo, normal) = Self::images(ctx, graph, size)?;
         let push = AuxFeaturesPush {
             width: size.width,
             height: size.height,

@@ -6,6 +6,7 @@
 pub mod brick_pool;
 mod inputs;
 pub mod labels;
+mod march;
 pub mod medium;
 pub mod packing;
 pub mod present;
@@ -37,13 +38,14 @@ use crate::passes::aux_features::{self, AuxFeatures};
 use crate::passes::motion::Motion;
 use crate::passes::path_trace::{PathTrace, PathTraceFeatures, VolumeLayout};
 use crate::passes::present::Present;
-use crate::passes::surface_features::{FeatureImages, SurfaceFeatures};
+use crate::passes::surface_features::SurfaceFeatures;
 use crate::scene::RenderSettings;
 use crate::shaders::frame::{ChannelOpacity, FrameBlock, SampleStream};
 use ash::vk;
 pub use brick_pool::VolumeResidency;
 use brick_pool::{Residency, VolumePath};
 use gpu_allocator::MemoryLocation;
+use march::{MarchKey, MarchPass};
 pub use present::{Overlay, PresentTarget, Screenshot};
 use scene_gpu::SceneImages;
 use std::sync::Arc;
@@ -186,6 +188,8 @@ pub struct Renderer {
     /// Several channels: their opacity under `current_lut`, for the frame block.
     channel_opacity: Box<ChannelOpacity>,
     last_inputs: Option<FrameInputs>,
+    /// What the feature images hold (`None`: unknown, march again).
+    last_march: Option<MarchKey>,
     slots: Vec<Slot>,
     pool: vk::CommandPool,
     frame_index: u64,
@@ -341,6 +345,7 @@ impl Renderer {
             majorant_max: 0.0,
             channel_opacity: Box::default(),
             last_inputs: None,
+            last_march: None,
             slots,
             pool,
             frame_index: 0,
@@ -488,28 +493,37 @@ impl Renderer {
         let motion = self.config.motion_source;
         let feature_readers = readers(&self.denoisers, |m| m.info.features.needed(motion));
         let want_features = request.features || !feature_readers.is_empty();
-        let (features, aux) = match &passes.aux {
-            Some(pass) if request.aux || guides => {
-                let mut owners = feature_readers;
-                for m in guide_readers {
-                    if !owners.contains(&m) {
-                        owners.push(m);
-                    }
-                }
-                let images = FeatureImages::new(ctx, graph, size)?;
-                let aux = frame.add_for(PassOwner::Methods(owners), |f| {
-                    pass.add(ctx, graph, f, &scene, size, request.aux, images)
-                })?;
-                (want_features.then_some(images), Some(aux))
-            }
-            _ if want_features => {
-                let owner = PassOwner::Methods(feature_readers);
-                let images =
-                    frame.add_for(owner, |f| passes.features.add(ctx, graph, f, &scene, size))?;
-                (Some(images), None)
-            }
-            _ => (None, None),
+        let pass = match &passes.aux {
+            Some(_) if request.aux || guides => Some(MarchPass::Guides {
+                normals: request.aux,
+            }),
+            _ if want_features => Some(MarchPass::Surface),
+            _ => None,
         };
+        let mut owners = feature_readers;
+        if matches!(pass, Some(MarchPass::Guides { .. })) {
+            for m in guide_readers {
+                if !owners.contains(&m) {
+                    owners.push(m);
+                }
+            }
+        }
+        let march = march::MarchRequest {
+            pass,
+            owner: PassOwner::Methods(owners),
+            features: want_features,
+        };
+        let (features, aux) = march::add(
+            ctx,
+            graph,
+            &mut frame,
+            passes,
+            &scene,
+            size,
+            march,
+            inputs,
+            &mut self.last_march,
+        )?;
         let noisy = passes.path_trace.add(
             ctx,
             graph,

@@ -240,6 +240,8 @@ impl Renderer {
             self.table_dirty = true;
         }
         if std::mem::take(&mut self.table_dirty) {
+            // Bricks landed: the medium the features march sees changed.
+            self.last_march = None;
             let table = r.table();
             let image = self.scene.brick_table;
             let bytes = bytemuck::cast_slice(&table);
