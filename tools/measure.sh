@@ -6,7 +6,7 @@
 #
 #   tools/measure.sh SET [SET ...]     SET: demo static development validation paper
 #                                           suite cost rae cuts cut-cost labels
-#                                           labels-cost channels-cost statmap
+#                                           labels-cost channels-cost statmap interaction
 #
 # Needs a release build (cargo build --release). The eval sets also add Intel OIDN with
 # tools/oidn_eval.py, which needs a Python with the dvr package, pyoidn, numpy, OpenEXR
@@ -282,6 +282,18 @@ with open("assets/results/channels-cost/profile.csv", "w", newline="") as f:
                         f"{p['total']['median_ms']:.3f}"])
 EOF2
       meta channels-cost "$out" "$secs" "dvr profile --scene S --frames 24 --size 256x256 --denoiser ours, S = the MNI T1 under mri-layered as one field, and as [volume] files = the same file 2 and 4 times, hidden (every channel but the first hidden) and split (every channel shown, white, under mri-layered with its opacity divided by the channel count), alternating, three runs each"
+      ;;
+    interaction)
+      # The frozen interaction set (drags, a zoom, a window drag, a light drag, cold
+      # opens) with the development and validation cut scenes, every method ours is
+      # judged against, and OIDN.
+      cuts=assets/scenes/development/mri-clip-sweep.toml,assets/scenes/development/phantom-clip-toggle.toml,assets/scenes/development/phantom-crop-shrink.toml,assets/scenes/validation/cloud-oblique-clip-light.toml
+      args=(--scene "interaction,$cuts" --size 128x128 --ref-spp 256 --aux
+        --denoiser none,taa,svgf,ours,rae)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      oidn "$out"
+      KEEP_METRICS=1 keep interaction "$out"
+      meta interaction "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
     statmap)
       # The development two-channel head (the T1 and a statistical map over it) under a

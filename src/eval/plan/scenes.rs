@@ -13,8 +13,15 @@ pub const STRESS_ANIMATIONS: [&str; 3] = ["tf-jump", "light-jump", "fast-orbit"]
 /// frozen validation set (48 frames of continuous change each, never tuned on), the
 /// development scenes beside the suite (kinds of change the built-ins lack, tuned on
 /// with it), the static views, and `paper`, the TVCG paper's conditions (ray marching,
-/// single scattering with the hybrid phase, emission, one animation type per scene).
-pub const FILE_SETS: [&str; 4] = ["validation", "development", "static", "paper"];
+/// single scattering with the hybrid phase, emission, one animation type per scene), and
+/// the frozen interaction set (drags at the speeds people drag, let go, and cold opens).
+pub const FILE_SETS: [&str; 5] = [
+    "validation",
+    "development",
+    "static",
+    "paper",
+    "interaction",
+];
 
 /// The scene files of a shipped set, sorted by file name.
 fn set_files(set: &str) -> Result<Vec<String>> {
@@ -162,6 +169,7 @@ mod tests {
             ("development", "dev/", 1),
             ("static", "static/", 2),
             ("paper", "paper/", 5),
+            ("interaction", "int/", 7),
         ];
         assert_eq!(sets.map(|(set, _, _)| set), FILE_SETS);
         for (set, prefix, least) in sets {

@@ -21,7 +21,8 @@ pub const GPU_WARMUP_FRAMES: usize = crate::profile::WARMUP_FRAMES;
 pub struct EvalArgs {
     /// `suite` (every built-in scene but the stress ones), `stress` (the tf-jump,
     /// light-jump and fast-orbit scenes), a shipped set (`validation`, `development`,
-    /// `static`, `paper`: `assets/scenes/<set>/`), or a comma-separated list of these,
+    /// `static`, `paper`, `interaction`: `assets/scenes/<set>/`), or a comma-separated
+    /// list of these,
     /// built-in scene names and scene files.
     #[arg(long, default_value = "suite")]
     pub scene: String,
