@@ -7,7 +7,7 @@
 mod common;
 
 use common::*;
-use dvr_engine::gpu::timestamps::PassTiming;
+use dvr_engine::gpu::timestamps::{PassOwner, PassTiming};
 use dvr_engine::renderer::{FrameInputs, FrameRequest, FrameResult, Renderer, FEATURE_IMAGES};
 use dvr_engine::scene::{ClipPlane, Cut};
 use dvr_engine::volume::{Volume, VolumeData};
@@ -96,12 +96,24 @@ fn the_march_runs_only_when_what_it_reads_changed() {
             .renderer(context(), methods)
             .expect("renderer");
         let done = run(&mut r, &frames);
+        // The copy that keeps the march is owned as the march is (the methods that read
+        // it: each one's cost), not a transfer.
+        let owner = |d: &FrameResult, passes: &[&str]| {
+            d.timings
+                .iter()
+                .find(|t| passes.contains(&t.pass.as_str()))
+                .map(|t| t.owner.clone())
+        };
+        let march_owner = owner(&done[0], &MARCHES).expect("frame 0 marches");
+        assert_ne!(march_owner, PassOwner::Transfer);
         for (f, (d, &march)) in done.iter().zip(&expect).enumerate() {
             assert_eq!(
                 (marched(&d.timings), kept(&d.timings)),
                 (march, !march),
                 "{methods:?} frame {f}: march expected {march}"
             );
+            let own = owner(d, &["features.kept", MARCHES[0], MARCHES[1]]);
+            assert_eq!(own.as_ref(), Some(&march_owner), "{methods:?} frame {f}");
         }
         // A kept frame's images (features and methods) are those of a renderer whose
         // first frame marched them, given the same history of inputs: here, the

@@ -156,6 +156,21 @@ impl<'f> Frame<'f> {
         self.push(name.into(), b.accesses, Vec::new(), Some(Box::new(record)));
     }
 
+    /// [`Frame::add_pass`] for a copy that stands in for rendering work (a kept march's
+    /// history copied forward): it counts for the frame's owner, not as a transfer.
+    pub fn add_copy_as_work(
+        &mut self,
+        name: impl Into<String>,
+        declare: impl FnOnce(&mut PassBuilder),
+        record: impl FnOnce(&mut PassContext) -> Result<()> + 'f,
+    ) {
+        let start = self.passes.len();
+        self.add_pass(name, declare, record);
+        for pass in &mut self.passes[start..] {
+            pass.owner = self.owner.clone();
+        }
+    }
+
     /// Adds a compute pass: one dispatch of `pipeline` over `grid` invocations (an
     /// [`Extent`] for a full-screen pass; workgroups from the shader's local size), with
     /// `push` as its push constants and every shader variable bound as `declare` says.

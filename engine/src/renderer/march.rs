@@ -100,7 +100,7 @@ pub(super) fn add(
     let features = request.features.then_some(images);
     if held && last.as_ref() == Some(&key) {
         frame.add_for(request.owner, |f| {
-            f.add_pass(
+            f.add_copy_as_work(
                 "features.kept",
                 |b| {
                     b.transfer_src(position.prev).transfer_dst(position.cur);
