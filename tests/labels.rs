@@ -9,7 +9,7 @@ use common::*;
 use dvr_engine::renderer::scene_setup::SceneSetup;
 use dvr_engine::renderer::{FrameRequest, LabelLookRef, FEATURE_IMAGES};
 use dvr_engine::scene::{Estimator, LabelMode};
-use dvr_engine::volume::labels::{LabelLook, LabelMap, Look, SMOOTHING_SIGMA};
+use dvr_engine::volume::labels::{EmptySpace, LabelLook, LabelMap, Look, SMOOTHING_SIGMA};
 use dvr_engine::volume::PatientTransform;
 use std::sync::Arc;
 
@@ -96,9 +96,9 @@ fn hidden_ball(fit_to_medium: bool) -> (f32, usize) {
     s.config.labels = Some(LabelMode::Tint);
     s.settings.set_filter_sigma(0.0).expect("pinhole");
     let of = |v: u16| if v == 1 { HIDDEN } else { SHOWN };
-    let zero = volume.zero_voxels().expect("dense");
+    let zero = EmptySpace::new(&ball, volume.zero_voxels().expect("dense")).expect("one grid");
     let shape = LabelLook::shape_of(&ball, of);
-    let empty = fit_to_medium.then_some(zero.as_slice());
+    let empty = fit_to_medium.then_some(&zero);
     let labels = LabelLookRef(Arc::new(LabelLook::with_shape(
         &ball, of, n, [1; 3], shape, empty,
     )));
@@ -189,7 +189,7 @@ fn a_map_of_one_visible_label_with_a_unit_tint_renders_the_frames_of_no_map() {
     let fitted = phantom_frames(Some(LabelMode::Tint), |s| {
         let v = &s.volume;
         let m = map(v.dims, |_, _, _| 7);
-        let zero = v.zero_voxels().expect("dense");
+        let zero = EmptySpace::new(&m, v.zero_voxels().expect("dense")).expect("one grid");
         let shape = LabelLook::shape_of(&m, |_| SHOWN);
         let l = LabelLook::with_shape(
             &m,
@@ -633,7 +633,8 @@ fn an_opacity_edit_reuses_the_shape_and_looks_as_one_made_afresh() {
     let of = |value| dvr_engine::scene::labels::look_of(&v, mode, value);
     // ct-bone is transparent at 0, so the phantom's empty voxels are fitted.
     assert!(lut.transparent_at_zero(1));
-    let zero = setup.volume.zero_voxels().expect("dense");
+    let zero =
+        EmptySpace::new(&labels.map, setup.volume.zero_voxels().expect("dense")).expect("one grid");
     let afresh = LabelLook::with_shape(
         &labels.map,
         of,

@@ -8,7 +8,7 @@ use super::uploads::VolumeUpload;
 use crate::scene::labels::{look_of, unlabelled};
 use crate::scene::{LabelMode, LabelView, Scene};
 use crate::transfer::TfLut;
-use crate::volume::labels::{LabelLook, LabelMap, LabelTable};
+use crate::volume::labels::{EmptySpace, LabelLook, LabelMap, LabelTable};
 use crate::volume::{PatientTransform, VolumeError};
 use glam::Vec3;
 use std::sync::{Arc, Mutex};
@@ -21,7 +21,7 @@ pub struct SceneLabels {
     grid: [u32; 3],
     /// Tint mode: the voxels whose fields are all 0 (the first time point's, for a
     /// series), which hold no medium under a TF transparent at 0.
-    zero: Option<Vec<bool>>,
+    zero: Option<EmptySpace>,
     channels: usize,
     cache: Mutex<Option<(LookKey, Arc<LabelLook>)>>,
 }
@@ -136,15 +136,16 @@ pub fn load(
             });
         }
     }
+    let zero = match spec.mode {
+        LabelMode::Tint => volume.zero_voxels().and_then(|z| EmptySpace::new(&map, z)),
+        LabelMode::Solid => None,
+    };
     let labels = SceneLabels {
         map,
         mode: spec.mode,
         brick: volume.bricks.brick,
         grid: volume.bricks.grid,
-        zero: match spec.mode {
-            LabelMode::Tint => volume.zero_voxels(),
-            LabelMode::Solid => None,
-        },
+        zero,
         channels: volume.channels() as usize,
         cache: Mutex::new(None),
     };
@@ -226,7 +227,7 @@ impl SceneLabels {
             Some((_, last)) if same_shown => last.shape.clone(),
             _ => LabelLook::shape_of(&self.map, of),
         };
-        let empty = self.zero.as_deref().filter(|_| zero_is_empty);
+        let empty = self.zero.as_ref().filter(|_| zero_is_empty);
         let look = Arc::new(LabelLook::with_shape(
             &self.map, of, self.brick, self.grid, shape, empty,
         ));

@@ -7,7 +7,7 @@ mod look;
 mod ome;
 mod table;
 
-pub use look::{LabelLook, Look, SMOOTHING_SIGMA};
+pub use look::{EmptySpace, LabelLook, Look, SMOOTHING_SIGMA};
 pub use ome::{first_label_image, image_label_table};
 pub use table::{Label, LabelTable, PALETTE};
 

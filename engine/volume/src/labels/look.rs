@@ -117,14 +117,14 @@ impl LabelLook {
 
     /// [`LabelLook::new`] that takes `shape` as it is: the shape of a look that shows the
     /// same labels (a colour or opacity edit leaves it, and filtering is most of the
-    /// work). `empty` marks the voxels that hold no medium (see the module's notes).
+    /// work). `empty`: the voxels that hold no medium (see the module's notes).
     pub fn with_shape(
         map: &LabelMap,
         look: impl Fn(u16) -> Look,
         brick: u32,
         grid: [u32; 3],
         shape: Arc<Vec<u8>>,
-        empty: Option<&[bool]>,
+        empty: Option<&EmptySpace>,
     ) -> Self {
         let mut table = vec![None; super::MAX_LABEL as usize + 1];
         let rgba: Vec<[u8; 4]> = map
@@ -133,12 +133,15 @@ impl LabelLook {
             .map(|&v| {
                 let l: Look = *table[usize::from(v)].get_or_insert_with(|| look(v));
                 let [r, g, b] = l.colour;
-                let mask = if l.visible { l.opacity } else { 0.0 };
-                [unorm(r), unorm(g), unorm(b), unorm(mask)]
+                [unorm(r), unorm(g), unorm(b), mask_of(&l)]
             })
             .collect();
         let rgba = match empty {
-            Some(empty) if empty.len() == rgba.len() => fit_to_medium(rgba, empty, map.dims),
+            Some(space) if space.empty.len() == rgba.len() => {
+                // Every label in a border list is in the map, so its look is in the table.
+                let mask = |l: u16| table[usize::from(l)].map_or(0, |l: Look| mask_of(&l));
+                fit_to_medium(rgba, space, mask)
+            }
             _ => rgba,
         };
         let brick_max = brick_maxima(&rgba, map.dims, brick, grid);
@@ -153,36 +156,95 @@ impl LabelLook {
     }
 }
 
-/// Each empty voxel's mask becomes the lowest of its non-empty 26 neighbours' (0 with
-/// none): the only cells it shares are with them.
-fn fit_to_medium(mut rgba: Vec<[u8; 4]>, empty: &[bool], dims: [u32; 3]) -> Vec<[u8; 4]> {
-    let [nx, ny, nz] = dims.map(|d| d as usize);
-    let mask: Vec<u8> = rgba.iter().map(|t| t[3]).collect();
-    let slice = nx * ny;
-    rgba.par_chunks_mut(slice)
-        .enumerate()
-        .for_each(|(z, plane)| {
-            for (o, texel) in plane.iter_mut().enumerate() {
-                let i = z * slice + o;
-                if !empty[i] {
-                    continue;
-                }
-                let (x, y) = (o % nx, o / nx);
-                let mut lowest: Option<u8> = None;
-                for zz in z.saturating_sub(1)..(z + 2).min(nz) {
-                    for yy in y.saturating_sub(1)..(y + 2).min(ny) {
-                        for xx in x.saturating_sub(1)..(x + 2).min(nx) {
-                            let j = zz * slice + yy * nx + xx;
-                            if !empty[j] {
-                                lowest = Some(lowest.map_or(mask[j], |m| m.min(mask[j])));
+/// The voxels that hold no medium (see the module's notes), and of those the ones beside
+/// tissue, each with the labels of its non-empty 26 neighbours: what a look's empty
+/// voxels take their mask from. Found once per map and volume, so a look made again
+/// (every frame of a label's fade) reads a list instead of every empty voxel's
+/// neighbours.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EmptySpace {
+    empty: Vec<bool>,
+    /// Empty voxels with a non-empty neighbour; `border[k]`'s neighbours' labels are
+    /// `labels[offsets[k]..offsets[k + 1]]`, each once.
+    border: Vec<u32>,
+    offsets: Vec<u32>,
+    labels: Vec<u16>,
+}
+
+impl EmptySpace {
+    /// `empty`: per voxel of `map`, whether it holds no medium. `None` when the lengths
+    /// differ.
+    pub fn new(map: &LabelMap, empty: Vec<bool>) -> Option<Self> {
+        if empty.len() != map.values.len() {
+            return None;
+        }
+        let [nx, ny, nz] = map.dims.map(|d| d as usize);
+        let slice = nx * ny;
+        // Per z plane: (voxel, its neighbours' labels) of the plane's border voxels.
+        let planes: Vec<Vec<(u32, Vec<u16>)>> = (0..nz)
+            .into_par_iter()
+            .map(|z| {
+                let mut out = Vec::new();
+                for o in 0..slice {
+                    let i = z * slice + o;
+                    if !empty[i] {
+                        continue;
+                    }
+                    let (x, y) = (o % nx, o / nx);
+                    let mut labels: Vec<u16> = Vec::new();
+                    for zz in z.saturating_sub(1)..(z + 2).min(nz) {
+                        for yy in y.saturating_sub(1)..(y + 2).min(ny) {
+                            for xx in x.saturating_sub(1)..(x + 2).min(nx) {
+                                let j = zz * slice + yy * nx + xx;
+                                if !empty[j] && !labels.contains(&map.values[j]) {
+                                    labels.push(map.values[j]);
+                                }
                             }
                         }
                     }
+                    if !labels.is_empty() {
+                        out.push((i as u32, labels));
+                    }
                 }
-                texel[3] = lowest.unwrap_or(0);
-            }
-        });
+                out
+            })
+            .collect();
+        let mut space = Self {
+            empty,
+            border: Vec::new(),
+            offsets: vec![0],
+            labels: Vec::new(),
+        };
+        for (voxel, labels) in planes.into_iter().flatten() {
+            space.border.push(voxel);
+            space.labels.extend(labels);
+            space.offsets.push(space.labels.len() as u32);
+        }
+        Some(space)
+    }
+}
+
+/// Each empty voxel's mask becomes the lowest of its non-empty 26 neighbours' (0 with
+/// none): the only cells it shares are with them. `mask` is a label's mask.
+fn fit_to_medium(
+    mut rgba: Vec<[u8; 4]>,
+    space: &EmptySpace,
+    mask: impl Fn(u16) -> u8,
+) -> Vec<[u8; 4]> {
+    rgba.par_iter_mut()
+        .zip(space.empty.par_iter())
+        .filter(|(_, &e)| e)
+        .for_each(|(texel, _)| texel[3] = 0);
+    for (k, &voxel) in space.border.iter().enumerate() {
+        let labels = &space.labels[space.offsets[k] as usize..space.offsets[k + 1] as usize];
+        rgba[voxel as usize][3] = labels.iter().map(|&l| mask(l)).min().unwrap_or(0);
+    }
     rgba
+}
+
+/// A label's mask: its opacity where shown, 0 where hidden.
+fn mask_of(l: &Look) -> u8 {
+    unorm(if l.visible { l.opacity } else { 0.0 })
 }
 
 fn unorm(x: f32) -> u8 {

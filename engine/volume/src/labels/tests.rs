@@ -228,3 +228,78 @@ fn an_oblique_label_map_is_refused_rather_than_interpolated() {
         "{msg}"
     );
 }
+
+/// Empty voxels take the lowest mask among their non-empty 26 neighbours (0 with none),
+/// from the border list made once: checked against each neighbourhood read directly,
+/// on a map of three labels with empty space in and around them, as labels hide and
+/// fade.
+#[test]
+fn empty_voxels_take_their_tissue_neighbours_lowest_mask() {
+    let dims = [13u32, 11, 9];
+    let n = (dims[0] * dims[1] * dims[2]) as usize;
+    // A fixed pseudo-random map: labels 0–3, a third of the voxels empty.
+    let mut state = 0x9e37_79b9u32;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state
+    };
+    let values: Vec<u16> = (0..n).map(|_| (next() % 4) as u16).collect();
+    let empty: Vec<bool> = (0..n).map(|_| next() % 3 == 0).collect();
+    let map = LabelMap {
+        name: "random".into(),
+        path: "random.nii".into(),
+        dims,
+        to_patient: crate::orientation::PatientTransform::aligned([1.0; 3]),
+        values,
+    };
+    let space = EmptySpace::new(&map, empty.clone()).expect("same length");
+    let [nx, ny, nz] = dims.map(|d| d as usize);
+    for (hidden, fade) in [(None, 1.0), (Some(2u16), 1.0), (Some(1), 0.4), (None, 0.0)] {
+        let look = |v: u16| Look {
+            colour: [0.5, 0.25, 1.0],
+            opacity: if v == 3 { fade } else { 0.8 },
+            visible: Some(v) != hidden,
+        };
+        let mask = |v: u16| {
+            let l = look(v);
+            ((if l.visible { l.opacity } else { 0.0 }) * 255.0).round() as u8
+        };
+        let shape = LabelLook::shape_of(&map, look);
+        let got = LabelLook::with_shape(&map, look, 4, [4, 3, 3], shape, Some(&space));
+        for z in 0..nz {
+            for y in 0..ny {
+                for x in 0..nx {
+                    let i = (z * ny + y) * nx + x;
+                    let want = if !empty[i] {
+                        mask(map.values[i])
+                    } else {
+                        let mut lowest: Option<u8> = None;
+                        for zz in z.saturating_sub(1)..(z + 2).min(nz) {
+                            for yy in y.saturating_sub(1)..(y + 2).min(ny) {
+                                for xx in x.saturating_sub(1)..(x + 2).min(nx) {
+                                    let j = (zz * ny + yy) * nx + xx;
+                                    if !empty[j] {
+                                        let m = mask(map.values[j]);
+                                        lowest = Some(lowest.map_or(m, |l| l.min(m)));
+                                    }
+                                }
+                            }
+                        }
+                        lowest.unwrap_or(0)
+                    };
+                    assert_eq!(
+                        got.rgba[i][3], want,
+                        "voxel {x},{y},{z} (empty {}), hidden {hidden:?}, fade {fade}",
+                        empty[i]
+                    );
+                }
+            }
+        }
+    }
+    assert!(
+        EmptySpace::new(&map, vec![true; 3]).is_none(),
+        "a mis-sized mask"
+    );
+}
