@@ -65,6 +65,7 @@ from results_sets import (
     b_labels,
     b_labels_line,
     b_labels_cost,
+    b_interaction,
 )
 from results_experiments import b_experiments_prior, b_experiments_strata
 
@@ -573,6 +574,7 @@ BLOCKS = {
     "labels-line": (b_labels_line, ["labels/summary.csv", "labels/metrics.csv",
                                     "labels/meta.json"]),
     "labels-cost": (b_labels_cost, ["labels-cost/profile.csv"]),
+    "interaction": (b_interaction, ["interaction/metrics.csv", "interaction/meta.json"]),
     "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv",
                                                 "validation/metrics.csv"]),
     "experiments-strata": (b_experiments_strata, ["experiments-strata/*.csv",
