@@ -177,6 +177,13 @@ impl RenderGraph {
         })
     }
 
+    /// Keeps `h` as a frame that used it would: [`RenderGraph::release_unused`] counts
+    /// this frame as one that did (images a frame keeps for later frames without a pass
+    /// touching them, as a kept features march's).
+    pub fn retain(&mut self, h: ImageHandle) {
+        self.images[h.0 as usize].used_in = self.frames_ended;
+    }
+
     /// Whether `h` holds what an earlier frame wrote: false for an image made (or made
     /// again at a new size, or after [`RenderGraph::release_unused`]) since.
     pub fn holds_content(&self, h: ImageHandle) -> bool {

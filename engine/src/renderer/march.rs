@@ -99,6 +99,13 @@ pub(super) fn add(
             .all(|h| graph.holds_content(h));
     let features = request.features.then_some(images);
     if held && last.as_ref() == Some(&key) {
+        // No pass may touch them this frame: they must not be released as unused.
+        for h in [images.normal, images.albedo]
+            .into_iter()
+            .chain(guides.into_iter().flat_map(|(a, n)| [a, n]))
+        {
+            graph.retain(h);
+        }
         frame.add_for(request.owner, |f| {
             f.add_copy_as_work(
                 "features.kept",
