@@ -43,7 +43,18 @@ pub(super) struct MarchKey {
 }
 
 impl MarchKey {
-    pub(super) fn new(pass: MarchPass, inputs: &FrameInputs) -> Self {
+    /// Whether a march of `pass` with `inputs` reads what this one read (compared in
+    /// place: the LUT is cloned only when a march runs).
+    fn matches(&self, pass: MarchPass, inputs: &FrameInputs) -> bool {
+        self.pass == pass
+            && self.camera == inputs.camera
+            && self.lut == inputs.lut
+            && self.cut == inputs.cut
+            && self.time == inputs.time
+            && self.labels == inputs.labels
+    }
+
+    fn new(pass: MarchPass, inputs: &FrameInputs) -> Self {
         Self {
             pass,
             camera: inputs.camera,
@@ -90,7 +101,6 @@ pub(super) fn add(
         MarchPass::Guides { .. } => Some(AuxFeatures::images(ctx, graph, size)?),
         MarchPass::Surface => None,
     };
-    let key = MarchKey::new(pass, inputs);
     let position = images.position;
     let held = position.valid
         && [position.prev, images.normal, images.albedo]
@@ -98,7 +108,7 @@ pub(super) fn add(
             .chain(guides.into_iter().flat_map(|(a, n)| [a, n]))
             .all(|h| graph.holds_content(h));
     let features = request.features.then_some(images);
-    if held && last.as_ref() == Some(&key) {
+    if held && last.as_ref().is_some_and(|k| k.matches(pass, inputs)) {
         // No pass may touch them this frame: they must not be released as unused.
         for h in [images.normal, images.albedo]
             .into_iter()
@@ -117,7 +127,7 @@ pub(super) fn add(
         });
         return Ok((features, guides));
     }
-    *last = Some(key);
+    *last = Some(MarchKey::new(pass, inputs));
     let guides = frame.add_for(request.owner, |f| match (pass, &passes.aux) {
         (MarchPass::Guides { normals }, Some(aux)) => aux
             .add(ctx, graph, f, scene, size, normals, images)
