@@ -73,8 +73,8 @@ def test_any_array_is_a_volume_or_a_named_refusal(a, spacing):
         refused(e, "array", "spacing", "dtype", "shape", "voxels")
         return
     # Accepted: a 3-D array (or [c, z, y, x] channels, at most 4) of a volume type,
-    # densities in [0, 1] and finite.
-    assert a.ndim in (3, 4) and a.dtype in (np.uint8, np.uint16, np.int16, np.float32)
+    # densities in [0, 1] and finite (float64 arrays are volumes too).
+    assert a.ndim in (3, 4) and a.dtype in (np.uint8, np.uint16, np.int16, np.float32, np.float64)
     if a.ndim == 4:
         assert v.channels == a.shape[0] <= 4 and v.times == 1
     d = v.to_numpy()
