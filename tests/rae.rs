@@ -9,7 +9,7 @@ mod common;
 
 use common::harness::Harness;
 use common::*;
-use dvr_engine::denoise::rae::{network_for, Precision, RaeWeights};
+use dvr_engine::denoise::rae::{network_for, Precision, RaeNet, RaeWeights};
 use dvr_engine::denoise::{registry, DENOISERS};
 use std::path::{Path, PathBuf};
 
@@ -92,7 +92,7 @@ fn shaders_match_torch_on_a_clip() {
         let name = DENOISERS
             .iter()
             // The harness builds denoisers for no dataset: the entry that runs `net` then.
-            .find(|d| d.rae_network(None) == Some((net, Precision::F32)))
+            .find(|d| d.variant::<RaeNet>().map(|r| r.network(None)) == Some((net, Precision::F32)))
             .map(|d| d.name)
             .unwrap();
         let (worst, _) = difference_from_torch(name, net);
@@ -109,7 +109,8 @@ fn shaders_match_torch_on_a_clip() {
 #[test]
 fn fp16_tensors_stay_close_to_torch() {
     let fp16 = registry::find("rae-fp16").expect("in the registry");
-    assert_eq!(fp16.rae_network(None), Some(("mri", Precision::F16)));
+    let fp16 = fp16.variant::<RaeNet>().map(|r| r.network(None));
+    assert_eq!(fp16, Some(("mri", Precision::F16)));
     let (worst, peak) = difference_from_torch("rae-fp16", "mri");
     assert!(
         worst < F16_TOLERANCE * peak.max(1.0),
@@ -126,7 +127,8 @@ fn shipped_weights_load() {
     assert_eq!(picked, ["phantom", "mri", "mri", "mri"]);
     let named = DENOISERS
         .iter()
-        .filter_map(|d| d.rae_network(None))
+        .filter_map(|d| d.variant::<RaeNet>())
+        .map(|r| r.network(None))
         .map(|(net, _)| net);
     for net in named.chain(picked) {
         let w = RaeWeights::builtin(net).unwrap_or_else(|e| panic!("{net}: {e}"));

@@ -9,19 +9,13 @@
 
 mod common;
 
-use ash::vk;
 use common::*;
 use dvr_engine::denoise::svgf::{edge, SvgfParams};
-use dvr_engine::denoise::{self, Changes, DenoiseInputs, Denoiser};
-use dvr_engine::gpu::{GpuContext, ImageDesc};
-use dvr_engine::graph::Extent;
-use dvr_engine::graph::{Frame, History, ImageHandle, RenderGraph};
-use dvr_engine::passes::surface_features::{FeatureImages, STEP_VOXELS};
-use dvr_engine::renderer::scene_gpu::add_upload;
+use dvr_engine::denoise::Changes;
+use dvr_engine::passes::surface_features::STEP_VOXELS;
 use dvr_engine::renderer::FrameRequest;
 use dvr_engine::shaders::frame::FrameBlock;
 use glam::{IVec4, Vec3, Vec4};
-use gpu_allocator::MemoryLocation;
 
 const W: usize = 32;
 const H: usize = 24;
@@ -97,87 +91,23 @@ fn noisy(s: &Scene, seed: u64) -> Vec<Px> {
 }
 
 // ---------------------------------------------------------------------------------------
-// One denoiser on uploaded inputs, outside the renderer.
+// One denoiser on the scene's frames, outside the renderer.
 
 struct Harness {
-    ctx: GpuContext,
-    graph: RenderGraph,
-    denoiser: Box<dyn Denoiser>,
+    harness: harness::Harness,
     scene: Scene,
-    desc: ImageDesc,
 }
 
 impl Harness {
     fn new(name: &str) -> Self {
-        let ctx = context();
-        let graph = RenderGraph::new(&ctx).expect("graph");
-        let denoiser =
-            denoise::registry::create(&ctx, name, &Default::default()).expect("denoiser");
         Self {
-            ctx,
-            graph,
-            denoiser,
+            harness: harness::Harness::new(name, W as u32, H as u32),
             scene: scene(),
-            desc: ImageDesc::d2(W as u32, H as u32, vk::Format::R32G32B32A32_SFLOAT),
         }
-    }
-
-    fn upload(&mut self, f: &mut Frame<'_>, name: &str, image: ImageHandle, px: &[Px]) {
-        add_upload(
-            &self.ctx,
-            &mut self.graph,
-            f,
-            name,
-            image,
-            bytemuck::cast_slice(px),
-        )
-        .expect("upload");
-    }
-
-    fn history(&mut self, f: &mut Frame<'_>, name: &str, px: &[Px]) -> History {
-        let h = self
-            .graph
-            .history(&self.ctx, name, self.desc)
-            .expect("history");
-        self.upload(f, &format!("upload_{name}"), h.cur, px);
-        h
-    }
-
-    /// Fills both images of the history `name` with `px` (without ending a frame, so
-    /// the next step sees the same pair and the same `valid`).
-    fn poison_history(&mut self, name: &str, px: &[Px]) {
-        let h = self
-            .graph
-            .history(&self.ctx, name, self.desc)
-            .expect("history");
-        let mut f = Frame::new();
-        self.upload(&mut f, &format!("poison_{name}_prev"), h.prev, px);
-        self.upload(&mut f, &format!("poison_{name}_cur"), h.cur, px);
-        let graph = &mut self.graph;
-        let ctx = &self.ctx;
-        ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
-            .expect("submit");
-    }
-
-    fn reset(&mut self, prefix: &str) {
-        self.graph.reset_history(prefix);
     }
 
     /// Feeds one noisy frame of the static scene; returns the denoiser's output.
     fn step(&mut self, noisy: &[Px]) -> Vec<Px> {
-        let n = W * H;
-        let ctx = &self.ctx;
-        let g = &mut self.graph;
-        let image = |g: &mut RenderGraph, name: &str| g.image(ctx, name, self.desc).expect("image");
-        let noisy_img = image(g, "t.noisy");
-        let moments_img = image(g, "t.moments");
-        let normal_img = image(g, "t.normal");
-        let albedo_img = image(g, "t.albedo");
-        let motion_img = image(g, "t.motion");
-        let size = std::mem::size_of::<FrameBlock>() as u64;
-        let ubo = g
-            .buffer(ctx, "t.uniforms", size, MemoryLocation::CpuToGpu)
-            .expect("buffer");
         let mut u: FrameBlock = bytemuck::Zeroable::zeroed();
         u.box_min = Vec4::new(-0.5, -0.5, -0.5, 1.0);
         u.box_max = Vec4::new(0.5, 0.5, 0.5, 1.0);
@@ -191,72 +121,17 @@ impl Harness {
             Vec4::new(1.0 / W as f32 - 1.0, 1.0 / H as f32 - 1.0, 0.0, 1.0),
         );
         u.prev_view_proj = u.view_proj;
-        g.buffer_mut(ubo)
-            .write(bytemuck::bytes_of(&u))
-            .expect("write uniforms");
-
-        let mut f = Frame::new();
-        let (albedo, normal, position) = (
-            self.scene.albedo.clone(),
-            self.scene.normal.clone(),
-            self.scene.position.clone(),
-        );
-        self.upload(&mut f, "upload_noisy", noisy_img, noisy);
-        self.upload(&mut f, "upload_moments", moments_img, &vec![[0.0; 4]; n]);
-        self.upload(&mut f, "upload_normal", normal_img, &normal);
-        self.upload(&mut f, "upload_albedo", albedo_img, &albedo);
-        self.upload(&mut f, "upload_motion", motion_img, &vec![[0.0; 4]; n]);
-        let first_hit = self.history(&mut f, "t.first_hit", &position);
-        let feature_position = self.history(&mut f, "t.position", &position);
-        let input = DenoiseInputs {
-            uniforms: ubo,
-            noisy: noisy_img,
-            moments: moments_img,
-            features: Some(FeatureImages {
-                position: feature_position,
-                normal: normal_img,
-                albedo: albedo_img,
-            }),
-            guides: None,
-            first_hit,
-            motion: motion_img,
-            size: Extent {
-                width: W as u32,
-                height: H as u32,
-            },
+        self.harness.step_with(&harness::Synthetic {
+            noisy,
+            moments: &vec![[0.0; 4]; W * H],
+            position: &self.scene.position,
+            normal: &self.scene.normal,
+            albedo: &self.scene.albedo,
+            uniforms: u,
             camera: Vec3::new(0.5, 0.5, 0.0),
             spp: 2,
             changes: Changes::default(),
-            retrace: None,
-        };
-        let out = self
-            .denoiser
-            .add(&self.ctx, &mut self.graph, &mut f, &input)
-            .expect("add");
-        let rb = self
-            .graph
-            .buffer(
-                &self.ctx,
-                "t.readback",
-                (n * 16) as u64,
-                MemoryLocation::GpuToCpu,
-            )
-            .expect("buffer");
-        f.add_readback("output", out, rb);
-        let graph = &mut self.graph;
-        let ctx = &self.ctx;
-        ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
-            .expect("submit");
-        self.graph.end_frame();
-        let bytes = self.graph.buffer_ref(rb).mapped().expect("mapped");
-        bytemuck::cast_slice::<u8, Px>(bytes).to_vec()
-    }
-}
-
-impl Drop for Harness {
-    fn drop(&mut self) {
-        let _ = self.ctx.wait_idle();
-        self.graph.destroy(&self.ctx);
+        })
     }
 }
 
@@ -480,8 +355,8 @@ fn svgf_frame0_ignores_garbage_and_reset_histories() {
             _ => [5.0, 0.0, 5.0, 2.0],
         })
         .collect();
-    poisoned.poison_history("svgf.color", &garbage);
-    poisoned.poison_history("svgf.moments", &garbage);
+    poisoned.harness.poison_history("svgf.color", &garbage);
+    poisoned.harness.poison_history("svgf.moments", &garbage);
     let out = poisoned.step(&input);
     assert_eq!(
         max_abs_diff(&out, &clean),
@@ -494,7 +369,7 @@ fn svgf_frame0_ignores_garbage_and_reset_histories() {
     for k in 0..4 {
         reset.step(&noisy(&s, 100 + k));
     }
-    reset.reset("svgf.");
+    reset.harness.reset("svgf.");
     let out = reset.step(&input);
     assert_eq!(
         max_abs_diff(&out, &clean),
@@ -547,7 +422,7 @@ fn taa_converges_on_a_static_input_and_restarts_after_reset() {
     let (e_in, e_out) = (rmse(&input0, &truth), rmse(&out, &truth));
     println!("taa RMSE after 40 frames: {e_out:.4} (input {e_in:.4})");
     assert!(e_out < 0.6 * e_in);
-    h.reset("taa.");
+    h.harness.reset("taa.");
     let input = noisy(&h.scene, 99);
     assert_eq!(max_abs_diff(&h.step(&input), &input), 0.0, "reset restarts");
     drop(h);

@@ -1,9 +1,10 @@
 //! Runs one denoiser on synthetic frames: the test supplies the noisy radiance, the scene
 //! is static (fixed world positions, zero motion), so a denoiser's temporal behaviour can
-//! be probed exactly (spikes, long static runs) without the path tracer's noise.
+//! be probed exactly (spikes, long static runs) without the path tracer's noise. A test
+//! with a scene of its own gives each frame's images itself ([`Harness::step_with`]).
 
 use ash::vk;
-use dvr_engine::denoise::{self, Changes, DenoiseInputs, Denoiser};
+use dvr_engine::denoise::{self, Changes, DenoiseFrame, DenoiseInputs, Denoiser};
 use dvr_engine::gpu::{GpuContext, ImageDesc};
 use dvr_engine::graph::Extent;
 use dvr_engine::graph::{Frame, History, ImageHandle, RenderGraph};
@@ -14,6 +15,8 @@ use dvr_engine::shaders::frame::FrameBlock;
 use glam::Vec3;
 use gpu_allocator::MemoryLocation;
 
+type Px = [f32; 4];
+
 pub struct Harness {
     pub ctx: GpuContext,
     graph: RenderGraph,
@@ -21,6 +24,22 @@ pub struct Harness {
     pub width: u32,
     pub height: u32,
     frame: u64,
+}
+
+/// One synthetic frame: the noisy radiance and everything a denoiser reads beside it,
+/// one value per pixel for the images.
+pub struct Synthetic<'a> {
+    pub noisy: &'a [Px],
+    /// Luminance moments (x mean, y second moment).
+    pub moments: &'a [Px],
+    /// World positions, for both the first hit and the surface features.
+    pub position: &'a [Px],
+    pub normal: &'a [Px],
+    pub albedo: &'a [Px],
+    pub uniforms: FrameBlock,
+    pub camera: Vec3,
+    pub spp: u32,
+    pub changes: Changes,
 }
 
 impl Harness {
@@ -39,7 +58,11 @@ impl Harness {
         }
     }
 
-    fn upload(&mut self, f: &mut Frame<'_>, name: &str, img: ImageHandle, px: &[[f32; 4]]) {
+    fn desc(&self) -> ImageDesc {
+        ImageDesc::d2(self.width, self.height, vk::Format::R32G32B32A32_SFLOAT)
+    }
+
+    fn upload(&mut self, f: &mut Frame<'_>, name: &str, img: ImageHandle, px: &[Px]) {
         add_upload(
             &self.ctx,
             &mut self.graph,
@@ -51,22 +74,53 @@ impl Harness {
         .expect("upload");
     }
 
-    fn history(&mut self, f: &mut Frame<'_>, name: &str, px: &[[f32; 4]]) -> History {
-        let desc = ImageDesc::d2(self.width, self.height, vk::Format::R32G32B32A32_SFLOAT);
-        let h = self.graph.history(&self.ctx, name, desc).expect("history");
+    fn history(&mut self, f: &mut Frame<'_>, name: &str, px: &[Px]) -> History {
+        let h = self
+            .graph
+            .history(&self.ctx, name, self.desc())
+            .expect("history");
         self.upload(f, &format!("upload_{name}"), h.cur, px);
         h
     }
 
-    /// Feeds one noisy frame; returns the denoiser's output.
-    pub fn step(&mut self, noisy: &[[f32; 4]]) -> Vec<[f32; 4]> {
+    /// Uploads `px` as the image `name` of this frame.
+    fn image(&mut self, f: &mut Frame<'_>, name: &str, px: &[Px]) -> ImageHandle {
+        let img = self
+            .graph
+            .image(&self.ctx, name, self.desc())
+            .expect("image");
+        self.upload(f, &format!("upload_{name}"), img, px);
+        img
+    }
+
+    /// Fills both images of the history `name` with `px` (without ending a frame, so
+    /// the next step sees the same pair and the same `valid`).
+    pub fn poison_history(&mut self, name: &str, px: &[Px]) {
+        let h = self
+            .graph
+            .history(&self.ctx, name, self.desc())
+            .expect("history");
+        let mut f = Frame::new();
+        self.upload(&mut f, &format!("poison_{name}_prev"), h.prev, px);
+        self.upload(&mut f, &format!("poison_{name}_cur"), h.cur, px);
+        let graph = &mut self.graph;
+        let ctx = &self.ctx;
+        ctx.submit_and_wait(|cmd| graph.execute(ctx, cmd, None, f))
+            .expect("submit");
+    }
+
+    /// Resets the histories whose names start with `prefix`.
+    pub fn reset(&mut self, prefix: &str) {
+        self.graph.reset_history(prefix);
+    }
+
+    /// Feeds one noisy frame of a flat surface at z = 0, seen by a still camera one unit
+    /// away; returns the denoiser's output.
+    pub fn step(&mut self, noisy: &[Px]) -> Vec<Px> {
         let (w, h) = (self.width, self.height);
         let n = (w * h) as usize;
-        assert_eq!(noisy.len(), n);
-        let desc = ImageDesc::d2(w, h, vk::Format::R32G32B32A32_SFLOAT);
-        // A flat surface at z = 0 seen by a camera one unit away: each pixel's world
-        // position is where its centre ray meets the plane, so reprojection round trips
-        // land exactly on the pixel.
+        // Each pixel's world position is where its centre ray meets the plane, so
+        // reprojection round trips land exactly on the pixel.
         let camera = CameraMatrices::look_at(
             Vec3::new(0.0, 0.0, 1.0),
             Vec3::ZERO,
@@ -76,7 +130,7 @@ impl Harness {
         );
         let view_proj = camera.proj * camera.view;
         let inv = view_proj.inverse();
-        let positions: Vec<[f32; 4]> = (0..n as u32)
+        let positions: Vec<Px> = (0..n as u32)
             .map(|i| {
                 let ndc_x = ((i % w) as f32 + 0.5) / w as f32 * 2.0 - 1.0;
                 let ndc_y = ((i / w) as f32 + 0.5) / h as f32 * 2.0 - 1.0;
@@ -87,83 +141,100 @@ impl Harness {
                 [p.x, p.y, p.z, 1.0]
             })
             .collect();
-        let mut frame_uniforms: FrameBlock = bytemuck::Zeroable::zeroed();
-        frame_uniforms.view_proj = view_proj;
-        frame_uniforms.inv_view_proj = inv;
-        frame_uniforms.prev_view_proj = view_proj;
-        frame_uniforms.camera_pos = camera.position.extend(1.0);
-        let normals = vec![[0.0, 0.0, 1.0, 1.0]; n];
-        let albedo = vec![[0.8, 0.8, 0.8, 1.0]; n];
-        let zeros = vec![[0.0f32; 4]; n];
-        let moments: Vec<[f32; 4]> = noisy
+        let mut uniforms: FrameBlock = bytemuck::Zeroable::zeroed();
+        uniforms.view_proj = view_proj;
+        uniforms.inv_view_proj = inv;
+        uniforms.prev_view_proj = view_proj;
+        uniforms.camera_pos = camera.position.extend(1.0);
+        let moments: Vec<Px> = noisy
             .iter()
             .map(|p| {
                 let y = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
                 [y, y * y, 0.0, 0.0]
             })
             .collect();
+        self.step_with(&Synthetic {
+            noisy,
+            moments: &moments,
+            position: &positions,
+            normal: &vec![[0.0, 0.0, 1.0, 1.0]; n],
+            albedo: &vec![[0.8, 0.8, 0.8, 1.0]; n],
+            uniforms,
+            camera: Vec3::new(0.0, 0.0, 1.0),
+            // One sample per pixel: the moments above are those of one sample (no
+            // variance), so a method that estimates noise from them must use the frame's
+            // spread instead.
+            spp: 1,
+            changes: Changes {
+                camera: self.frame == 0,
+                ..Changes::default()
+            },
+        })
+    }
+
+    /// Feeds one synthetic frame with zero motion; returns the denoiser's output.
+    pub fn step_with(&mut self, s: &Synthetic) -> Vec<Px> {
+        let n = (self.width * self.height) as usize;
+        assert_eq!(s.noisy.len(), n);
         let mut f = Frame::new();
-        let g = &mut self.graph;
-        let ctx = &self.ctx;
-        let noisy_img = g.image(ctx, "h.noisy", desc).expect("image");
-        let moments_img = g.image(ctx, "h.moments", desc).expect("image");
-        let normal_img = g.image(ctx, "h.normal", desc).expect("image");
-        let albedo_img = g.image(ctx, "h.albedo", desc).expect("image");
-        let motion_img = g.image(ctx, "h.motion", desc).expect("image");
-        let uniforms = g
+        let uniforms = self
+            .graph
             .buffer(
-                ctx,
+                &self.ctx,
                 "h.uniforms",
                 std::mem::size_of::<FrameBlock>() as u64,
                 MemoryLocation::CpuToGpu,
             )
             .expect("buffer");
-        g.buffer_mut(uniforms)
-            .write(bytemuck::bytes_of(&frame_uniforms))
+        self.graph
+            .buffer_mut(uniforms)
+            .write(bytemuck::bytes_of(&s.uniforms))
             .expect("uniforms");
-        self.upload(&mut f, "upload_noisy", noisy_img, noisy);
-        self.upload(&mut f, "upload_moments", moments_img, &moments);
-        self.upload(&mut f, "upload_normal", normal_img, &normals);
-        self.upload(&mut f, "upload_albedo", albedo_img, &albedo);
-        self.upload(&mut f, "upload_motion", motion_img, &zeros);
-        let first_hit = self.history(&mut f, "h.first_hit", &positions);
-        let feature_position = self.history(&mut f, "h.features_position", &positions);
+        let noisy = self.image(&mut f, "h.noisy", s.noisy);
+        let moments = self.image(&mut f, "h.moments", s.moments);
+        let normal = self.image(&mut f, "h.normal", s.normal);
+        let albedo = self.image(&mut f, "h.albedo", s.albedo);
+        let motion = self.image(&mut f, "h.motion", &vec![[0.0; 4]; n]);
+        let first_hit = self.history(&mut f, "h.first_hit", s.position);
+        let feature_position = self.history(&mut f, "h.features_position", s.position);
         let input = DenoiseInputs {
             uniforms,
-            noisy: noisy_img,
-            moments: moments_img,
+            noisy,
+            moments,
             features: Some(FeatureImages {
                 position: feature_position,
-                normal: normal_img,
-                albedo: albedo_img,
+                normal,
+                albedo,
             }),
             guides: None,
             first_hit,
-            motion: motion_img,
+            motion,
             size: Extent {
-                width: w,
-                height: h,
+                width: self.width,
+                height: self.height,
             },
-            camera: glam::Vec3::new(0.0, 0.0, 1.0),
-            // One sample per pixel: the moments above are those of one sample (no variance), so
-            // a method that estimates noise from them must use the frame's spread instead.
-            spp: 1,
-            changes: Changes {
-                camera: self.frame == 0,
-                lights: false,
-                transfer_function: false,
-                cut: false,
-            },
+            camera: s.camera,
+            spp: s.spp,
+            changes: s.changes,
             retrace: None,
         };
         let out = self
             .denoiser
-            .add(&self.ctx, &mut self.graph, &mut f, &input)
+            .add(DenoiseFrame {
+                ctx: &self.ctx,
+                graph: &mut self.graph,
+                frame: &mut f,
+                input: &input,
+            })
             .expect("add");
-        let bytes = (n * 16) as u64;
         let rb = self
             .graph
-            .buffer(&self.ctx, "h.readback", bytes, MemoryLocation::GpuToCpu)
+            .buffer(
+                &self.ctx,
+                "h.readback",
+                (n * 16) as u64,
+                MemoryLocation::GpuToCpu,
+            )
             .expect("buffer");
         f.add_readback("output", out, rb);
         let graph = &mut self.graph;
@@ -172,8 +243,7 @@ impl Harness {
             .expect("submit");
         self.graph.end_frame();
         self.frame += 1;
-        bytemuck::cast_slice::<u8, [f32; 4]>(self.graph.buffer_ref(rb).mapped().expect("mapped"))
-            .to_vec()
+        bytemuck::cast_slice::<u8, Px>(self.graph.buffer_ref(rb).mapped().expect("mapped")).to_vec()
     }
 }
 

@@ -1,10 +1,10 @@
 //! `accum`: progressive accumulation while nothing changes; any camera, light or TF
 //! change starts over. Converges to the reference on static scenes, lags on animated ones.
 
-use super::{DenoiseInputs, Denoiser};
+use super::{DenoiseFrame, Denoiser, DenoiserConfig};
 use crate::error::Result;
 use crate::gpu::GpuContext;
-use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::graph::ImageHandle;
 use crate::passes::accumulate::Accumulate;
 
 pub struct Accum {
@@ -14,26 +14,21 @@ pub struct Accum {
 }
 
 impl Accum {
-    pub fn new(ctx: &GpuContext, name: &'static str) -> Result<Self> {
-        Ok(Self {
+    pub fn create(
+        ctx: &GpuContext,
+        name: &'static str,
+        _: &DenoiserConfig,
+    ) -> Result<Box<dyn Denoiser>> {
+        Ok(Box::new(Self {
             name,
             pass: Accumulate::new(ctx)?,
-        })
+        }))
     }
 }
 
 impl Denoiser for Accum {
-    fn name(&self) -> &str {
-        self.name
-    }
-
-    fn add<'f>(
-        &'f self,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
-    ) -> Result<ImageHandle> {
+    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.into_parts();
         if input.changes.any() {
             graph.reset_history(&format!("{}.", self.name));
         }

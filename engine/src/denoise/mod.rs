@@ -3,6 +3,7 @@
 //! differences between methods are the denoisers' alone.
 
 mod accum;
+mod entry;
 pub mod ours;
 mod passthrough;
 pub mod rae;
@@ -16,7 +17,9 @@ pub use accum::Accum;
 pub use ours::{Ours, OursVariant};
 pub use passthrough::Passthrough;
 pub use rae::{Rae, RaeWeights};
-pub use registry::{DenoiserConfig, DenoiserInfo, FeatureUse, DENOISERS};
+pub use registry::{
+    Build, DenoiserConfig, DenoiserInfo, FeatureUse, Overrides, Registry, DENOISERS,
+};
 pub use svgf::Svgf;
 pub use taa::Taa;
 pub use wrls_paper::{Wrls, WrlsVariant};
@@ -32,18 +35,25 @@ use ash::vk;
 /// goes.
 pub type Overridable<P> = (&'static str, f32, f32, fn(&mut P, f32));
 
-/// The environment variables that override denoiser parameters (`ours`, the paper's
-/// family, svgf): what a method computes depends on them.
-pub const OVERRIDE_VARIABLES: [&str; 3] = ["DVR_OURS", "DVR_WRLS", "DVR_SVGF"];
+/// The environment variables that override denoiser parameters (`DVR_SVGF`,
+/// `DVR_OURS`, `DVR_WRLS`: each registry row names the one its method reads), in table
+/// order: what a method computes depends on them.
+pub fn override_variables() -> Vec<&'static str> {
+    registry::BUILTIN
+        .overrides()
+        .iter()
+        .map(|o| o.variable)
+        .collect()
+}
 
 /// A sentence for each override variable set in the environment that none of the
 /// `running` methods reads, naming the variable and the methods it applies to: a user
 /// who set one expects it to act, or to be told that it does not.
 pub fn unused_overrides(running: &[&str]) -> Vec<String> {
-    OVERRIDE_VARIABLES
-        .iter()
+    override_variables()
+        .into_iter()
         .filter(|v| std::env::var(v).is_ok_and(|s| !s.trim().is_empty()))
-        .filter_map(|&v| {
+        .filter_map(|v| {
             let readers: Vec<&str> = registry::DENOISERS
                 .iter()
                 .filter(|d| d.override_variable() == Some(v))
@@ -60,14 +70,13 @@ pub fn unused_overrides(running: &[&str]) -> Vec<String> {
         .collect()
 }
 
-/// Checks the parameter overrides in the environment (`DVR_OURS`, `DVR_WRLS`,
-/// `DVR_SVGF`) as the denoisers will read them, so a command can refuse a bad value
-/// before it renders anything, not when the method is built after the references.
+/// Checks the parameter overrides in the environment (each row's variable) as the
+/// denoisers will read them, so a command can refuse a bad value before it renders
+/// anything, not when the method is built after the references.
 pub fn check_env_overrides() -> Result<()> {
-    let var = |name| std::env::var(name).ok();
-    ours::OursParams::default().with_overrides(var("DVR_OURS").as_deref())?;
-    wrls_paper::WrlsParams::default().with_overrides(var("DVR_WRLS").as_deref())?;
-    svgf::SvgfParams::default().with_overrides(var("DVR_SVGF").as_deref())?;
+    for o in registry::BUILTIN.overrides() {
+        (o.check)(o.value().as_deref())?;
+    }
     Ok(())
 }
 
@@ -298,15 +307,33 @@ impl Reprojection {
     }
 }
 
+/// What a denoiser adds its passes with: the device, the graph, the frame being
+/// recorded (whose passes the renderer counts as the denoiser's own) and the frame's
+/// inputs.
+pub struct DenoiseFrame<'a, 'f> {
+    pub ctx: &'a GpuContext,
+    pub graph: &'a mut RenderGraph,
+    pub frame: &'a mut Frame<'f>,
+    pub input: &'a DenoiseInputs,
+}
+
+impl<'a, 'f> DenoiseFrame<'a, 'f> {
+    /// The device, graph, frame and inputs, for a body that hands them to its passes.
+    pub fn into_parts(
+        self,
+    ) -> (
+        &'a GpuContext,
+        &'a mut RenderGraph,
+        &'a mut Frame<'f>,
+        &'a DenoiseInputs,
+    ) {
+        (self.ctx, self.graph, self.frame, self.input)
+    }
+}
+
+/// A denoiser: its registry row names it ([`DenoiserInfo::name`]), and it names its own
+/// passes and images after that name.
 pub trait Denoiser {
-    /// The name used on the command line and in reports.
-    fn name(&self) -> &str;
     /// Adds the denoiser's passes; returns its HDR output image.
-    fn add<'f>(
-        &'f self,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
-    ) -> Result<ImageHandle>;
+    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle>;
 }

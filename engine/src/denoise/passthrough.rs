@@ -1,25 +1,24 @@
 //! `none`: the noisy input, unchanged (the baseline every method is compared with).
 
-use super::{DenoiseInputs, Denoiser};
+use super::{DenoiseFrame, Denoiser, DenoiserConfig};
 use crate::error::Result;
 use crate::gpu::GpuContext;
-use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::graph::ImageHandle;
 
-/// The name comes from its registry row.
-pub struct Passthrough(pub &'static str);
+pub struct Passthrough;
+
+impl Passthrough {
+    pub fn create(
+        _: &GpuContext,
+        _: &'static str,
+        _: &DenoiserConfig,
+    ) -> Result<Box<dyn Denoiser>> {
+        Ok(Box::new(Passthrough))
+    }
+}
 
 impl Denoiser for Passthrough {
-    fn name(&self) -> &str {
-        self.0
-    }
-
-    fn add<'f>(
-        &'f self,
-        _ctx: &GpuContext,
-        _graph: &mut RenderGraph,
-        _frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
-    ) -> Result<ImageHandle> {
-        Ok(input.noisy)
+    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        Ok(f.input.noisy)
     }
 }

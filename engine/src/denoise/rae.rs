@@ -28,11 +28,11 @@
 //! recurrent state is never reset on camera, light or TF changes: the network was
 //! trained on moving sequences and has no reprojection.
 
-use super::{DenoiseInputs, Denoiser};
+use super::{Build, DenoiseFrame, Denoiser, DenoiserConfig};
 use crate::error::{EngineError, Result};
 use crate::gpu::{GpuContext, ImageDesc, Pipeline};
 use crate::gpu_block;
-use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
+use crate::graph::{BufferHandle, Frame, ImageHandle};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use std::cell::Cell;
@@ -112,6 +112,37 @@ pub fn network_for(dataset: Option<&str>) -> &'static str {
     match dataset {
         Some("phantom") => "phantom",
         _ => "mri",
+    }
+}
+
+/// What a RAE row runs: the shipped network `net` (None: the one trained on the
+/// scene's dataset, see [`network_for`]) at `precision`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RaeNet {
+    pub net: Option<&'static str>,
+    pub precision: Precision,
+}
+
+impl RaeNet {
+    /// The network and tensor precision it runs on a scene of built-in `dataset`.
+    pub fn network(&self, dataset: Option<&str>) -> (&'static str, Precision) {
+        (
+            self.net.unwrap_or_else(|| network_for(dataset)),
+            self.precision,
+        )
+    }
+}
+
+impl Build for RaeNet {
+    fn build(
+        &self,
+        ctx: &GpuContext,
+        name: &'static str,
+        config: &DenoiserConfig,
+    ) -> Result<Box<dyn Denoiser>> {
+        let (net, precision) = self.network(config.dataset);
+        let weights = RaeWeights::builtin(net)?;
+        Ok(Box::new(Rae::new(ctx, name, weights, precision)?))
     }
 }
 
@@ -385,17 +416,8 @@ struct Pool {
 }
 
 impl Denoiser for Rae {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn add<'f>(
-        &'f self,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
-    ) -> Result<ImageHandle> {
+    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.into_parts();
         let n = &self.name;
         let wts = &self.weights;
         let levels = wts.levels();

@@ -1,120 +1,47 @@
 //! The denoisers dvr has, in one table: the name the command line, `dvr eval`, the
 //! explorer and the reports use, a one-line description, what the frame must render for
-//! it, and how to build it. Everything that lists, checks or builds a denoiser by name
-//! reads [`DENOISERS`].
+//! it, the variable that overrides its parameters, and how to build it (see
+//! [`DenoiserInfo`]). Everything that lists, checks or builds a denoiser by name reads a
+//! [`Registry`]: the built-in one is [`DENOISERS`], and [`Registry::with`] adds a row
+//! (a test's toy denoiser) that the renderer then builds as it builds any other.
 
-use super::{Accum, Denoiser, MotionSource, Passthrough, Rae, RaeWeights, Svgf, Taa};
-use super::{Ours, OursVariant, Wrls, WrlsVariant};
+use super::rae::RaeNet;
+use super::{Accum, Passthrough, Svgf, Taa};
+use super::{OursVariant, WrlsVariant};
 use crate::error::{EngineError, Result};
 use crate::gpu::GpuContext;
-use crate::passes::path_trace::PathTraceFeatures;
+use std::borrow::Cow;
 
+pub use super::entry::{Build, DenoiserConfig, DenoiserInfo, FeatureUse, Overrides};
 pub use super::rae::Precision;
+pub use super::Denoiser;
 
-/// Whether a denoiser reads the surface features (the deterministic opacity-threshold
-/// position, normal and albedo), which cost about a path trace on lavapipe and are
-/// rendered only for denoisers that read them.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FeatureUse {
-    Never,
-    /// When it reprojects with them (`--motion features`).
-    ForMotion,
-    /// Always (SVGF's edge-stopping and albedo demodulation).
-    Always,
+/// A RAE row: the shipped network `net` (None: the one trained on the scene's dataset,
+/// see [`super::rae::network_for`]) at `precision`.
+const fn rae(name: &'static str, description: &'static str, net: &'static RaeNet) -> DenoiserInfo {
+    DenoiserInfo::new(name, description, FeatureUse::Never, net)
 }
 
-impl FeatureUse {
-    pub fn needed(self, motion: MotionSource) -> bool {
-        match self {
-            FeatureUse::Never => false,
-            FeatureUse::ForMotion => motion == MotionSource::Features,
-            FeatureUse::Always => true,
-        }
-    }
-}
-
-/// How an entry is built.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
-    Passthrough,
-    Accum,
-    Taa,
-    Svgf,
-    /// Ours or one of its ablations, with its switches.
-    Ours(OursVariant),
-    /// A member of the paper's wRLS family, with its switches.
-    Wrls(WrlsVariant),
-    /// The recurrent autoencoder: the shipped network `net` (None: the one trained on
-    /// the scene's dataset, see [`super::rae::network_for`]) at `precision`.
-    Rae {
-        net: Option<&'static str>,
-        precision: Precision,
-    },
-}
-
-/// One denoiser dvr has.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DenoiserInfo {
-    /// The name on the command line and in every report.
-    pub name: &'static str,
-    pub description: &'static str,
-    pub features: FeatureUse,
-    kind: Kind,
-}
-
-/// What building a denoiser depends on besides its name.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct DenoiserConfig<'a> {
-    /// What temporal methods reproject with.
-    pub motion: MotionSource,
-    /// The built-in dataset the scene's volume is, if any (learned denoisers pick their
-    /// network by it).
-    pub dataset: Option<&'a str>,
-    /// What the path tracer is specialised for (a denoiser that traces paths again must
-    /// trace the same ones).
-    pub features: PathTraceFeatures,
-}
-
-const fn entry(
+/// A row of ours or one of its ablations. Always: the spatial prior's fit reads the
+/// surface's gradient normal; the guides: it fits the prior's model on the albedo.
+const fn ours(
     name: &'static str,
     description: &'static str,
-    features: FeatureUse,
-    kind: Kind,
+    variant: &'static OursVariant,
 ) -> DenoiserInfo {
-    DenoiserInfo {
-        name,
-        description,
-        features,
-        kind,
-    }
+    DenoiserInfo::new(name, description, FeatureUse::Always, variant)
+        .reading_guides()
+        .overridden_by(super::ours::OVERRIDES)
 }
 
-const fn rae(
+/// A row of the paper's wRLS family.
+const fn wrls(
     name: &'static str,
     description: &'static str,
-    net: Option<&'static str>,
-    precision: Precision,
+    variant: &'static WrlsVariant,
 ) -> DenoiserInfo {
-    entry(
-        name,
-        description,
-        FeatureUse::Never,
-        Kind::Rae { net, precision },
-    )
-}
-
-const fn ours(name: &'static str, description: &'static str, variant: OursVariant) -> DenoiserInfo {
-    // Always: the spatial prior's fit reads the surface's gradient normal.
-    entry(name, description, FeatureUse::Always, Kind::Ours(variant))
-}
-
-const fn wrls(name: &'static str, description: &'static str, variant: WrlsVariant) -> DenoiserInfo {
-    entry(
-        name,
-        description,
-        FeatureUse::ForMotion,
-        Kind::Wrls(variant),
-    )
+    DenoiserInfo::new(name, description, FeatureUse::ForMotion, variant)
+        .overridden_by(super::wrls_paper::OVERRIDES)
 }
 
 /// Ours (see [`OursVariant`]), and the paper's model family (see [`WrlsVariant`]).
@@ -125,157 +52,93 @@ use FeatureUse::{Always, ForMotion, Never};
 
 /// Every denoiser, in the order lists and reports show them.
 pub const DENOISERS: &[DenoiserInfo] = &[
-    entry("none", "the noisy input, unchanged", Never, Kind::Passthrough),
-    entry(
+    DenoiserInfo::new("none", "the noisy input, unchanged", Never, &Passthrough::create),
+    DenoiserInfo::new(
         "accum",
         "progressive accumulation; starts over on any camera, light or TF change",
         Never,
-        Kind::Accum,
+        &Accum::create,
     ),
-    entry(
+    DenoiserInfo::new(
         "taa",
         "exponential moving average with reprojection and variance clipping",
         ForMotion,
-        Kind::Taa,
+        &Taa::create,
     ),
-    entry(
+    DenoiserInfo::new(
         "svgf",
         "spatiotemporal variance-guided filtering (Schied et al. 2017)",
         Always,
-        Kind::Svgf,
-    ),
+        &Svgf::create,
+    )
+    .reading_guides()
+    .overridden_by(super::svgf::OVERRIDES),
     ours(
         "ours",
         "a per-pixel Kalman filter told by temporal gradients how much the scene changed, with a pooled lag test, a spatial prior on the guide albedo and an à-trous filter",
-        OURS,
+        &OURS,
     ),
     // Ablations of ours: one stage each (tests/ablations.rs checks it by the stages' images).
     ours(
         "ours-no-gradient",
         "ours without temporal gradients",
-        OursVariant { gradients: false, ..OURS },
+        &OursVariant { gradients: false, ..OURS },
     ),
     ours(
         "ours-no-lag",
         "ours without the pooled lag test's shift of the state",
-        OursVariant { lag: false, ..OURS },
+        &OursVariant { lag: false, ..OURS },
     ),
     ours(
         "ours-no-prior",
         "ours without the spatial prior's combination (young estimates go to the à-trous, which still carries by the prior's model)",
-        OursVariant { prior: false, ..OURS },
+        &OursVariant { prior: false, ..OURS },
     ),
     ours(
         "ours-no-atrous",
         "ours without the à-trous filter (the per-pixel estimates)",
-        OursVariant { atrous: false, ..OURS },
+        &OursVariant { atrous: false, ..OURS },
     ),
     wrls(
         "wrls-paper",
         "the paper's weighted RLS denoiser (TVCG §5–6) as published",
-        WrlsVariant { paper_predictor: true, restart_on_change: false, ..PAPER },
+        &WrlsVariant { paper_predictor: true, restart_on_change: false, ..PAPER },
     ),
     wrls(
         "rls-paper",
         "wrls-paper without its weights (w = 1): the paper's RLS-F ablation on its own predictor",
-        WrlsVariant { weighted: false, paper_predictor: true, restart_on_change: false, ..PAPER },
+        &WrlsVariant { weighted: false, paper_predictor: true, restart_on_change: false, ..PAPER },
     ),
     wrls(
         "wrls",
         "the paper's weighted RLS on the family's base: the feature from the reprojected history, residual weights, restarts",
-        PAPER,
+        &PAPER,
     ),
     // The paper's ablations (Fig. 8) of `wrls`.
     wrls(
         "rls",
         "the paper's RLS-F ablation: unweighted RLS",
-        WrlsVariant { weighted: false, ..PAPER },
+        &WrlsVariant { weighted: false, ..PAPER },
     ),
     wrls(
         "wrls-nf",
         "the paper's ablation without the temporal feature",
-        WrlsVariant { feature: false, ..PAPER },
+        &WrlsVariant { feature: false, ..PAPER },
     ),
     wrls(
         "rls-nf",
         "unweighted RLS without the temporal feature",
-        WrlsVariant { weighted: false, feature: false, ..PAPER },
+        &WrlsVariant { weighted: false, feature: false, ..PAPER },
     ),
     rae(
         "rae",
         "recurrent denoising autoencoder (Chaitanya et al. 2017), the network trained on the scene's dataset",
-        None,
-        Precision::F32,
+        &RaeNet { net: None, precision: Precision::F32 },
     ),
-    rae("rae-phantom", "the RAE trained on the phantom", Some("phantom"), Precision::F32),
-    rae("rae-mri", "the RAE trained on the MRI", Some("mri"), Precision::F32),
-    rae("rae-fp16", "rae with half-precision tensors", None, Precision::F16),
+    rae("rae-phantom", "the RAE trained on the phantom", &RaeNet { net: Some("phantom"), precision: Precision::F32 }),
+    rae("rae-mri", "the RAE trained on the MRI", &RaeNet { net: Some("mri"), precision: Precision::F32 }),
+    rae("rae-fp16", "rae with half-precision tensors", &RaeNet { net: None, precision: Precision::F16 }),
 ];
-
-impl DenoiserInfo {
-    /// The network and tensor precision a RAE entry runs on a scene of built-in
-    /// `dataset`; None for other denoisers.
-    pub fn rae_network(&self, dataset: Option<&str>) -> Option<(&'static str, Precision)> {
-        match self.kind {
-            Kind::Rae { net, precision } => Some((
-                net.unwrap_or_else(|| super::rae::network_for(dataset)),
-                precision,
-            )),
-            _ => None,
-        }
-    }
-
-    /// The environment variable that overrides its parameters (see
-    /// [`super::OVERRIDE_VARIABLES`]), if it has one.
-    pub fn override_variable(&self) -> Option<&'static str> {
-        match self.kind {
-            Kind::Ours(_) => Some("DVR_OURS"),
-            Kind::Wrls(_) => Some("DVR_WRLS"),
-            Kind::Svgf => Some("DVR_SVGF"),
-            _ => None,
-        }
-    }
-
-    /// Whether it reads the guide albedo composited along the ray
-    /// ([`DenoiseInputs::guides`](super::DenoiseInputs::guides)): SVGF demodulates by it,
-    /// ours and each of its ablations fit the prior's model on it.
-    pub fn guides(&self) -> bool {
-        matches!(self.kind, Kind::Svgf | Kind::Ours(_))
-    }
-
-    /// Builds the denoiser.
-    pub fn create(&self, ctx: &GpuContext, config: &DenoiserConfig) -> Result<Box<dyn Denoiser>> {
-        let motion = config.motion;
-        Ok(match self.kind {
-            Kind::Passthrough => Box::new(Passthrough(self.name)),
-            Kind::Accum => Box::new(Accum::new(ctx, self.name)?),
-            Kind::Taa => Box::new(Taa::new(ctx, self.name, motion)?),
-            Kind::Svgf => Box::new(Svgf::new(ctx, self.name, motion)?),
-            Kind::Ours(variant) => {
-                Box::new(Ours::new(ctx, self.name, variant, motion, config.features)?)
-            }
-            Kind::Wrls(variant) => Box::new(Wrls::new(ctx, self.name, variant, motion)?),
-            Kind::Rae { .. } => {
-                let (net, precision) = self
-                    .rae_network(config.dataset)
-                    .ok_or_else(|| unknown(self.name))?;
-                Box::new(Rae::new(
-                    ctx,
-                    self.name,
-                    RaeWeights::builtin(net)?,
-                    precision,
-                )?)
-            }
-        })
-    }
-}
-
-fn unknown(name: &str) -> EngineError {
-    EngineError::UnknownDenoiser {
-        name: name.to_string(),
-        available: names().collect::<Vec<_>>().join(", "),
-    }
-}
 
 /// Every denoiser's name, in table order.
 pub fn names() -> impl Iterator<Item = &'static str> {
@@ -284,15 +147,88 @@ pub fn names() -> impl Iterator<Item = &'static str> {
 
 /// The denoiser called `name`, or [`EngineError::UnknownDenoiser`] listing them all.
 pub fn find(name: &str) -> Result<&'static DenoiserInfo> {
-    DENOISERS
-        .iter()
-        .find(|d| d.name == name)
-        .ok_or_else(|| unknown(name))
+    BUILTIN.find(name)
 }
 
 /// Builds the denoiser called `name`.
 pub fn create(ctx: &GpuContext, name: &str, config: &DenoiserConfig) -> Result<Box<dyn Denoiser>> {
     find(name)?.create(ctx, config)
+}
+
+/// The rows the renderer finds denoisers in by name: the built-in table, or it with
+/// rows added ([`Registry::with`]).
+#[derive(Clone, Debug)]
+pub struct Registry {
+    rows: Cow<'static, [DenoiserInfo]>,
+}
+
+/// The built-in registry: [`DENOISERS`].
+pub static BUILTIN: Registry = Registry {
+    rows: Cow::Borrowed(DENOISERS),
+};
+
+impl Default for Registry {
+    fn default() -> Self {
+        BUILTIN.clone()
+    }
+}
+
+/// Registries are equal when they hold the same rows: the same names, each built by the
+/// same builder.
+impl PartialEq for Registry {
+    fn eq(&self, other: &Self) -> bool {
+        self.rows.len() == other.rows.len()
+            && self.rows.iter().zip(other.rows.iter()).all(|(a, b)| {
+                a.name == b.name && std::ptr::addr_eq(a.build as *const _, b.build as *const _)
+            })
+    }
+}
+
+impl Registry {
+    /// This registry with `row` added after its rows; a name it already has is refused.
+    pub fn with(mut self, row: DenoiserInfo) -> Result<Self> {
+        if self.find(row.name).is_ok() {
+            return Err(EngineError::InvalidSetting {
+                name: "denoiser",
+                value: row.name.to_string(),
+                allowed: "a name no other row of the registry has".into(),
+            });
+        }
+        self.rows.to_mut().push(row);
+        Ok(self)
+    }
+
+    /// Its rows, in the order lists and reports show them.
+    pub fn rows(&self) -> &[DenoiserInfo] {
+        &self.rows
+    }
+
+    /// The row called `name`, or [`EngineError::UnknownDenoiser`] listing them all.
+    pub fn find(&self, name: &str) -> Result<&DenoiserInfo> {
+        self.rows
+            .iter()
+            .find(|d| d.name == name)
+            .ok_or_else(|| EngineError::UnknownDenoiser {
+                name: name.to_string(),
+                available: self.names().join(", "),
+            })
+    }
+
+    fn names(&self) -> Vec<&'static str> {
+        self.rows.iter().map(|d| d.name).collect()
+    }
+
+    /// The environment variables its rows' parameters are overridden by, each once with
+    /// its check, in the order of the rows that first name them.
+    pub fn overrides(&self) -> Vec<Overrides> {
+        let mut out: Vec<Overrides> = Vec::new();
+        for o in self.rows.iter().filter_map(|d| d.overrides) {
+            if !out.iter().any(|seen| seen.variable == o.variable) {
+                out.push(o);
+            }
+        }
+        out
+    }
 }
 
 #[cfg(test)]
@@ -306,14 +242,15 @@ mod tests {
             assert!(!all[..i].contains(n), "{n} is listed twice");
         }
         // Each wRLS or ours row is a different variant (a copied row would rename one).
-        let variants: Vec<_> = DENOISERS
-            .iter()
-            .filter(|d| matches!(d.kind, Kind::Wrls(_) | Kind::Ours(_)))
-            .map(|d| d.kind)
-            .collect();
-        for (i, v) in variants.iter().enumerate() {
-            assert!(!variants[..i].contains(v), "{v:?} is listed twice");
+        fn distinct<T: std::any::Any + PartialEq + std::fmt::Debug>() {
+            let variants: Vec<&T> = DENOISERS.iter().filter_map(|d| d.variant::<T>()).collect();
+            for (i, v) in variants.iter().enumerate() {
+                assert!(!variants[..i].contains(v), "{v:?} is listed twice");
+            }
         }
+        distinct::<OursVariant>();
+        distinct::<WrlsVariant>();
+        distinct::<RaeNet>();
         assert!(DENOISERS.iter().all(|d| !d.description.is_empty()));
     }
 
@@ -324,7 +261,7 @@ mod tests {
         assert!(ours.iter().all(|&on| on), "ours has every part");
         let mut ablations = 0;
         for d in DENOISERS {
-            if let Kind::Ours(v) = d.kind {
+            if let Some(&v) = d.variant::<OursVariant>() {
                 let off = ours.iter().zip(parts(v)).filter(|(a, b)| a != &b).count();
                 let expected = usize::from(d.name != "ours");
                 assert_eq!(off, expected, "{} differs from ours in {off} parts", d.name);
@@ -345,7 +282,12 @@ mod tests {
 
     #[test]
     fn rae_entries_pick_their_network() {
-        let net = |n: &str, d| find(n).ok().and_then(|e| e.rae_network(d));
+        let net = |n: &str, d| {
+            find(n)
+                .ok()
+                .and_then(|e| e.variant::<RaeNet>())
+                .map(|r| r.network(d))
+        };
         assert_eq!(
             net("rae", Some("phantom")),
             Some(("phantom", Precision::F32))
@@ -360,10 +302,25 @@ mod tests {
     }
 
     #[test]
-    fn feature_use_follows_the_motion_source() {
-        assert!(FeatureUse::Always.needed(MotionSource::FirstHit));
-        assert!(FeatureUse::ForMotion.needed(MotionSource::Features));
-        assert!(!FeatureUse::ForMotion.needed(MotionSource::FirstHit));
-        assert!(!FeatureUse::Never.needed(MotionSource::Features));
+    fn rows_carry_what_the_frame_needs() {
+        let row = |n| find(n).expect("a row");
+        assert!(row("svgf").guides && row("ours-no-lag").guides && !row("taa").guides);
+        assert_eq!(row("ours").override_variable(), Some("DVR_OURS"));
+        assert_eq!(row("rls-nf").override_variable(), Some("DVR_WRLS"));
+        assert_eq!(row("svgf").override_variable(), Some("DVR_SVGF"));
+        assert_eq!(row("rae").override_variable(), None);
+        let variables: Vec<_> = BUILTIN.overrides().iter().map(|o| o.variable).collect();
+        assert_eq!(variables, ["DVR_SVGF", "DVR_OURS", "DVR_WRLS"]);
+    }
+
+    #[test]
+    fn a_registry_takes_a_new_row_once() {
+        let toy = DenoiserInfo::new("toy", "a toy", FeatureUse::Never, &Passthrough::create);
+        let with = Registry::default().with(toy).expect("a new name");
+        assert_eq!(with.find("toy").map(|d| d.description).ok(), Some("a toy"));
+        assert_eq!(with.rows().len(), DENOISERS.len() + 1);
+        assert_ne!(with, BUILTIN);
+        assert!(with.with(toy).is_err(), "a name twice");
+        assert!(find("toy").is_err(), "the built-in table is unchanged");
     }
 }

@@ -27,11 +27,11 @@
 //! transfer function change: reprojection follows motion, and shading changes are
 //! followed at the moving averages' rate (the method's known lag).
 
-use super::{DenoiseInputs, Denoiser, MotionSource};
+use super::{DenoiseFrame, Denoiser, DenoiserConfig, MotionSource, Overrides};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::gpu_block;
-use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::graph::ImageHandle;
 use crate::passes::surface_features::STEP_VOXELS;
 use glam::Vec4;
 
@@ -138,6 +138,12 @@ impl SvgfParams {
     }
 }
 
+/// `DVR_SVGF`, the variable whose `name=value` pairs override [`SvgfParams`].
+pub const OVERRIDES: Overrides = Overrides {
+    variable: "DVR_SVGF",
+    check: |spec| SvgfParams::DEFAULT.with_overrides(spec).map(drop),
+};
+
 /// The parameters `DVR_SVGF` may set (for parameter studies with `dvr eval`), with the
 /// range each takes.
 const OVERRIDABLE: &[super::Overridable<SvgfParams>] = &[
@@ -170,10 +176,14 @@ pub struct Svgf {
 }
 
 impl Svgf {
-    pub fn new(ctx: &GpuContext, name: &'static str, motion: MotionSource) -> Result<Self> {
-        let params =
-            SvgfParams::default().with_overrides(std::env::var("DVR_SVGF").ok().as_deref())?;
-        Ok(Self {
+    pub fn create(
+        ctx: &GpuContext,
+        name: &'static str,
+        config: &DenoiserConfig,
+    ) -> Result<Box<dyn Denoiser>> {
+        let motion = config.motion;
+        let params = SvgfParams::DEFAULT.with_overrides(OVERRIDES.value().as_deref())?;
+        Ok(Box::new(Self {
             name,
             temporal: ctx.pipeline(
                 "svgf_temporal",
@@ -186,22 +196,13 @@ impl Svgf {
             )?,
             params,
             motion,
-        })
+        }))
     }
 }
 
 impl Denoiser for Svgf {
-    fn name(&self) -> &str {
-        self.name
-    }
-
-    fn add<'f>(
-        &'f self,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
-    ) -> Result<ImageHandle> {
+    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.into_parts();
         let size = input.size;
         let desc = input.rgba32f();
         let n = self.name;
@@ -211,11 +212,11 @@ impl Denoiser for Svgf {
         let ping = graph.image(ctx, &format!("{n}.ping"), desc)?;
         let pong = graph.image(ctx, &format!("{n}.pong"), desc)?;
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
-        let reproj = input.reprojection(self.name(), self.motion)?;
+        let reproj = input.reprojection(self.name, self.motion)?;
         let valid = color.valid && moments.valid && reproj.valid;
         let p = self.params;
         let noisy = input.noisy;
-        let features = input.features(self.name())?;
+        let features = input.features(self.name)?;
         let (albedo, normal, position) = (features.albedo, features.normal, features.position.cur);
         // Synthetic inputs without guides demodulate by the threshold surface's albedo.
         let demod = input.guides.unwrap_or(albedo);

@@ -5,11 +5,11 @@
 //! the output: the average is what the next frame reprojects. Like `svgf` it is not reset
 //! on camera, light or TF changes; the clip box limits how long stale colour survives.
 
-use super::{DenoiseInputs, Denoiser, MotionSource};
+use super::{DenoiseFrame, Denoiser, DenoiserConfig, MotionSource};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::gpu_block;
-use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::graph::ImageHandle;
 use glam::Vec4;
 
 gpu_block! {
@@ -57,32 +57,28 @@ pub struct Taa {
 }
 
 impl Taa {
-    pub fn new(ctx: &GpuContext, name: &'static str, motion: MotionSource) -> Result<Self> {
-        Ok(Self {
+    pub fn create(
+        ctx: &GpuContext,
+        name: &'static str,
+        config: &DenoiserConfig,
+    ) -> Result<Box<dyn Denoiser>> {
+        let motion = config.motion;
+        Ok(Box::new(Self {
             name,
             pipeline: ctx.pipeline("taa", &[("MOTION_SOURCE", SpecValue::I32(motion.spec()))])?,
             params: TaaParams::default(),
             motion,
-        })
+        }))
     }
 }
 
 impl Denoiser for Taa {
-    fn name(&self) -> &str {
-        self.name
-    }
-
-    fn add<'f>(
-        &'f self,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
-    ) -> Result<ImageHandle> {
+    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.into_parts();
         let size = input.size;
         let desc = input.rgba32f();
         let color = graph.history(ctx, &format!("{}.color", self.name), desc)?;
-        let reproj = input.reprojection(self.name(), self.motion)?;
+        let reproj = input.reprojection(self.name, self.motion)?;
         let valid = color.valid && reproj.valid;
         let p = self.params;
         let push = TaaPush {

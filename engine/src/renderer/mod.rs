@@ -27,7 +27,8 @@ pub use reference::{samples_per_dispatch, MAX_SAMPLES_PER_DISPATCH, PIXEL_SAMPLE
 use submit::{add_readbacks, read_pixels, submit, Slot};
 
 use crate::denoise::{
-    self, registry, Changes, DenoiseInputs, Denoiser, DenoiserConfig, DenoiserInfo, Retrace,
+    self, Changes, DenoiseFrame, DenoiseInputs, Denoiser, DenoiserConfig, DenoiserInfo, Registry,
+    Retrace,
 };
 use crate::error::{EngineError, Result, VkContext};
 use crate::gpu::timestamps::{PassOwner, TimestampPool};
@@ -73,6 +74,8 @@ pub struct RendererConfig {
     /// How a label map beside the volume is shown (the volume passes are specialised
     /// on it); `None`: no label map.
     pub labels: Option<crate::scene::LabelMode>,
+    /// The rows the renderer finds its denoisers' names in.
+    pub registry: Registry,
 }
 
 impl Default for RendererConfig {
@@ -87,6 +90,7 @@ impl Default for RendererConfig {
             dataset: None,
             gpu_memory: None,
             labels: None,
+            registry: Registry::default(),
         }
     }
 }
@@ -104,7 +108,7 @@ pub enum SettingsChange {
 
 /// A denoiser the frame runs, with its registry entry.
 struct Method {
-    info: &'static DenoiserInfo,
+    info: DenoiserInfo,
     denoiser: Box<dyn Denoiser>,
 }
 
@@ -463,7 +467,7 @@ impl Renderer {
         if present.is_some() && self.passes.present.is_none() {
             self.passes.present = Some(Present::new(&self.ctx)?);
         }
-        let guide_readers = readers(&self.denoisers, |m| m.info.guides());
+        let guide_readers = readers(&self.denoisers, |m| m.info.guides);
         let guides = !guide_readers.is_empty();
         if (request.aux || guides) && self.passes.aux.is_none() {
             self.passes.aux = Some(AuxFeatures::new(&self.ctx, self.features.volume)?);
@@ -577,7 +581,15 @@ impl Renderer {
         let mut outputs: Vec<(String, ImageHandle)> = Vec::new();
         for m in &self.denoisers {
             let name = m.info.name;
-            let out = frame.add_owned(name, |f| m.denoiser.add(ctx, graph, f, &input))?;
+            let out = frame.add_owned(name, |frame| {
+                let input = &input;
+                m.denoiser.add(DenoiseFrame {
+                    ctx,
+                    graph,
+                    frame,
+                    input,
+                })
+            })?;
             outputs.push((name.to_string(), out));
         }
 
@@ -715,7 +727,8 @@ fn create_methods(
     features: PathTraceFeatures,
     names: &[&str],
 ) -> Result<Vec<Method>> {
-    let config = DenoiserConfig {
+    let registry = &config.registry;
+    let denoiser_config = DenoiserConfig {
         motion: config.motion_source,
         dataset: config.dataset,
         features,
@@ -723,10 +736,10 @@ fn create_methods(
     names
         .iter()
         .map(|n| {
-            let info = registry::find(n)?;
+            let info = *registry.find(n)?;
             Ok(Method {
                 info,
-                denoiser: info.create(ctx, &config)?,
+                denoiser: info.create(ctx, &denoiser_config)?,
             })
         })
         .collect()

@@ -23,7 +23,7 @@ pub mod orbit;
 pub use labels::{LabelEdit, Pick};
 pub use orbit::{Anatomical, OrbitCamera};
 
-use crate::denoise::registry;
+use crate::denoise::Registry;
 use crate::error::EngineError;
 use crate::gpu::GpuContext;
 use crate::graph::Extent;
@@ -140,7 +140,7 @@ impl Session {
         denoisers: &[&str],
     ) -> Result<Self> {
         let ctx = ctx.into();
-        let denoisers = registry_names(denoisers)?;
+        let denoisers = registry_names(&setup.config.registry, denoisers)?;
         let names: Vec<&str> = denoisers.iter().map(String::as_str).collect();
         let renderer = setup.renderer(Arc::clone(&ctx), &names)?;
         let view = setup.scene.view_at(0);
@@ -245,7 +245,7 @@ impl Session {
             Edit::Settings(settings) => return self.set_settings(settings),
             Edit::Denoisers(names) => {
                 let names: Vec<&str> = names.iter().map(String::as_str).collect();
-                let names = registry_names(&names)?;
+                let names = registry_names(&self.setup.config.registry, &names)?;
                 if names == self.denoisers {
                     return Ok(Vec::new());
                 }
@@ -504,10 +504,10 @@ impl Session {
 }
 
 /// The registry's names for `names` (each checked, duplicates dropped, order kept).
-fn registry_names(names: &[&str]) -> Result<Vec<String>> {
+fn registry_names(registry: &Registry, names: &[&str]) -> Result<Vec<String>> {
     let mut out: Vec<String> = Vec::new();
     for n in names {
-        let name = registry::find(n)?.name.to_string();
+        let name = registry.find(n)?.name.to_string();
         if !out.contains(&name) {
             out.push(name);
         }

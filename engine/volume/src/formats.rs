@@ -1,6 +1,7 @@
 //! The table of volume formats: how each is recognised (a folder probe, name endings,
 //! magic bytes) and which function reads it. [`crate::Volume::load`] walks this table
-//! and nothing else, so a new format is its module and one row here.
+//! and nothing else, so a new format is its module and one row here. A [`Table`] is the
+//! walk over a table: [`FORMATS`], or (in a test) it with a toy row added.
 //!
 //! Order matters where two rows could claim one input: folder probes run in table order
 //! (an OME-Zarr folder before "any other folder is a DICOM series"), then name endings,
@@ -21,12 +22,14 @@ pub(crate) struct Request {
 }
 
 /// Bytes at a fixed offset that identify a format.
+#[derive(Clone, Copy)]
 pub(crate) struct Magic {
     pub offset: usize,
     pub bytes: &'static [u8],
 }
 
 /// One format: its name in messages, how it is recognised, how it is read.
+#[derive(Clone, Copy)]
 pub(crate) struct Format {
     pub name: &'static str,
     /// Lower-case name endings that select it (`.nii.gz` before `.gz` would matter).
@@ -118,96 +121,118 @@ pub(crate) const FORMATS: &[Format] = &[
 /// Name endings of raw data, which need a sidecar or explicit parameters.
 pub(crate) const RAW_EXTENSIONS: &[&str] = &[".raw", ".bin", ".dat", ".vol"];
 
-/// The format that reads `path`, by folder probe, name ending, then magic bytes.
-pub(crate) fn format_of(path: &Path) -> Option<&'static Format> {
-    if path.is_dir() {
-        return FORMATS
-            .iter()
-            .find(|f| f.folder.is_some_and(|probe| probe(path)));
-    }
-    let lower = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    if let Some(f) = FORMATS
-        .iter()
-        .find(|f| f.extensions.iter().any(|e| lower.ends_with(e)))
-    {
-        return Some(f);
-    }
-    // Only regular files are sniffed: a FIFO or device must not be opened here (the
-    // loaders refuse those with their own error).
-    if !path.is_file() {
-        return None;
-    }
-    let head = leading_bytes(path)?;
-    FORMATS.iter().find(|f| {
-        f.magic.iter().any(|m| {
-            head.get(m.offset..m.offset + m.bytes.len())
-                .is_some_and(|b| b == m.bytes)
-        })
-    })
-}
+/// A table of formats, walked in its order.
+#[derive(Clone, Copy)]
+pub(crate) struct Table<'t>(pub &'t [Format]);
 
-/// The first bytes of a file, enough for every magic in the table.
-fn leading_bytes(path: &Path) -> Option<Vec<u8>> {
-    let need = FORMATS
-        .iter()
-        .flat_map(|f| f.magic.iter().map(|m| m.offset + m.bytes.len()))
-        .max()
-        .unwrap_or(0);
-    let mut head = Vec::with_capacity(need);
-    std::fs::File::open(path)
-        .ok()?
-        .take(need as u64)
-        .read_to_end(&mut head)
-        .ok()?;
-    Some(head)
-}
+/// The formats `Volume::load` reads.
+pub(crate) const BUILTIN: Table<'static> = Table(FORMATS);
 
-/// Reads `path` with the format the table picks (see [`format_of`]), or raw data
-/// described by a sidecar `<file>.json` / `<file>.toml`.
+/// Reads `path` with the built-in table (see [`Table::load`]).
 pub(crate) fn load(path: &Path, request: Request) -> Result<Volume, VolumeError> {
-    if let Some(format) = format_of(path) {
-        log::debug!("{}: read as {}", path.display(), format.name);
-        return (format.load)(path, request);
-    }
-    if let Some(params) = raw::read_sidecar(path)? {
-        return raw::load(path, &params);
-    }
-    let lower = path.to_string_lossy().to_ascii_lowercase();
-    if RAW_EXTENSIONS.iter().any(|e| lower.ends_with(e)) {
-        return Err(VolumeError::MissingRawParams {
-            path: path.to_path_buf(),
-        });
-    }
-    Err(VolumeError::Unsupported {
-        path: path.to_path_buf(),
-        reason: format!(
-            "unknown volume format; expected {}, a DICOM or OME-Zarr folder, or raw data \
-             with a <file>.json/.toml sidecar",
-            known_endings()
-        ),
-    })
+    BUILTIN.load(path, request)
 }
 
-/// Opens `path` as a series with the format the table picks; raw data (a sidecar) is
-/// one channel at one time point without an orientation.
+/// Opens `path` as a series with the built-in table (see [`Table::open_series`]).
 pub(crate) fn open_series(path: &Path) -> Result<Box<dyn Source>, VolumeError> {
-    if let Some(format) = format_of(path) {
-        return (format.series)(path);
-    }
-    // Raw, or the error `load` gives for what it cannot read.
-    WholeFile::open(path, load(path, Request::default())?, false)
+    BUILTIN.open_series(path)
 }
 
-/// Every name ending of the table, for messages: ".zarr, .dcm, .nrrd, …".
-pub(crate) fn known_endings() -> String {
-    FORMATS
-        .iter()
-        .flat_map(|f| f.extensions.iter().copied())
-        .collect::<Vec<_>>()
-        .join(", ")
+impl<'t> Table<'t> {
+    /// The format that reads `path`, by folder probe, name ending, then magic bytes.
+    pub(crate) fn format_of(self, path: &Path) -> Option<&'t Format> {
+        if path.is_dir() {
+            return self
+                .0
+                .iter()
+                .find(|f| f.folder.is_some_and(|probe| probe(path)));
+        }
+        let lower = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        if let Some(f) = self
+            .0
+            .iter()
+            .find(|f| f.extensions.iter().any(|e| lower.ends_with(e)))
+        {
+            return Some(f);
+        }
+        // Only regular files are sniffed: a FIFO or device must not be opened here (the
+        // loaders refuse those with their own error).
+        if !path.is_file() {
+            return None;
+        }
+        let head = self.leading_bytes(path)?;
+        self.0.iter().find(|f| {
+            f.magic.iter().any(|m| {
+                head.get(m.offset..m.offset + m.bytes.len())
+                    .is_some_and(|b| b == m.bytes)
+            })
+        })
+    }
+
+    /// The first bytes of a file, enough for every magic in the table.
+    fn leading_bytes(self, path: &Path) -> Option<Vec<u8>> {
+        let need = self
+            .0
+            .iter()
+            .flat_map(|f| f.magic.iter().map(|m| m.offset + m.bytes.len()))
+            .max()
+            .unwrap_or(0);
+        let mut head = Vec::with_capacity(need);
+        std::fs::File::open(path)
+            .ok()?
+            .take(need as u64)
+            .read_to_end(&mut head)
+            .ok()?;
+        Some(head)
+    }
+
+    /// Reads `path` with the format the table picks (see [`Table::format_of`]), or raw
+    /// data described by a sidecar `<file>.json` / `<file>.toml`.
+    pub(crate) fn load(self, path: &Path, request: Request) -> Result<Volume, VolumeError> {
+        if let Some(format) = self.format_of(path) {
+            log::debug!("{}: read as {}", path.display(), format.name);
+            return (format.load)(path, request);
+        }
+        if let Some(params) = raw::read_sidecar(path)? {
+            return raw::load(path, &params);
+        }
+        let lower = path.to_string_lossy().to_ascii_lowercase();
+        if RAW_EXTENSIONS.iter().any(|e| lower.ends_with(e)) {
+            return Err(VolumeError::MissingRawParams {
+                path: path.to_path_buf(),
+            });
+        }
+        Err(VolumeError::Unsupported {
+            path: path.to_path_buf(),
+            reason: format!(
+                "unknown volume format; expected {}, a DICOM or OME-Zarr folder, or raw data \
+                 with a <file>.json/.toml sidecar",
+                self.known_endings()
+            ),
+        })
+    }
+
+    /// Opens `path` as a series with the format the table picks; raw data (a sidecar) is
+    /// one channel at one time point without an orientation.
+    pub(crate) fn open_series(self, path: &Path) -> Result<Box<dyn Source>, VolumeError> {
+        if let Some(format) = self.format_of(path) {
+            return (format.series)(path);
+        }
+        // Raw, or the error `load` gives for what it cannot read.
+        WholeFile::open(path, self.load(path, Request::default())?, false)
+    }
+
+    /// Every name ending of the table, for messages: ".zarr, .dcm, .nrrd, …".
+    pub(crate) fn known_endings(self) -> String {
+        self.0
+            .iter()
+            .flat_map(|f| f.extensions.iter().copied())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
 }
 
 #[cfg(test)]
@@ -252,16 +277,16 @@ mod tests {
         for (name, bytes, want) in cases {
             let p = dir.path().join(name);
             std::fs::write(&p, bytes).expect("write");
-            assert_eq!(format_of(&p).map(|f| f.name), Some(want), "{name}");
+            assert_eq!(BUILTIN.format_of(&p).map(|f| f.name), Some(want), "{name}");
         }
         let mut nifti = vec![0u8; 352];
         nifti[344..348].copy_from_slice(b"n+1\0");
         let p = dir.path().join("d.img");
         std::fs::write(&p, nifti).expect("write");
-        assert_eq!(format_of(&p).map(|f| f.name), Some("NIfTI-1"));
+        assert_eq!(BUILTIN.format_of(&p).map(|f| f.name), Some("NIfTI-1"));
         let p = dir.path().join("e.bin");
         std::fs::write(&p, [1u8, 2, 3]).expect("write");
-        assert!(format_of(&p).is_none());
+        assert!(BUILTIN.format_of(&p).is_none());
     }
 
     #[test]
@@ -273,5 +298,64 @@ mod tests {
                 assert!(msg.contains(e), "{msg} lacks {e}");
             }
         }
+    }
+
+    /// The toy format of the plugin test: `TOY3`, three little-endian u32 dims, then
+    /// the u8 voxels, x fastest.
+    fn load_toy(path: &Path) -> Result<Volume, VolumeError> {
+        let bytes = std::fs::read(path).expect("a toy file");
+        let dim = |i: usize| u32::from_le_bytes(bytes[4 + 4 * i..8 + 4 * i].try_into().unwrap());
+        let voxels = bytes[16..].to_vec();
+        Volume::new(
+            "toy",
+            [dim(0), dim(1), dim(2)],
+            [1.0; 3],
+            crate::VolumeData::U8(voxels),
+        )
+    }
+
+    /// The row a new format adds to [`FORMATS`].
+    const TOY: Format = Format {
+        name: "toy",
+        extensions: &[".toy"],
+        magic: &[Magic {
+            offset: 0,
+            bytes: b"TOY3",
+        }],
+        folder: None,
+        load: |p, _| load_toy(p),
+        series: |p| WholeFile::open(p, load_toy(p)?, false),
+    };
+
+    #[test]
+    fn a_new_format_is_one_row() {
+        let rows: Vec<Format> = FORMATS.iter().copied().chain([TOY]).collect();
+        let table = Table(&rows);
+        let dir = tempfile::tempdir().expect("tempdir");
+        let file = [
+            b"TOY3".as_slice(),
+            &[2, 0, 0, 0, 1, 0, 0, 0, 3, 0, 0, 0],
+            &[0, 51, 102, 153, 204, 255],
+        ]
+        .concat();
+        // By its ending, and by its magic under a name that says nothing.
+        for name in ["a.toy", "b"] {
+            let p = dir.path().join(name);
+            std::fs::write(&p, &file).expect("write");
+            assert_eq!(table.format_of(&p).map(|f| f.name), Some("toy"), "{name}");
+            let v = table.load(&p, Request::default()).expect("a toy volume");
+            assert_eq!(v.dims, [2, 1, 3]);
+            assert_eq!(v.value(1, 0, 2), Some(1.0));
+            let series = table.open_series(&p).expect("a toy series");
+            assert_eq!(series.info().dims, [2, 1, 3]);
+            assert!(
+                BUILTIN.load(&p, Request::default()).is_err(),
+                "{name}: not built in"
+            );
+        }
+        let err = table
+            .load(Path::new("/nonexistent/picture.png"), Request::default())
+            .unwrap_err();
+        assert!(err.to_string().contains(".toy"), "{err}");
     }
 }

@@ -201,8 +201,8 @@ impl ResultKey {
             motion: args.render.motion.to_string(),
             aux: args.aux,
             shaders: shaders_hash(),
-            overrides: dvr_engine::denoise::OVERRIDE_VARIABLES
-                .iter()
+            overrides: dvr_engine::denoise::override_variables()
+                .into_iter()
                 .filter_map(|v| Some((v.to_string(), std::env::var(v).ok()?)))
                 .collect(),
         }

@@ -41,10 +41,11 @@ mod prior;
 mod update;
 
 use super::variance_atrous::{self, VarianceAtrousPush};
-use super::{DenoiseInputs, Denoiser, MotionSource, Overridable};
+use super::{Build, Overrides};
+use super::{DenoiseFrame, Denoiser, DenoiserConfig, MotionSource, Overridable};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline, SpecValue};
-use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::graph::ImageHandle;
 use crate::passes::path_trace::{self, PathTraceFeatures};
 use gradient::OursGradientPush;
 use gradient_pool::OursGradientPoolPush;
@@ -96,6 +97,12 @@ impl Default for OursParams {
         }
     }
 }
+
+/// `DVR_OURS`, the variable whose `name=value` pairs override [`OursParams`].
+pub const OVERRIDES: Overrides = Overrides {
+    variable: "DVR_OURS",
+    check: |spec| OursParams::default().with_overrides(spec).map(drop),
+};
 
 /// The parameters `DVR_OURS` may set (for parameter studies with `dvr eval`), with the
 /// range each takes.
@@ -180,8 +187,7 @@ impl Ours {
         motion: MotionSource,
         features: PathTraceFeatures,
     ) -> Result<Self> {
-        let params =
-            OursParams::default().with_overrides(std::env::var("DVR_OURS").ok().as_deref())?;
+        let params = OursParams::default().with_overrides(OVERRIDES.value().as_deref())?;
         let motion_source = ("MOTION_SOURCE", SpecValue::I32(motion.spec()));
         Ok(Self {
             name: name.to_string(),
@@ -213,18 +219,22 @@ impl Ours {
     }
 }
 
-impl Denoiser for Ours {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn add<'f>(
-        &'f self,
+/// A row's variant builds ours with its stages.
+impl Build for OursVariant {
+    fn build(
+        &self,
         ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
-    ) -> Result<ImageHandle> {
+        name: &'static str,
+        config: &DenoiserConfig,
+    ) -> Result<Box<dyn Denoiser>> {
+        let ours = Ours::new(ctx, name, *self, config.motion, config.features)?;
+        Ok(Box::new(ours))
+    }
+}
+
+impl Denoiser for Ours {
+    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.into_parts();
         let desc = input.rgba32f();
         let n = &self.name;
         let lag = lag::LagImages {

@@ -16,10 +16,10 @@ mod spatial;
 mod update;
 
 use super::variance_atrous::{self, VarianceAtrousPush};
-use super::{DenoiseInputs, Denoiser, MotionSource, Overridable};
+use super::{Build, DenoiseFrame, Denoiser, DenoiserConfig, MotionSource, Overridable, Overrides};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline, SpecValue};
-use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::graph::ImageHandle;
 use spatial::WrlsSpatialPush;
 use update::{WrlsConstantPush, WrlsUpdatePush};
 
@@ -67,6 +67,12 @@ impl Default for WrlsParams {
         }
     }
 }
+
+/// `DVR_WRLS`, the variable whose `name=value` pairs override [`WrlsParams`].
+pub const OVERRIDES: Overrides = Overrides {
+    variable: "DVR_WRLS",
+    check: |spec| WrlsParams::default().with_overrides(spec).map(drop),
+};
 
 /// The parameters `DVR_WRLS` may set, the range each takes, and where each goes.
 const OVERRIDABLE: &[Overridable<WrlsParams>] = &[
@@ -167,8 +173,7 @@ impl Wrls {
                 variance_atrous::pipeline(ctx, false, false)?,
             )
         };
-        let params =
-            WrlsParams::default().with_overrides(std::env::var("DVR_WRLS").ok().as_deref())?;
+        let params = WrlsParams::default().with_overrides(OVERRIDES.value().as_deref())?;
         Ok(Self {
             name: name.to_string(),
             params,
@@ -178,18 +183,21 @@ impl Wrls {
     }
 }
 
-impl Denoiser for Wrls {
-    fn name(&self) -> &str {
-        &self.name
-    }
-
-    fn add<'f>(
-        &'f self,
+/// A row's variant builds the family's member with its switches.
+impl Build for WrlsVariant {
+    fn build(
+        &self,
         ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
-    ) -> Result<ImageHandle> {
+        name: &'static str,
+        config: &DenoiserConfig,
+    ) -> Result<Box<dyn Denoiser>> {
+        Ok(Box::new(Wrls::new(ctx, name, *self, config.motion)?))
+    }
+}
+
+impl Denoiser for Wrls {
+    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.into_parts();
         let desc = input.rgba32f();
         let n = &self.name;
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
