@@ -13,7 +13,7 @@ mod common;
 
 use common::*;
 use dvr_engine::renderer::uploads::{LutUpload, VolumeUpload};
-use dvr_engine::renderer::{FrameInputs, FrameRequest, Renderer, VolumeResidency};
+use dvr_engine::renderer::{FrameInputs, Renderer, VolumeResidency};
 use dvr_engine::scene::{ClipPlane, Cut};
 use dvr_engine::volume::{Volume, VolumeData};
 use glam::Vec3;
@@ -82,20 +82,11 @@ fn run(r: &mut Renderer, tfs: &[LutUpload]) -> Vec<Vec<(String, Vec<[f32; 4]>)>>
 fn run_cut(r: &mut Renderer, tfs: &[LutUpload], cut: &Cut) -> Vec<Vec<(String, Vec<[f32; 4]>)>> {
     let camera = front_camera(2.2, 40.0);
     let lights = vec![point_light(Vec3::new(0.8, 1.0, 1.5), 6.0), environment(0.3)];
-    let request = FrameRequest {
-        readback: true,
-        ..Default::default()
-    };
-    let mut results = Vec::new();
-    for lut in tfs {
-        let i = FrameInputs {
-            cut: cut.clone(),
-            ..inputs(camera, lights.clone(), lut.clone())
-        };
-        results.extend(r.frame(&i, &request).expect("frame"));
-    }
-    results.extend(r.flush().expect("flush"));
-    results.sort_by_key(|f| f.index);
+    let frames = tfs.iter().map(|lut| FrameInputs {
+        cut: cut.clone(),
+        ..inputs(camera, lights.clone(), lut.clone())
+    });
+    let results = render_frames(r, frames, &readback());
     results.into_iter().map(|f| f.images).collect()
 }
 

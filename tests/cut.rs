@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use dvr_engine::renderer::{FrameInputs, FrameRequest};
+use dvr_engine::renderer::FrameInputs;
 use dvr_engine::scene::{ClipPlane, CropBox, CropUnits, Cut};
 use glam::{DVec3, Vec3};
 
@@ -151,30 +151,21 @@ fn frames(cut: &Cut) -> Vec<Vec<(String, Vec<[f32; 4]>)>> {
         &volume,
         &["none", "ours", "svgf"],
     );
-    let request = FrameRequest {
-        readback: true,
-        ..Default::default()
-    };
-    let mut out = Vec::new();
-    for f in 0..3 {
-        let i = FrameInputs {
-            cut: cut.clone(),
-            ..inputs(
-                dvr_engine::renderer::CameraMatrices::look_at(
-                    Vec3::new(1.2 + 0.05 * f as f32, 1.0, 1.4),
-                    Vec3::ZERO,
-                    Vec3::Z,
-                    40f32.to_radians(),
-                    1.0,
-                ),
-                vec![point_light(Vec3::new(1.0, 1.5, 2.0), 8.0), environment(0.2)],
-                constant_lut(0.6, 0.8),
-            )
-        };
-        out.extend(r.frame(&i, &request).expect("frame"));
-    }
-    out.extend(r.flush().expect("flush"));
-    out.sort_by_key(|f| f.index);
+    let frames = (0..3).map(|f| FrameInputs {
+        cut: cut.clone(),
+        ..inputs(
+            dvr_engine::renderer::CameraMatrices::look_at(
+                Vec3::new(1.2 + 0.05 * f as f32, 1.0, 1.4),
+                Vec3::ZERO,
+                Vec3::Z,
+                40f32.to_radians(),
+                1.0,
+            ),
+            vec![point_light(Vec3::new(1.0, 1.5, 2.0), 8.0), environment(0.2)],
+            constant_lut(0.6, 0.8),
+        )
+    });
+    let out = render_frames(&mut r, frames, &readback());
     out.into_iter().map(|f| f.images).collect()
 }
 

@@ -159,20 +159,11 @@ fn phantom_frames(
     let mut r = setup
         .renderer(context(), &["ours", "svgf"])
         .expect("renderer");
-    let request = FrameRequest {
-        readback: true,
-        ..Default::default()
-    };
-    let mut out = Vec::new();
-    for f in 0..3 {
-        let i = dvr_engine::renderer::FrameInputs {
-            labels: look.clone(),
-            ..setup.frame_inputs(f)
-        };
-        out.extend(r.frame(&i, &request).expect("frame"));
-    }
-    out.extend(r.flush().expect("flush"));
-    out.sort_by_key(|f| f.index);
+    let frames = (0..3).map(|f| dvr_engine::renderer::FrameInputs {
+        labels: look.clone(),
+        ..setup.frame_inputs(f)
+    });
+    let out = render_frames(&mut r, frames, &readback());
     out.into_iter().map(|f| f.images).collect()
 }
 

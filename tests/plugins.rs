@@ -7,14 +7,13 @@
 mod common;
 
 use common::*;
-use dvr_engine::denoise::{DenoiseFrame, Denoiser, DenoiserConfig, DenoiserInfo};
+use dvr_engine::denoise::{Built, DenoiseFrame, Denoiser, DenoiserConfig, DenoiserInfo};
 use dvr_engine::denoise::{FeatureUse, Registry};
 use dvr_engine::error::{EngineError, Result};
 use dvr_engine::gpu::timestamps::PassOwner;
 use dvr_engine::gpu::GpuContext;
 use dvr_engine::graph::ImageHandle;
 use dvr_engine::passes::accumulate::Accumulate;
-use dvr_engine::renderer::FrameRequest;
 
 /// The running mean of the noisy frames (accum without its restarts), which insists on
 /// the surface features and the guide albedo its row says it reads.
@@ -24,11 +23,7 @@ struct ToyMean {
 }
 
 impl ToyMean {
-    fn create(
-        ctx: &GpuContext,
-        name: &'static str,
-        _: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>> {
+    fn create(ctx: &GpuContext, name: &'static str, _: &DenoiserConfig) -> Built {
         Ok(Box::new(Self {
             name,
             pass: Accumulate::new(ctx)?,
@@ -82,15 +77,8 @@ fn a_toy_denoiser_is_one_row() {
 
     setup.config.registry = Registry::default().with(TOY).expect("a new name");
     let mut r = setup.renderer(context(), &names).expect("renderer");
-    let request = FrameRequest {
-        readback: true,
-        ..Default::default()
-    };
-    let mut results = Vec::new();
-    for f in 0..FRAMES {
-        results.extend(r.frame(&setup.frame_inputs(f), &request).expect("frame"));
-    }
-    results.extend(r.flush().expect("flush"));
+    let frames = (0..FRAMES).map(|f| setup.frame_inputs(f));
+    let results = render_frames(&mut r, frames, &readback());
     assert_eq!(results.len(), FRAMES as usize);
 
     let mut sum: Vec<[f64; 3]> = Vec::new();

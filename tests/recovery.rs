@@ -19,7 +19,7 @@ mod common;
 
 use common::*;
 use dvr_engine::metrics::{psnr, tonemap_srgb, Rgb32Image};
-use dvr_engine::renderer::{FrameInputs, FrameRequest, Renderer};
+use dvr_engine::renderer::{FrameInputs, Renderer};
 
 /// The deficit below the restart varies with the image size, and not with whether the
 /// image's edge cuts a stratum (with 5×5 strata, stratum 6 gave 2.00 dB at 24², which it
@@ -48,19 +48,8 @@ fn rgb(px: &[[f32; 4]]) -> Rgb32Image {
 
 /// `r`'s output for each of `frames`, in order (the frames in flight flushed at the end).
 fn render_all(r: &mut Renderer, frames: impl Iterator<Item = FrameInputs>) -> Vec<Vec<[f32; 4]>> {
-    let request = FrameRequest {
-        readback: true,
-        ..Default::default()
-    };
-    let mut outputs = Vec::new();
-    for inputs in frames {
-        if let Some(done) = r.frame(&inputs, &request).expect("frame") {
-            outputs.push(done.images[0].1.clone());
-        }
-    }
-    let flushed = r.flush().expect("flush");
-    outputs.extend(flushed.into_iter().map(|d| d.images[0].1.clone()));
-    outputs
+    let done = render_frames(r, frames, &readback());
+    done.into_iter().map(|d| d.images[0].1.clone()).collect()
 }
 
 /// (the jump's frame, PSNR per frame from the jump on, the restarted filter's at the same

@@ -25,17 +25,8 @@ fn every_denoiser_stays_finite_and_bounded_on_every_built_in_animation() {
         let mut r = setup
             .renderer(context(), &registry::names().collect::<Vec<_>>())
             .expect("renderer");
-        let request = FrameRequest {
-            readback: true,
-            reset: false,
-            aux: false,
-            features: false,
-        };
-        let mut results = Vec::new();
-        for f in 0..8 {
-            results.extend(r.frame(&setup.frame_inputs(f), &request).expect("frame"));
-        }
-        results.extend(r.flush().expect("flush"));
+        let frames = (0..8).map(|f| setup.frame_inputs(f));
+        let results = render_frames(&mut r, frames, &readback());
         assert_eq!(results.len(), 8);
         for done in &results {
             let noisy_max = done.images[0]

@@ -9,7 +9,8 @@ pub mod eval;
 use dvr_engine::gpu::{validation, GpuContext};
 use dvr_engine::graph::Extent;
 use dvr_engine::renderer::uploads::{BrickRanges, LutUpload, VolumeFormat, VolumeUpload};
-use dvr_engine::renderer::{CameraMatrices, FrameInputs, Renderer, RendererConfig};
+use dvr_engine::renderer::{CameraMatrices, FrameInputs, FrameRequest, FrameResult};
+use dvr_engine::renderer::{Renderer, RendererConfig};
 use dvr_engine::scene::RenderSettings;
 use dvr_engine::shaders::frame::{GpuLight, ENV_CONSTANT, LIGHT_ENV, LIGHT_POINT};
 use glam::{Vec3, Vec4};
@@ -158,6 +159,30 @@ pub fn inputs(camera: CameraMatrices, lights: Vec<GpuLight>, lut: LutUpload) -> 
         time: None,
         labels: None,
     }
+}
+
+/// A frame request that reads every method's output back.
+pub fn readback() -> FrameRequest {
+    FrameRequest {
+        readback: true,
+        ..Default::default()
+    }
+}
+
+/// Renders `frames` in order with `request`, then the frames still in flight: every
+/// result, by frame index.
+pub fn render_frames(
+    r: &mut Renderer,
+    frames: impl IntoIterator<Item = FrameInputs>,
+    request: &FrameRequest,
+) -> Vec<FrameResult> {
+    let mut done = Vec::new();
+    for inputs in frames {
+        done.extend(r.frame(&inputs, request).expect("frame"));
+    }
+    done.extend(r.flush().expect("flush"));
+    done.sort_by_key(|f| f.index);
+    done
 }
 
 /// Mean squared error over the colour channels of two rgba images.

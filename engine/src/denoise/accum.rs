@@ -1,7 +1,7 @@
 //! `accum`: progressive accumulation while nothing changes; any camera, light or TF
 //! change starts over. Converges to the reference on static scenes, lags on animated ones.
 
-use super::{DenoiseFrame, Denoiser, DenoiserConfig};
+use super::{Built, DenoiseFrame, Denoiser, DenoiserConfig};
 use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::graph::ImageHandle;
@@ -14,11 +14,7 @@ pub struct Accum {
 }
 
 impl Accum {
-    pub fn create(
-        ctx: &GpuContext,
-        name: &'static str,
-        _: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>> {
+    pub fn create(ctx: &GpuContext, name: &'static str, _: &DenoiserConfig) -> Built {
         Ok(Box::new(Self {
             name,
             pass: Accumulate::new(ctx)?,

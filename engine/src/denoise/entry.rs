@@ -3,7 +3,7 @@
 //! it is built. A row carries all of it, so the registry's table
 //! ([`super::registry::DENOISERS`]) is the one place a denoiser is listed.
 
-use super::{Denoiser, MotionSource};
+use super::{Denoiser, MotionSource, Overrides};
 use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::passes::path_trace::PathTraceFeatures;
@@ -45,47 +45,25 @@ pub struct DenoiserConfig<'a> {
     pub features: PathTraceFeatures,
 }
 
+/// What building a denoiser gives: the denoiser, or why it could not be built (a
+/// pipeline, a weight file, an override).
+pub type Built = Result<Box<dyn Denoiser>>;
+
 /// How a row builds its denoiser, named `name` (its passes and images are named after
 /// it). A method without variants is built by a function of this signature (its
 /// `create`); a method with variants implements it on its variant struct, whose value
 /// in the row holds the switches ([`super::OursVariant`], [`super::WrlsVariant`],
 /// [`super::rae::RaeNet`]).
 pub trait Build: Any + Sync {
-    fn build(
-        &self,
-        ctx: &GpuContext,
-        name: &'static str,
-        config: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>>;
+    fn build(&self, ctx: &GpuContext, name: &'static str, config: &DenoiserConfig) -> Built;
 }
 
 impl<F> Build for F
 where
-    F: Fn(&GpuContext, &'static str, &DenoiserConfig) -> Result<Box<dyn Denoiser>> + Sync + 'static,
+    F: Fn(&GpuContext, &'static str, &DenoiserConfig) -> Built + Sync + 'static,
 {
-    fn build(
-        &self,
-        ctx: &GpuContext,
-        name: &'static str,
-        config: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>> {
+    fn build(&self, ctx: &GpuContext, name: &'static str, config: &DenoiserConfig) -> Built {
         self(ctx, name, config)
-    }
-}
-
-/// The environment variable that overrides a denoiser's parameters (`name=value` pairs,
-/// see [`super::with_overrides`]), and the check of its value as the denoiser will read
-/// it, so a command refuses a bad value before it renders anything.
-#[derive(Clone, Copy, Debug)]
-pub struct Overrides {
-    pub variable: &'static str,
-    pub check: fn(Option<&str>) -> Result<()>,
-}
-
-impl Overrides {
-    /// The variable's value in the environment, if it is set.
-    pub fn value(&self) -> Option<String> {
-        std::env::var(self.variable).ok()
     }
 }
 
@@ -152,7 +130,7 @@ impl DenoiserInfo {
     }
 
     /// Builds the denoiser.
-    pub fn create(&self, ctx: &GpuContext, config: &DenoiserConfig) -> Result<Box<dyn Denoiser>> {
+    pub fn create(&self, ctx: &GpuContext, config: &DenoiserConfig) -> Built {
         self.build.build(ctx, self.name, config)
     }
 }

@@ -5,6 +5,7 @@
 mod accum;
 mod entry;
 pub mod ours;
+mod overrides;
 mod passthrough;
 pub mod rae;
 pub mod registry;
@@ -15,11 +16,13 @@ pub mod wrls_paper;
 
 pub use accum::Accum;
 pub use ours::{Ours, OursVariant};
+#[cfg(test)]
+pub(crate) use overrides::assert_overrides_refused;
+pub use overrides::{check_env_overrides, override_variables, unused_overrides, with_overrides};
+pub use overrides::{Overridable, Overrides, Tunables};
 pub use passthrough::Passthrough;
 pub use rae::{Rae, RaeWeights};
-pub use registry::{
-    Build, DenoiserConfig, DenoiserInfo, FeatureUse, Overrides, Registry, DENOISERS,
-};
+pub use registry::{Build, Built, DenoiserConfig, DenoiserInfo, FeatureUse, Registry, DENOISERS};
 pub use svgf::Svgf;
 pub use taa::Taa;
 pub use wrls_paper::{Wrls, WrlsVariant};
@@ -30,111 +33,6 @@ use crate::graph::{Bindings, BufferHandle, Extent, Frame, History, ImageHandle, 
 use crate::passes::surface_features::FeatureImages;
 use crate::passes::SceneBindings;
 use ash::vk;
-
-/// One overridable parameter of a denoiser: its name, the range it takes, and where it
-/// goes.
-pub type Overridable<P> = (&'static str, f32, f32, fn(&mut P, f32));
-
-/// The environment variables that override denoiser parameters (`DVR_SVGF`,
-/// `DVR_OURS`, `DVR_WRLS`: each registry row names the one its method reads), in table
-/// order: what a method computes depends on them.
-pub fn override_variables() -> Vec<&'static str> {
-    registry::BUILTIN
-        .overrides()
-        .iter()
-        .map(|o| o.variable)
-        .collect()
-}
-
-/// A sentence for each override variable set in the environment that none of the
-/// `running` methods reads, naming the variable and the methods it applies to: a user
-/// who set one expects it to act, or to be told that it does not.
-pub fn unused_overrides(running: &[&str]) -> Vec<String> {
-    override_variables()
-        .into_iter()
-        .filter(|v| std::env::var(v).is_ok_and(|s| !s.trim().is_empty()))
-        .filter_map(|v| {
-            let readers: Vec<&str> = registry::DENOISERS
-                .iter()
-                .filter(|d| d.override_variable() == Some(v))
-                .map(|d| d.name)
-                .collect();
-            (!running.iter().any(|r| readers.contains(r))).then(|| {
-                format!(
-                    "{v} is set but no method it applies to runs ({} read it; running: {})",
-                    readers.join(", "),
-                    running.join(", ")
-                )
-            })
-        })
-        .collect()
-}
-
-/// Checks the parameter overrides in the environment (each row's variable) as the
-/// denoisers will read them, so a command can refuse a bad value before it renders
-/// anything, not when the method is built after the references.
-pub fn check_env_overrides() -> Result<()> {
-    for o in registry::BUILTIN.overrides() {
-        (o.check)(o.value().as_deref())?;
-    }
-    Ok(())
-}
-
-/// `params` with the `name=value` pairs of `spec` (comma-separated, e.g. from the
-/// environment variable `variable`) applied, for parameter studies with `dvr eval`. An
-/// unknown name lists the known ones; a value outside its range (or not finite) is an
-/// error naming the range.
-pub fn with_overrides<P>(
-    mut params: P,
-    variable: &'static str,
-    spec: Option<&str>,
-    table: &[Overridable<P>],
-) -> Result<P> {
-    let Some(spec) = spec else {
-        return Ok(params);
-    };
-    for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let bad = |problem: String| EngineError::InvalidSetting {
-            name: variable,
-            value: format!("{item:?}"),
-            allowed: problem,
-        };
-        let (name, value) = item
-            .split_once('=')
-            .ok_or_else(|| bad("expected name=value pairs, comma-separated".into()))?;
-        let v: f64 = value
-            .trim()
-            .parse()
-            .map_err(|e| bad(format!("the value must be a number ({e})")))?;
-        let (_, lo, hi, set) = table
-            .iter()
-            .find(|(n, ..)| *n == name.trim())
-            .ok_or_else(|| {
-                let known: Vec<&str> = table.iter().map(|(n, ..)| *n).collect();
-                bad(format!("parameters: {}", known.join(", ")))
-            })?;
-        // Checked as given (f64), so the documented inclusive bounds hold.
-        if !(v >= f64::from(*lo) && v <= f64::from(*hi)) {
-            return Err(bad(format!("{} must be in [{lo}, {hi}]", name.trim())));
-        }
-        set(&mut params, v as f32);
-    }
-    Ok(params)
-}
-
-/// Fails unless `with_overrides` refuses every `(spec, says)` of `cases` with an error
-/// naming `variable` and saying `says`: the overrides' tests of every denoiser.
-#[cfg(test)]
-pub(crate) fn assert_overrides_refused<P: std::fmt::Debug>(
-    with_overrides: impl Fn(Option<&str>) -> Result<P>,
-    variable: &str,
-    cases: &[(&str, &str)],
-) {
-    for &(spec, says) in cases {
-        let e = with_overrides(Some(spec)).expect_err(spec).to_string();
-        assert!(e.contains(variable) && e.contains(says), "{spec}: {e}");
-    }
-}
 
 /// Disocclusion tolerance of the shared reprojection (include/reproject.glsl): how far,
 /// in pixels, last frame's surface may land from this pixel when projected back.

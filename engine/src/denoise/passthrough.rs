@@ -1,6 +1,6 @@
 //! `none`: the noisy input, unchanged (the baseline every method is compared with).
 
-use super::{DenoiseFrame, Denoiser, DenoiserConfig};
+use super::{Built, DenoiseFrame, Denoiser, DenoiserConfig};
 use crate::error::Result;
 use crate::gpu::GpuContext;
 use crate::graph::ImageHandle;
@@ -8,11 +8,7 @@ use crate::graph::ImageHandle;
 pub struct Passthrough;
 
 impl Passthrough {
-    pub fn create(
-        _: &GpuContext,
-        _: &'static str,
-        _: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>> {
+    pub fn create(_: &GpuContext, _: &'static str, _: &DenoiserConfig) -> Built {
         Ok(Box::new(Passthrough))
     }
 }

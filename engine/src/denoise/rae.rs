@@ -28,7 +28,7 @@
 //! recurrent state is never reset on camera, light or TF changes: the network was
 //! trained on moving sequences and has no reprojection.
 
-use super::{Build, DenoiseFrame, Denoiser, DenoiserConfig};
+use super::{Build, Built, DenoiseFrame, Denoiser, DenoiserConfig};
 use crate::error::{EngineError, Result};
 use crate::gpu::{GpuContext, ImageDesc, Pipeline};
 use crate::gpu_block;
@@ -134,12 +134,7 @@ impl RaeNet {
 }
 
 impl Build for RaeNet {
-    fn build(
-        &self,
-        ctx: &GpuContext,
-        name: &'static str,
-        config: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>> {
+    fn build(&self, ctx: &GpuContext, name: &'static str, config: &DenoiserConfig) -> Built {
         let (net, precision) = self.network(config.dataset);
         let weights = RaeWeights::builtin(net)?;
         Ok(Box::new(Rae::new(ctx, name, weights, precision)?))

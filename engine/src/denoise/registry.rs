@@ -5,16 +5,19 @@
 //! [`Registry`]: the built-in one is [`DENOISERS`], and [`Registry::with`] adds a row
 //! (a test's toy denoiser) that the renderer then builds as it builds any other.
 
+use super::ours::OursParams;
 use super::rae::RaeNet;
+use super::svgf::SvgfParams;
+use super::wrls_paper::WrlsParams;
 use super::{Accum, Passthrough, Svgf, Taa};
 use super::{OursVariant, WrlsVariant};
 use crate::error::{EngineError, Result};
 use crate::gpu::GpuContext;
 use std::borrow::Cow;
 
-pub use super::entry::{Build, DenoiserConfig, DenoiserInfo, FeatureUse, Overrides};
+pub use super::entry::{Build, Built, DenoiserConfig, DenoiserInfo, FeatureUse};
 pub use super::rae::Precision;
-pub use super::Denoiser;
+use super::Overrides;
 
 /// A RAE row: the shipped network `net` (None: the one trained on the scene's dataset,
 /// see [`super::rae::network_for`]) at `precision`.
@@ -31,7 +34,7 @@ const fn ours(
 ) -> DenoiserInfo {
     DenoiserInfo::new(name, description, FeatureUse::Always, variant)
         .reading_guides()
-        .overridden_by(super::ours::OVERRIDES)
+        .overridden_by(Overrides::of::<OursParams>())
 }
 
 /// A row of the paper's wRLS family.
@@ -41,7 +44,7 @@ const fn wrls(
     variant: &'static WrlsVariant,
 ) -> DenoiserInfo {
     DenoiserInfo::new(name, description, FeatureUse::ForMotion, variant)
-        .overridden_by(super::wrls_paper::OVERRIDES)
+        .overridden_by(Overrides::of::<WrlsParams>())
 }
 
 /// Ours (see [`OursVariant`]), and the paper's model family (see [`WrlsVariant`]).
@@ -72,7 +75,7 @@ pub const DENOISERS: &[DenoiserInfo] = &[
         &Svgf::create,
     )
     .reading_guides()
-    .overridden_by(super::svgf::OVERRIDES),
+    .overridden_by(Overrides::of::<SvgfParams>()),
     ours(
         "ours",
         "a per-pixel Kalman filter told by temporal gradients how much the scene changed, with a pooled lag test, a spatial prior on the guide albedo and an à-trous filter",
@@ -151,7 +154,7 @@ pub fn find(name: &str) -> Result<&'static DenoiserInfo> {
 }
 
 /// Builds the denoiser called `name`.
-pub fn create(ctx: &GpuContext, name: &str, config: &DenoiserConfig) -> Result<Box<dyn Denoiser>> {
+pub fn create(ctx: &GpuContext, name: &str, config: &DenoiserConfig) -> Built {
     find(name)?.create(ctx, config)
 }
 

@@ -27,7 +27,7 @@
 //! transfer function change: reprojection follows motion, and shading changes are
 //! followed at the moving averages' rate (the method's known lag).
 
-use super::{DenoiseFrame, Denoiser, DenoiserConfig, MotionSource, Overrides};
+use super::{Built, DenoiseFrame, Denoiser, DenoiserConfig, MotionSource, Overridable, Tunables};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::gpu_block;
@@ -122,31 +122,28 @@ impl SvgfParams {
         iterations: 5,
         feedback: 0,
     };
+}
 
-    /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
-    /// `DVR_SVGF="color_alpha=0.05,sigma_l=10"`.
-    pub fn with_overrides(self, spec: Option<&str>) -> Result<Self> {
-        let p = super::with_overrides(self, "DVR_SVGF", spec, OVERRIDABLE)?;
-        if p.feedback + 1 >= p.iterations {
+/// `DVR_SVGF="color_alpha=0.05,sigma_l=10"` sets parameters for a study with `dvr eval`.
+impl Tunables for SvgfParams {
+    const VARIABLE: &'static str = "DVR_SVGF";
+    const TABLE: &'static [Overridable<Self>] = OVERRIDABLE;
+
+    fn consistent(self) -> Result<Self> {
+        if self.feedback + 1 >= self.iterations {
             return Err(crate::error::EngineError::InvalidSetting {
-                name: "DVR_SVGF",
-                value: format!("feedback={}, iterations={}", p.feedback, p.iterations),
+                name: Self::VARIABLE,
+                value: format!("feedback={}, iterations={}", self.feedback, self.iterations),
                 allowed: "a fed-back iteration before the last (feedback < iterations - 1)".into(),
             });
         }
-        Ok(p)
+        Ok(self)
     }
 }
 
-/// `DVR_SVGF`, the variable whose `name=value` pairs override [`SvgfParams`].
-pub const OVERRIDES: Overrides = Overrides {
-    variable: "DVR_SVGF",
-    check: |spec| SvgfParams::DEFAULT.with_overrides(spec).map(drop),
-};
-
 /// The parameters `DVR_SVGF` may set (for parameter studies with `dvr eval`), with the
 /// range each takes.
-const OVERRIDABLE: &[super::Overridable<SvgfParams>] = &[
+const OVERRIDABLE: &[Overridable<SvgfParams>] = &[
     ("color_alpha", 0.0, 1.0, |p, v| p.color_alpha = v),
     ("moments_alpha", 0.0, 1.0, |p, v| p.moments_alpha = v),
     ("min_history", 1.0, 1e3, |p, v| p.min_history = v),
@@ -176,13 +173,9 @@ pub struct Svgf {
 }
 
 impl Svgf {
-    pub fn create(
-        ctx: &GpuContext,
-        name: &'static str,
-        config: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>> {
+    pub fn create(ctx: &GpuContext, name: &'static str, config: &DenoiserConfig) -> Built {
         let motion = config.motion;
-        let params = SvgfParams::DEFAULT.with_overrides(OVERRIDES.value().as_deref())?;
+        let params = SvgfParams::from_env()?;
         Ok(Box::new(Self {
             name,
             temporal: ctx.pipeline(
@@ -499,7 +492,7 @@ pub mod edge {
 
 #[cfg(test)]
 mod tests {
-    use super::SvgfParams;
+    use super::{SvgfParams, Tunables};
 
     #[test]
     fn overrides_are_named_range_checked_and_consistent() {

@@ -5,7 +5,7 @@
 //! the output: the average is what the next frame reprojects. Like `svgf` it is not reset
 //! on camera, light or TF changes; the clip box limits how long stale colour survives.
 
-use super::{DenoiseFrame, Denoiser, DenoiserConfig, MotionSource};
+use super::{Built, DenoiseFrame, Denoiser, DenoiserConfig, MotionSource};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::gpu_block;
@@ -57,11 +57,7 @@ pub struct Taa {
 }
 
 impl Taa {
-    pub fn create(
-        ctx: &GpuContext,
-        name: &'static str,
-        config: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>> {
+    pub fn create(ctx: &GpuContext, name: &'static str, config: &DenoiserConfig) -> Built {
         let motion = config.motion;
         Ok(Box::new(Self {
             name,

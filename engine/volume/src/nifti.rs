@@ -17,7 +17,7 @@ use std::path::Path;
 
 use super::error::VolumeError;
 use super::samples::{Affine, Rescale, SampleKind, Samples, Stored};
-use super::series::{channel_list, Source, SourceInfo};
+use super::series::{channel_list, Source, SourceInfo, Window, Windowed};
 use super::{io, name_of, validate_dims, validate_spacing, PatientTransform, Volume};
 
 /// Size of a NIfTI-1 header.
@@ -94,12 +94,7 @@ impl Source for NiftiSeries {
     fn info(&self) -> &SourceInfo {
         &self.info
     }
-    fn read(
-        &self,
-        channel: usize,
-        time: usize,
-        window: Option<(f64, f64)>,
-    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+    fn read(&self, channel: usize, time: usize, window: Option<Window>) -> Windowed {
         let block = channel as u64 * u64::from(self.header.times) + time as u64;
         volume(&self.info.path, &self.header, block, window)
     }

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 use super::error::VolumeError;
 use super::samples::{SampleKind, Samples, Stored};
-use super::series::{channel_list, Source, SourceInfo};
+use super::series::{channel_list, Source, SourceInfo, Window, Windowed};
 use super::{io, name_of, validate_dims, validate_spacing, PatientTransform, Volume};
 use axes::{classify_axes, gather, Axes};
 
@@ -86,12 +86,7 @@ impl Source for NrrdSeries {
     fn info(&self) -> &SourceInfo {
         &self.info
     }
-    fn read(
-        &self,
-        channel: usize,
-        time: usize,
-        window: Option<(f64, f64)>,
-    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+    fn read(&self, channel: usize, time: usize, window: Option<Window>) -> Windowed {
         self.nrrd.volume(channel, time, window)
     }
 }

@@ -15,7 +15,7 @@
 
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
-use super::series::{channel_list, Source, SourceChannel, SourceInfo};
+use super::series::{channel_list, Source, SourceChannel, SourceInfo, Window, Windowed};
 use super::{io, name_of, validate_dims, validate_spacing, Volume, MAX_DIM};
 use std::path::Path;
 use tiff::decoder::{Decoder, DecodingResult, Limits};
@@ -267,12 +267,7 @@ impl Source for TiffSeries {
     fn info(&self) -> &SourceInfo {
         &self.info
     }
-    fn read(
-        &self,
-        channel: usize,
-        time: usize,
-        window: Option<(f64, f64)>,
-    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+    fn read(&self, channel: usize, time: usize, window: Option<Window>) -> Windowed {
         read_stack(
             &self.info.path,
             self.pixels.as_ref(),

@@ -146,18 +146,19 @@ pub(crate) struct SourceInfo {
     pub times: usize,
 }
 
+/// A window: the physical values that map to density 0 and 1.
+pub(crate) type Window = (f64, f64);
+
+/// A volume read through a window, with the window used (its own where none was given).
+pub(crate) type Windowed = Result<(Volume, Window), VolumeError>;
+
 /// A file read channel by channel, time point by time point. Each read opens the file
 /// again (no state between reads), so a source is shared across threads as it is.
 pub(crate) trait Source: Send + Sync {
     fn info(&self) -> &SourceInfo;
     /// One channel at one time point in RAS order, normalised through `window` where
     /// given, else its own; with the window used.
-    fn read(
-        &self,
-        channel: usize,
-        time: usize,
-        window: Option<(f64, f64)>,
-    ) -> Result<(Volume, (f64, f64)), VolumeError>;
+    fn read(&self, channel: usize, time: usize, window: Option<Window>) -> Windowed;
 }
 
 /// A source of one channel at one time point read whole by [`Volume::load`]'s loader:
@@ -194,12 +195,7 @@ impl Source for WholeFile {
     fn info(&self) -> &SourceInfo {
         &self.info
     }
-    fn read(
-        &self,
-        _channel: usize,
-        _time: usize,
-        _window: Option<(f64, f64)>,
-    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+    fn read(&self, _channel: usize, _time: usize, _window: Option<Window>) -> Windowed {
         // One channel, one time point: its own window is the series' window.
         let v = (*self.volume).clone();
         let w = (f64::from(v.window[0]), f64::from(v.window[1]));

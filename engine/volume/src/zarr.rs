@@ -26,7 +26,7 @@ mod omero;
 
 use super::error::VolumeError;
 use super::samples::{Samples, Stored};
-use super::series::{channel_list, Source, SourceChannel, SourceInfo};
+use super::series::{channel_list, Source, SourceChannel, SourceInfo, Window, Windowed};
 use super::{name_of, validate_spacing, Volume, MAX_DIM, MAX_VOXELS};
 use crate::bytes::human_bytes;
 use bounded::BoundedStore;
@@ -221,12 +221,7 @@ impl Source for ZarrSeries {
     fn info(&self) -> &SourceInfo {
         &self.info
     }
-    fn read(
-        &self,
-        channel: usize,
-        time: usize,
-        window: Option<(f64, f64)>,
-    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+    fn read(&self, channel: usize, time: usize, window: Option<Window>) -> Windowed {
         read_level(
             &self.info.path,
             &self.image,

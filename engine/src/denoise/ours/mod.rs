@@ -41,7 +41,7 @@ mod prior;
 mod update;
 
 use super::variance_atrous::{self, VarianceAtrousPush};
-use super::{Build, Overrides};
+use super::{Build, Built, Tunables};
 use super::{DenoiseFrame, Denoiser, DenoiserConfig, MotionSource, Overridable};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline, SpecValue};
@@ -98,12 +98,6 @@ impl Default for OursParams {
     }
 }
 
-/// `DVR_OURS`, the variable whose `name=value` pairs override [`OursParams`].
-pub const OVERRIDES: Overrides = Overrides {
-    variable: "DVR_OURS",
-    check: |spec| OursParams::default().with_overrides(spec).map(drop),
-};
-
 /// The parameters `DVR_OURS` may set (for parameter studies with `dvr eval`), with the
 /// range each takes.
 const OVERRIDABLE: &[Overridable<OursParams>] = &[
@@ -116,12 +110,10 @@ const OVERRIDABLE: &[Overridable<OursParams>] = &[
     ("keep", 0.0, 1.0, |p, v| p.keep = v),
 ];
 
-impl OursParams {
-    /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
-    /// `DVR_OURS="change_q=2,keep=0.1"`.
-    pub fn with_overrides(self, spec: Option<&str>) -> Result<Self> {
-        super::with_overrides(self, "DVR_OURS", spec, OVERRIDABLE)
-    }
+/// `DVR_OURS="change_q=2,keep=0.1"` sets parameters for a study with `dvr eval`.
+impl Tunables for OursParams {
+    const VARIABLE: &'static str = "DVR_OURS";
+    const TABLE: &'static [Overridable<Self>] = OVERRIDABLE;
 }
 
 /// Which stages act: `ours` has all; each ablation switches exactly one off and leaves
@@ -187,7 +179,7 @@ impl Ours {
         motion: MotionSource,
         features: PathTraceFeatures,
     ) -> Result<Self> {
-        let params = OursParams::default().with_overrides(OVERRIDES.value().as_deref())?;
+        let params = OursParams::from_env()?;
         let motion_source = ("MOTION_SOURCE", SpecValue::I32(motion.spec()));
         Ok(Self {
             name: name.to_string(),
@@ -221,12 +213,7 @@ impl Ours {
 
 /// A row's variant builds ours with its stages.
 impl Build for OursVariant {
-    fn build(
-        &self,
-        ctx: &GpuContext,
-        name: &'static str,
-        config: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>> {
+    fn build(&self, ctx: &GpuContext, name: &'static str, config: &DenoiserConfig) -> Built {
         let ours = Ours::new(ctx, name, *self, config.motion, config.features)?;
         Ok(Box::new(ours))
     }

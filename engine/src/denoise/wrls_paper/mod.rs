@@ -16,7 +16,9 @@ mod spatial;
 mod update;
 
 use super::variance_atrous::{self, VarianceAtrousPush};
-use super::{Build, DenoiseFrame, Denoiser, DenoiserConfig, MotionSource, Overridable, Overrides};
+use super::{
+    Build, Built, DenoiseFrame, Denoiser, DenoiserConfig, MotionSource, Overridable, Tunables,
+};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Pipeline, SpecValue};
 use crate::graph::ImageHandle;
@@ -68,12 +70,6 @@ impl Default for WrlsParams {
     }
 }
 
-/// `DVR_WRLS`, the variable whose `name=value` pairs override [`WrlsParams`].
-pub const OVERRIDES: Overrides = Overrides {
-    variable: "DVR_WRLS",
-    check: |spec| WrlsParams::default().with_overrides(spec).map(drop),
-};
-
 /// The parameters `DVR_WRLS` may set, the range each takes, and where each goes.
 const OVERRIDABLE: &[Overridable<WrlsParams>] = &[
     ("lambda", 0.01, 1.0, |p, v| p.lambda = v),
@@ -85,12 +81,10 @@ const OVERRIDABLE: &[Overridable<WrlsParams>] = &[
     ("outlier_sigmas", 1e-3, 1e3, |p, v| p.outlier_sigmas = v),
 ];
 
-impl WrlsParams {
-    /// These parameters with `name=value` pairs (comma-separated) applied, e.g. from
-    /// `DVR_WRLS="lambda=0.99,kappa=3"`.
-    pub fn with_overrides(self, spec: Option<&str>) -> Result<Self> {
-        super::with_overrides(self, "DVR_WRLS", spec, OVERRIDABLE)
-    }
+/// `DVR_WRLS="lambda=0.99,kappa=3"` sets parameters for a study with `dvr eval`.
+impl Tunables for WrlsParams {
+    const VARIABLE: &'static str = "DVR_WRLS";
+    const TABLE: &'static [Overridable<Self>] = OVERRIDABLE;
 }
 
 /// Which variant: the paper's ablation switches (weighting, temporal feature), its exact
@@ -173,7 +167,7 @@ impl Wrls {
                 variance_atrous::pipeline(ctx, false, false)?,
             )
         };
-        let params = WrlsParams::default().with_overrides(OVERRIDES.value().as_deref())?;
+        let params = WrlsParams::from_env()?;
         Ok(Self {
             name: name.to_string(),
             params,
@@ -185,12 +179,7 @@ impl Wrls {
 
 /// A row's variant builds the family's member with its switches.
 impl Build for WrlsVariant {
-    fn build(
-        &self,
-        ctx: &GpuContext,
-        name: &'static str,
-        config: &DenoiserConfig,
-    ) -> Result<Box<dyn Denoiser>> {
+    fn build(&self, ctx: &GpuContext, name: &'static str, config: &DenoiserConfig) -> Built {
         Ok(Box::new(Wrls::new(ctx, name, *self, config.motion)?))
     }
 }

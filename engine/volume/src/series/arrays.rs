@@ -2,7 +2,7 @@
 //! (a numpy `(T, C, Z, Y, X)` array), read and normalised as a file's would be, each
 //! channel through the window of its first time point.
 
-use super::{Arrangement, Series, Source, SourceChannel, SourceInfo};
+use super::{Arrangement, Series, Source, SourceChannel, SourceInfo, Window, Windowed};
 use crate::samples::{Samples, Stored};
 use crate::{validate_dims, validate_spacing, Volume, VolumeError, Voxels};
 use std::path::{Path, PathBuf};
@@ -18,12 +18,7 @@ impl Source for Arrays {
     fn info(&self) -> &SourceInfo {
         &self.info
     }
-    fn read(
-        &self,
-        channel: usize,
-        time: usize,
-        window: Option<(f64, f64)>,
-    ) -> Result<(Volume, (f64, f64)), VolumeError> {
+    fn read(&self, channel: usize, time: usize, window: Option<Window>) -> Windowed {
         let samples = match &self.blocks[time][channel] {
             Voxels::U8(v) => Samples::U8(v.clone()),
             Voxels::U16(v) => Samples::U16(v.clone()),
