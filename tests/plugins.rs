@@ -32,8 +32,8 @@ impl ToyMean {
 }
 
 impl Denoiser for ToyMean {
-    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
-        let (ctx, graph, frame, input) = f.into_parts();
+    fn add<'f>(&'f self, mut f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.parts();
         input.features(self.name)?;
         input.guides.ok_or_else(|| EngineError::Pass {
             pass: self.name.into(),

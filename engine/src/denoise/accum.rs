@@ -23,8 +23,8 @@ impl Accum {
 }
 
 impl Denoiser for Accum {
-    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
-        let (ctx, graph, frame, input) = f.into_parts();
+    fn add<'f>(&'f self, mut f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.parts();
         if input.changes.any() {
             graph.reset_history(&format!("{}.", self.name));
         }

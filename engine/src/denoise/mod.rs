@@ -216,16 +216,17 @@ pub struct DenoiseFrame<'a, 'f> {
 }
 
 impl<'a, 'f> DenoiseFrame<'a, 'f> {
-    /// The device, graph, frame and inputs, for a body that hands them to its passes.
-    pub fn into_parts(
-        self,
+    /// The device, graph, frame and inputs, for a body that hands them to its passes
+    /// (and then this frame to its next stage).
+    pub fn parts(
+        &mut self,
     ) -> (
         &'a GpuContext,
-        &'a mut RenderGraph,
-        &'a mut Frame<'f>,
+        &mut RenderGraph,
+        &mut Frame<'f>,
         &'a DenoiseInputs,
     ) {
-        (self.ctx, self.graph, self.frame, self.input)
+        (self.ctx, &mut *self.graph, &mut *self.frame, self.input)
     }
 }
 

@@ -411,8 +411,8 @@ struct Pool {
 }
 
 impl Denoiser for Rae {
-    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
-        let (ctx, graph, frame, input) = f.into_parts();
+    fn add<'f>(&'f self, mut f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.parts();
         let n = &self.name;
         let wts = &self.weights;
         let levels = wts.levels();

@@ -194,8 +194,8 @@ impl Svgf {
 }
 
 impl Denoiser for Svgf {
-    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
-        let (ctx, graph, frame, input) = f.into_parts();
+    fn add<'f>(&'f self, mut f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.parts();
         let size = input.size;
         let desc = input.rgba32f();
         let n = self.name;

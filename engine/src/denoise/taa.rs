@@ -69,8 +69,8 @@ impl Taa {
 }
 
 impl Denoiser for Taa {
-    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
-        let (ctx, graph, frame, input) = f.into_parts();
+    fn add<'f>(&'f self, mut f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.parts();
         let size = input.size;
         let desc = input.rgba32f();
         let color = graph.history(ctx, &format!("{}.color", self.name), desc)?;

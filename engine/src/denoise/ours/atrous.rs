@@ -6,20 +6,19 @@
 
 use super::Ours;
 use crate::denoise::variance_atrous::{add_level, Level};
+use crate::denoise::DenoiseFrame;
 use crate::error::Result;
-use crate::gpu::GpuContext;
-use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
+use crate::graph::ImageHandle;
 
 impl Ours {
     pub(super) fn add_atrous<'f>(
         &'f self,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        size: Extent,
+        f: &mut DenoiseFrame<'_, 'f>,
         estimate: ImageHandle,
         prediction: Option<ImageHandle>,
     ) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.parts();
+        let size = input.size;
         // The carrying variant where there is a prediction to carry by.
         let pipeline = match (prediction, &self.atrous_carry, &self.atrous) {
             (Some(_), Some(carry), _) => carry,

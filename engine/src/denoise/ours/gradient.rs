@@ -4,11 +4,11 @@
 //! scene; the pooling pass compares the two per stratum.
 
 use super::Ours;
-use crate::denoise::DenoiseInputs;
+use crate::denoise::DenoiseFrame;
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc};
+use crate::gpu::ImageDesc;
 use crate::gpu_block;
-use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::graph::ImageHandle;
 use ash::vk;
 use glam::{Mat4, Vec4};
 
@@ -48,13 +48,8 @@ impl Ours {
     /// Adds the temporal-gradient pass and its pooling when the scene changed since last
     /// frame; the images exist either way (the update pass binds them, and reads them
     /// only when `valid`).
-    pub(super) fn add_gradients<'f>(
-        &'f self,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
-    ) -> Result<Gradients> {
+    pub(super) fn add_gradients<'f>(&'f self, f: &mut DenoiseFrame<'_, 'f>) -> Result<Gradients> {
+        let (ctx, graph, frame, input) = f.parts();
         let size = input.size;
         let s = self.params.stratum.max(1);
         let desc = ImageDesc::d2(

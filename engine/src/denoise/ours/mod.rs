@@ -220,27 +220,27 @@ impl Build for OursVariant {
 }
 
 impl Denoiser for Ours {
-    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
-        let (ctx, graph, frame, input) = f.into_parts();
+    fn add<'f>(&'f self, mut f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, _, input) = f.parts();
         let desc = input.rgba32f();
         let n = &self.name;
         let lag = lag::LagImages {
             residual: graph.history(ctx, &format!("{n}.residual"), desc)?,
             pooled: graph.history(ctx, &format!("{n}.lag"), desc)?,
         };
-        let gradients = self.add_gradients(ctx, graph, frame, input)?;
-        let estimate = self.add_update(ctx, graph, frame, input, &gradients, &lag)?;
-        self.add_lag(frame, input.size, &lag);
+        let gradients = self.add_gradients(&mut f)?;
+        let estimate = self.add_update(&mut f, &gradients, &lag)?;
+        self.add_lag(f.frame, input.size, &lag);
         let normal = input.features.map(|f| f.normal);
         let (estimate, prediction) = match (input.guides, normal) {
             (Some(albedo), Some(normal)) => {
                 let guides = prior::PriorGuides { albedo, normal };
-                let (e, p) = self.add_prior(ctx, graph, frame, estimate, guides)?;
+                let (e, p) = self.add_prior(&mut f, estimate, guides)?;
                 (e, Some(p))
             }
             _ => (estimate, None),
         };
-        self.add_atrous(ctx, graph, frame, input.size, estimate, prediction)
+        self.add_atrous(&mut f, estimate, prediction)
     }
 }
 

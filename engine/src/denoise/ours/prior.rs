@@ -6,10 +6,11 @@
 //! each neighbour by the model's prediction (`CARRY` in variance_atrous.comp).
 
 use super::Ours;
+use crate::denoise::DenoiseFrame;
 use crate::error::Result;
 use crate::gpu::{GpuContext, ImageDesc, Pipeline, SpecValue};
 use crate::gpu_block;
-use crate::graph::{Extent, Frame, ImageHandle, RenderGraph};
+use crate::graph::{Extent, ImageHandle};
 use ash::vk;
 
 /// Pixels between two fits' centres: the grid's size here, and the shaders' specialisation
@@ -98,12 +99,11 @@ impl Ours {
     /// pixel's prediction (rgb, a 1 where there is a fit) for the à-trous to carry by.
     pub(super) fn add_prior<'f>(
         &'f self,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
+        f: &mut DenoiseFrame<'_, 'f>,
         estimate: ImageHandle,
         guides: PriorGuides,
     ) -> Result<(ImageHandle, ImageHandle)> {
+        let (ctx, graph, frame, _) = f.parts();
         let PriorGuides { albedo, normal } = guides;
         let n = &self.name;
         let desc = graph.image_desc(estimate);

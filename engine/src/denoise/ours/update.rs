@@ -7,11 +7,11 @@
 use super::gradient::Gradients;
 use super::lag::LagImages;
 use super::Ours;
-use crate::denoise::DenoiseInputs;
+use crate::denoise::DenoiseFrame;
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc};
+use crate::gpu::ImageDesc;
 use crate::gpu_block;
-use crate::graph::{Frame, ImageHandle, RenderGraph};
+use crate::graph::ImageHandle;
 use ash::vk;
 use glam::Vec4;
 
@@ -54,13 +54,11 @@ impl Ours {
     /// readers clamp it at zero) with its variance (a).
     pub(super) fn add_update<'f>(
         &'f self,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
+        f: &mut DenoiseFrame<'_, 'f>,
         gradients: &Gradients,
         lag: &LagImages,
     ) -> Result<ImageHandle> {
+        let (ctx, graph, frame, input) = f.parts();
         let size = input.size;
         let desc = input.rgba32f();
         let n = &self.name;

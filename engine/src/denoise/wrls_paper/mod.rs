@@ -185,20 +185,20 @@ impl Build for WrlsVariant {
 }
 
 impl Denoiser for Wrls {
-    fn add<'f>(&'f self, f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
-        let (ctx, graph, frame, input) = f.into_parts();
+    fn add<'f>(&'f self, mut f: DenoiseFrame<'_, 'f>) -> Result<ImageHandle> {
+        let (ctx, graph, _, input) = f.parts();
         let desc = input.rgba32f();
         let n = &self.name;
         let out = graph.image(ctx, &format!("{n}.out"), desc)?;
         let prediction = graph.image(ctx, &format!("{n}.prediction"), desc)?;
         match &self.passes {
             Passes::Feature(update, spatial) => {
-                let m = self.add_feature_update(update, ctx, graph, frame, input, prediction)?;
-                self.add_paper_spatial(spatial, frame, input, &m, out);
+                let m = self.add_feature_update(update, &mut f, prediction)?;
+                self.add_paper_spatial(spatial, f.frame, input, &m, out);
             }
             Passes::Constant(update, atrous) => {
-                self.add_constant_update(update, ctx, graph, frame, input, prediction)?;
-                self.add_atrous(atrous, frame, input.size, prediction, out);
+                self.add_constant_update(update, &mut f, prediction)?;
+                self.add_atrous(atrous, f.frame, input.size, prediction, out);
             }
         }
         Ok(out)

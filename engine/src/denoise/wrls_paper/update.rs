@@ -5,11 +5,11 @@
 //! models' errors that the shaders' model selection would use).
 
 use super::Wrls;
-use crate::denoise::DenoiseInputs;
+use crate::denoise::DenoiseFrame;
 use crate::error::Result;
-use crate::gpu::{GpuContext, ImageDesc, Pipeline};
+use crate::gpu::{ImageDesc, Pipeline};
 use crate::gpu_block;
-use crate::graph::{Frame, History, ImageHandle, RenderGraph};
+use crate::graph::{History, ImageHandle, RenderGraph};
 use ash::vk;
 use glam::Vec4;
 
@@ -64,16 +64,13 @@ pub(super) struct FeatureModels {
 impl Wrls {
     /// The constant model: `model` (rgb β, a P) and `stats` (running noise level, frames
     /// in a row with a far residual); writes its prediction with its variance.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn add_constant_update<'f>(
         &'f self,
         pipeline: &Pipeline<WrlsConstantPush>,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
+        f: &mut DenoiseFrame<'_, 'f>,
         prediction: ImageHandle,
     ) -> Result<()> {
+        let (ctx, graph, frame, input) = f.parts();
         let desc = input.rgba32f();
         let n = &self.name;
         let model = graph.history(ctx, &format!("{n}.model"), desc)?;
@@ -117,16 +114,13 @@ impl Wrls {
 
     /// The paper's models: the temporal feature z, β per channel, the shared P, and the
     /// constant model and both models' errors its spatial pass binds.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn add_feature_update<'f>(
         &'f self,
         pipeline: &Pipeline<WrlsUpdatePush>,
-        ctx: &GpuContext,
-        graph: &mut RenderGraph,
-        frame: &mut Frame<'f>,
-        input: &DenoiseInputs,
+        f: &mut DenoiseFrame<'_, 'f>,
         prediction: ImageHandle,
     ) -> Result<FeatureModels> {
+        let (ctx, graph, frame, input) = f.parts();
         let desc = input.rgba32f();
         let n = &self.name;
         let history =
