@@ -55,6 +55,18 @@ pub enum EngineError {
     },
 }
 
+/// A render setting a scene's setter refused is the engine's `InvalidSetting`, with
+/// the same fields and message.
+impl From<dvr_scene::SettingError> for EngineError {
+    fn from(e: dvr_scene::SettingError) -> Self {
+        EngineError::InvalidSetting {
+            name: e.name,
+            value: e.value,
+            allowed: e.allowed,
+        }
+    }
+}
+
 pub type Result<T, E = EngineError> = std::result::Result<T, E>;
 
 /// Shorthand for wrapping a raw `vk::Result` with the call that produced it.
