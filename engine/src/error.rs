@@ -79,3 +79,19 @@ impl<T> VkContext<T> for std::result::Result<T, ash::vk::Result> {
         self.map_err(|result| EngineError::Vk { call, result })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_refused_render_setting_is_invalid_setting_with_the_same_message() {
+        let refused = crate::scene::RenderSettings::default()
+            .set_spp(0)
+            .expect_err("0 spp");
+        let message = refused.to_string();
+        let e = EngineError::from(refused);
+        assert!(matches!(e, EngineError::InvalidSetting { name: "spp", .. }));
+        assert_eq!(e.to_string(), message);
+    }
+}

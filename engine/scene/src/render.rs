@@ -348,15 +348,12 @@ impl RenderSettings {
             .and_then(|_| copy.set_filter_sigma(self.filter_sigma))
             .and_then(|_| copy.set_feature_threshold(self.feature_threshold))
             .and_then(|_| copy.set_gpu_memory(self.gpu_memory))
-            .map_err(
-                |SettingError {
-                     name,
-                     value,
-                     allowed,
-                 }| {
-                    ctx.invalid(format!("render.{name}"), format!("{value}: {allowed}"))
-                },
-            )
+            .map_err(|e| {
+                ctx.invalid(
+                    format!("render.{}", e.name),
+                    format!("{}: {}", e.value, e.allowed),
+                )
+            })
     }
 }
 
