@@ -1,7 +1,10 @@
 //! The application's layers import only downward (OVERVIEW.md, "Layers of the
 //! application"): every `crate::<module>` path in `src/` names a module of a lower layer
 //! (or its own), and inside `dvr eval` every `crate::eval::<layer>` or `super::<layer>`
-//! path names a lower eval layer. Reads the sources as text; needs no GPU.
+//! path names a lower eval layer. And the engine's GPU-free crates (`engine/volume`,
+//! `engine/scene`, `engine/metrics`) name no Vulkan crate among their dependencies, so
+//! they keep building and testing without a Vulkan loader. Reads the sources and
+//! manifests as text; needs no GPU.
 
 use std::path::{Path, PathBuf};
 
@@ -135,4 +138,67 @@ fn the_checker_sees_an_upward_import() {
     )
     .expect("write");
     assert_eq!(upward(src, &plan), vec!["eval/plan/mod.rs: eval layer run"]);
+}
+
+/// The engine's crates that build and test without a Vulkan loader.
+const GPU_FREE_CRATES: &[&str] = &["engine/volume", "engine/scene", "engine/metrics"];
+
+/// Crates that need Vulkan (or the engine that does) at build or test time.
+const VULKAN_CRATES: &[&str] = &[
+    "ash",
+    "ash-window",
+    "gpu-allocator",
+    "shaderc",
+    "glsl-build",
+    "dvr-engine",
+];
+
+/// The Vulkan crates a manifest's dependency sections (normal, dev and build) name.
+fn vulkan_dependencies(manifest: &str) -> Vec<String> {
+    let mut section = "";
+    let mut found = Vec::new();
+    for line in manifest.lines().map(str::trim) {
+        if line.starts_with('[') {
+            section = line;
+            continue;
+        }
+        if !section.ends_with("dependencies]") {
+            continue;
+        }
+        let name = line
+            .split(|c: char| c == '=' || c == '.' || c.is_whitespace())
+            .next()
+            .unwrap_or("");
+        if VULKAN_CRATES.contains(&name) {
+            found.push(format!("{section} {name}"));
+        }
+    }
+    found
+}
+
+#[test]
+fn the_gpu_free_crates_name_no_vulkan_crate() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let workspace = std::fs::read_to_string(root.join("Cargo.toml")).expect("read Cargo.toml");
+    for krate in GPU_FREE_CRATES {
+        assert!(
+            workspace.contains(&format!("\"{krate}\"")),
+            "{krate} is not a workspace member"
+        );
+        let manifest = std::fs::read_to_string(root.join(krate).join("Cargo.toml"))
+            .unwrap_or_else(|e| panic!("{krate}/Cargo.toml: {e}"));
+        let bad = vulkan_dependencies(&manifest);
+        assert!(bad.is_empty(), "{krate}/Cargo.toml: {}", bad.join(", "));
+    }
+}
+
+#[test]
+fn the_checker_sees_a_vulkan_dependency() {
+    let manifest = "[package]\nname = \"x\"\n\n[dependencies]\nglam.workspace = true\n\
+                    ash.workspace = true\n\n[dev-dependencies]\n\
+                    dvr-engine = { path = \"..\" }\n";
+    assert_eq!(
+        vulkan_dependencies(manifest),
+        vec!["[dependencies] ash", "[dev-dependencies] dvr-engine"]
+    );
 }

@@ -402,7 +402,7 @@ fn bad_overrides_fail_before_rendering_and_empty_entries_are_usage_errors() {
     let args = tiny_eval(&out);
     for (var, value, says) in [
         ("DVR_WRLS", "lambda=nan", "lambda must be in"),
-        ("DVR_OURS", "outlier_z=1e30", "outlier_z must be in"),
+        ("DVR_OURS", "jump_z=1e30", "jump_z must be in"),
         ("DVR_SVGF", "sigma_l=-1", "sigma_l must be in"),
     ] {
         let o = wait_within(

@@ -4,7 +4,10 @@
 1. The built book (docs/book, from `mdbook build docs`): every relative link and image in
    every page points at a file that exists, and every #anchor at an id in that file.
    Pages link to the repository's files as ../../<path>, which resolves from both
-   docs/src/ (where the Markdown is read) and docs/book/ (where the HTML is).
+   docs/src/ (where the Markdown is read) and docs/book/ (where the HTML is). Images
+   are the book's own: every image resolves inside the built book, checked in docs/book
+   and in a book built into a temporary folder (`mdbook build docs -d <tmp>`), where a
+   path out of the book finds nothing (tools/book_images.py links them in).
 2. The Markdown outside the book (README.md, OVERVIEW.md, CHANGELOG.md, python/README.md):
    the same for their relative links, anchors by GitHub's heading slugs.
 3. OVERVIEW.md names every tracked source file by a path that resolves to it alone
@@ -27,12 +30,13 @@ import posixpath
 import re
 import subprocess
 import sys
+import tempfile
 import urllib.parse
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 MARKDOWN = ["README.md", "OVERVIEW.md", "CHANGELOG.md", "python/README.md"]
 # Tracked files OVERVIEW.md must name: source, shaders, tests, tools, the Python package.
-SOURCE_DIRS = ["src", "engine/src", "engine/volume/src", "engine/metrics/src", "engine/glsl-build", "engine/tests",
+SOURCE_DIRS = ["src", "engine/src", "engine/volume/src", "engine/scene/src", "engine/metrics/src", "engine/glsl-build", "engine/tests",
                "shaders", "tests", "tools", "python/src", "python/dvr", "python/tests",
                "python/examples", "fuzz/src"]
 SOURCE_EXCLUDE = ["tests/fixtures/"]
@@ -46,6 +50,7 @@ class Links(html.parser.HTMLParser):
     def __init__(self):
         super().__init__()
         self.links = []
+        self.images = []
         self.ids = set()
 
     def handle_starttag(self, tag, attrs):
@@ -56,6 +61,8 @@ class Links(html.parser.HTMLParser):
         for key in ("href", "src"):
             if a.get(key) is not None and tag in ("a", "img", "link", "script", "source"):
                 self.links.append(a[key])
+        if tag in ("img", "source") and a.get("src"):
+            self.images.append(a["src"])
 
 
 def parse_html(path, cache={}):
@@ -71,18 +78,55 @@ def external(link):
     return bool(re.match(r"^[a-zA-Z][a-zA-Z0-9+.-]*:", link)) or link.startswith("//")
 
 
-def check_book(book):
-    errors = []
-    if not os.path.isdir(book):
-        return [f"{os.path.relpath(book, ROOT)}: not built (mdbook build docs)"]
+def book_pages(book):
+    """The book's HTML pages; the API reference (cargo doc, pdoc) is generated with its
+    own links: the book's links into it are checked, its own pages are not walked."""
     pages = []
     for d, dirs, files in os.walk(book):
-        # The API reference (cargo doc, pdoc) is generated with its own links: the book's
-        # links into it are checked, its own pages are not walked.
         if os.path.relpath(d, book) == ".":
             dirs[:] = [x for x in dirs if x != "api"]
         pages += [os.path.join(d, f) for f in files if f.endswith(".html")]
-    for page in sorted(pages):
+    return sorted(pages)
+
+
+def check_images(book):
+    """Every image of the book's pages is a file inside the book: a built book is a
+    folder that stands alone, wherever it was built."""
+    errors = []
+    book = os.path.realpath(book)
+    for page in book_pages(book):
+        for src in parse_html(page).images:
+            if external(src) or src.startswith("data:"):
+                continue
+            target = urllib.parse.unquote(src.partition("#")[0])
+            path = os.path.normpath(os.path.join(os.path.dirname(page), target))
+            if os.path.relpath(path, book).startswith("..") or not os.path.isfile(path):
+                errors.append(f"{os.path.relpath(page, book)}: image {src} is not in the "
+                              f"built book ({book})")
+    return errors
+
+
+def check_book_elsewhere():
+    """The book built into a temporary folder (`mdbook build docs -d <tmp>`, from the
+    repository's root as its preprocessor needs): every image is there."""
+    with tempfile.TemporaryDirectory(prefix="dvr-book-") as tmp:
+        out = os.path.join(tmp, "book")
+        try:
+            subprocess.run(["mdbook", "build", "docs", "-d", out], cwd=ROOT, check=True,
+                           capture_output=True, text=True)
+        except FileNotFoundError:
+            return ["mdbook is not installed (tools/setup.sh --tests installs it); "
+                    "--no-book skips the book"]
+        except subprocess.CalledProcessError as e:
+            return [f"mdbook build docs -d {out} failed: {e.stderr.strip()}"]
+        return [f"book built elsewhere: {e}" for e in check_images(out)]
+
+
+def check_book(book):
+    if not os.path.isdir(book):
+        return [f"{os.path.relpath(book, ROOT)}: not built (mdbook build docs)"]
+    errors = check_images(book)
+    for page in book_pages(book):
         rel = os.path.relpath(page, ROOT)
         for link in parse_html(page).links:
             if not link or external(link):
@@ -261,7 +305,7 @@ def main():
     ap.add_argument("--book", default=os.path.join(ROOT, "docs", "book"))
     ap.add_argument("--no-book", action="store_true", help="skip the built book")
     args = ap.parse_args()
-    errors = [] if args.no_book else check_book(args.book)
+    errors = [] if args.no_book else check_book(args.book) + check_book_elsewhere()
     for rel in MARKDOWN:
         errors += check_markdown(rel)
     errors += check_overview()

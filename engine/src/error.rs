@@ -55,6 +55,18 @@ pub enum EngineError {
     },
 }
 
+/// A render setting a scene's setter refused is the engine's `InvalidSetting`, with
+/// the same fields and message.
+impl From<dvr_scene::SettingError> for EngineError {
+    fn from(e: dvr_scene::SettingError) -> Self {
+        EngineError::InvalidSetting {
+            name: e.name,
+            value: e.value,
+            allowed: e.allowed,
+        }
+    }
+}
+
 pub type Result<T, E = EngineError> = std::result::Result<T, E>;
 
 /// Shorthand for wrapping a raw `vk::Result` with the call that produced it.
@@ -65,5 +77,21 @@ pub(crate) trait VkContext<T> {
 impl<T> VkContext<T> for std::result::Result<T, ash::vk::Result> {
     fn vk(self, call: &'static str) -> Result<T> {
         self.map_err(|result| EngineError::Vk { call, result })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_refused_render_setting_is_invalid_setting_with_the_same_message() {
+        let refused = crate::scene::RenderSettings::default()
+            .set_spp(0)
+            .expect_err("0 spp");
+        let message = refused.to_string();
+        let e = EngineError::from(refused);
+        assert!(matches!(e, EngineError::InvalidSetting { name: "spp", .. }));
+        assert_eq!(e.to_string(), message);
     }
 }

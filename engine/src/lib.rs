@@ -3,8 +3,9 @@
 //! `gpu` (device, memory, pipelines, timestamps) → `graph` (explicit render graph) →
 //! `passes` (one GPU pass per file) and `denoise` (each denoiser's passes and history) →
 //! `renderer` (the frame) → `session` (a live view: edits in, frames out; what the
-//! explorer, the scripted animations and Python drive). CPU-side data (`volume` and `metrics`, crates of their own, `transfer`, `scene`) feeds
-//! them; `assets` says where the shipped files are.
+//! explorer, the scripted animations and Python drive). CPU-side data (`volume`,
+//! `metrics`, `scene` and its `transfer`, crates of their own) feeds them; `assets` says
+//! where the shipped files are.
 
 pub mod denoise;
 pub mod error;
@@ -13,15 +14,15 @@ pub mod graph;
 pub mod image_io;
 pub mod passes;
 pub mod renderer;
-pub mod scene;
 pub mod session;
 pub mod shaders;
-pub mod transfer;
 
 pub use error::{EngineError, Result};
 
 // The GPU-free layers, crates of their own that the engine re-exports under the names
 // the applications use.
 pub use dvr_metrics as metrics;
+pub use dvr_scene as scene;
+pub use dvr_scene::transfer;
 pub use dvr_volume as volume;
 pub use dvr_volume::{assets, bytes, files};

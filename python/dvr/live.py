@@ -21,7 +21,7 @@ class FieldError(AttributeError, ValueError):
     are, also a ``ValueError`` where a dict's key was the bad input."""
 
 
-# The keys each kind of [[light]] takes (engine/src/scene/light.rs, LightFile).
+# The keys each kind of [[light]] takes (engine/scene/src/light.rs, LightFile).
 LIGHT_FIELDS = {
     "point": ("kind", "position", "colour", "intensity"),
     "area": ("kind", "position", "target", "normal", "size", "colour", "intensity"),

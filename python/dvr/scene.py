@@ -1,5 +1,5 @@
 """Scenes, transfer functions, cameras and lights: small Python classes over the dicts
-that dvr's scene and TF files hold (``engine/src/scene/mod.rs`` documents every key).
+that dvr's scene and TF files hold (``engine/scene/src/lib.rs`` documents every key).
 The engine checks them with the code that checks files, so errors read as the CLI's."""
 
 import copy
@@ -24,7 +24,7 @@ __all__ = [
 ]
 
 
-# The keys of a TF file's [[point]] (engine/src/transfer/control_point.rs).
+# The keys of a TF file's [[point]] (engine/scene/src/transfer/control_point.rs).
 POINT_FIELDS = ("density", "opacity", "diffuse", "specular", "emissive", "roughness")
 
 

@@ -1,7 +1,8 @@
 """The Python tools that make and check the book: `tools/results_io.py`'s formatting and
-tables, `tools/check_docs.py`'s anchors and its rule that OVERVIEW.md names each source
-file by a path that resolves to it alone, and `tools/ct_views.py`'s CT in Hounsfield
-units. Imported from the checkout's tools/ folder; no GPU. And the validation set's
+tables, `tools/check_docs.py`'s anchors, its rule that OVERVIEW.md names each source
+file by a path that resolves to it alone and its rule that a built book's images are in
+it, `tools/book_images.py`'s images linked into the book, and `tools/ct_views.py`'s CT
+in Hounsfield units. Imported from the checkout's tools/ folder; no GPU. And the validation set's
 README: one row per frozen scene file with the day it was frozen."""
 
 import importlib
@@ -16,7 +17,7 @@ import pytest
 def tools(root):
     sys.path.insert(0, str(root / "tools"))
     try:
-        yield {name: importlib.import_module(name) for name in ("results_io", "check_docs")}
+        yield {name: importlib.import_module(name) for name in ("results_io", "check_docs", "book_images")}
     finally:
         sys.path.remove(str(root / "tools"))
 
@@ -84,6 +85,43 @@ def test_overview_must_name_a_file_by_a_path_that_resolves_to_it_alone(tools):
 
 def test_the_checkout_passes_its_own_overview_check(tools):
     assert tools["check_docs"].check_overview() == []
+
+
+def test_the_books_images_point_into_the_book(tools, tmp_path):
+    b = tools["book_images"]
+    repo = tmp_path / "repo"
+    src = repo / "docs" / "src"
+    page = (
+        "![a](../../assets/gallery/x.png) ![b](pictures/y.png) "
+        '<img src="../../assets/screenshots/z.png"> ![c](https://example.org/w.png) '
+        "[a link, not an image](../../assets/results/r.csv)"
+    )
+    out, shown = b.rewrite(page, str(src), str(src), str(repo))
+    assert shown == {"assets/gallery/x.png", "assets/screenshots/z.png"}
+    assert "![a](assets/gallery/x.png)" in out and 'src="assets/screenshots/z.png"' in out
+    assert "![b](pictures/y.png)" in out and "https://example.org/w.png" in out
+    assert "(../../assets/results/r.csv)" in out
+    # The links are made relative to the repository's files; a stale one goes.
+    (repo / "assets" / "gallery").mkdir(parents=True)
+    (repo / "assets" / "gallery" / "x.png").write_bytes(b"png")
+    (src / "assets" / "old").mkdir(parents=True)
+    (src / "assets" / "old" / "gone.png").symlink_to("../../../../assets/gallery/x.png")
+    b.link_shown(str(src), str(repo), {"assets/gallery/x.png"})
+    assert (src / "assets" / "gallery" / "x.png").read_bytes() == b"png"
+    assert not (src / "assets" / "old").exists()
+    with pytest.raises(SystemExit, match="missing.png"):
+        b.link_shown(str(src), str(repo), {"assets/gallery/missing.png"})
+
+
+def test_a_built_books_image_outside_the_book_is_an_error(tools, tmp_path):
+    c = tools["check_docs"]
+    book = tmp_path / "book"
+    book.mkdir()
+    (tmp_path / "outside.png").write_bytes(b"png")
+    (book / "in.png").write_bytes(b"png")
+    (book / "page.html").write_text('<img src="in.png"><img src="../outside.png">')
+    errors = c.check_images(str(book))
+    assert len(errors) == 1 and "../outside.png" in errors[0], errors
 
 
 def test_the_ct_is_written_in_hounsfield_units_with_a_marker_on_the_right(root, tmp_path):

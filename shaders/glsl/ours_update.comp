@@ -29,10 +29,10 @@
 // P = (1 − K) P⁻. With nothing changing Q = 0 and K = 1/n: the running mean, which only
 // improves.
 // Outliers from the normalised innovation ν² = |y − x⁻|² / 3 / (P⁻ + R): beyond
-// z = outlier_z standard deviations R is raised to R ν² / z², so the step K (y − x⁻)
+// z = clip_z standard deviations R is raised to R ν² / z², so the step K (y − x⁻)
 // falls as 1 / |y − x⁻| (a redescending weight; the residual handed to the lag test is
 // clipped to z deviations, Huber's ψ). Jumps from the pooled lag test: a residual the
-// neighbourhood shares beyond outlier_z standard errors of its mean is a moved level, and
+// neighbourhood shares beyond jump_z standard errors of its mean is a moved level, and
 // its square is added to P⁻ so the filter follows it. A firefly, however often it repeats
 // in one pixel, is weighed down (heavy-tailed noise puts bright paths in a pixel in
 // successive frames); a change of the scene moves a region.
@@ -75,15 +75,13 @@ layout(push_constant) uniform OursUpdatePush {
     float change_q;       // share of a measured change the pixel's own may differ by
     float motion_q;       // process noise of a moving pixel, in units of R
     float lag_z;          // pooled residual, in standard errors, that is a shift
-    float outlier_z;      // innovation, in standard deviations, beyond which it is clipped
+    float clip_z;         // innovation, in standard deviations, beyond which it is clipped
+    float jump_z;         // pooled residual, in standard errors, beyond which it is a jump
     uint shift;           // a significant pooled residual shifts the state (0: ours-no-lag)
     uint pad0;
     uint pad1;
-    uint pad2;
 } pc;
 
-// TINY guards against division by zero (radiance² units).
-const float TINY = VARIANCE_FLOOR;
 // The lag test's running residual (LAG_BLEND of this frame's, the rest last frame's,
 // carried along with the change and less the shift it caused): a lag persists from frame
 // to frame while the noise does not, so at one half the running residual has a third of
@@ -121,10 +119,10 @@ float fresh_noise(vec4 s) {
     float level2 = dot(m, m) / 3.0;
     if (pc.spp >= 2.0) {
         float L = luminance(m);
-        float colour_share = L * L > TINY ? level2 / (L * L) : 1.0;
-        return s.x / n * colour_share + TINY;
+        float colour_share = L * L > VARIANCE_FLOOR ? level2 / (L * L) : 1.0;
+        return s.x / n * colour_share + VARIANCE_FLOOR;
     }
-    return max(s.x / n - level2, 0.0) * n / float(NOISE_TAPS - 1) + TINY;
+    return max(s.x / n - level2, 0.0) * n / float(NOISE_TAPS - 1) + VARIANCE_FLOOR;
 }
 
 // The history's estimate resampled by Catmull-Rom over the 4×4 texels around `r.uv`
@@ -189,7 +187,7 @@ void main() {
         float g = dot(sc.ratio, vec3(1.0 / 3.0));
         x = m.rgb * sc.ratio;
         P = m.a * g * g;
-        R = max(noise * g * g, TINY);
+        R = max(noise * g * g, VARIANCE_FLOOR);
         D = max(noise_state.y, 0.0) * g * g;
         float P_carried = P;
         // The change's scale: the larger of the pixel's level and its neighbourhood's in
@@ -215,15 +213,15 @@ void main() {
             // Where nothing ever changed (D = Q = 0) nothing is added: a static view
             // only averages.
             vec4 lag = history_fetch(lag_prev, r);
-            float z2 = dot(lag.rgb, lag.rgb) / 3.0 / max(lag.a, TINY);
+            float z2 = dot(lag.rgb, lag.rgb) / 3.0 / max(lag.a, VARIANCE_FLOOR);
             float B = D + Q;
             shifted = pc.shift != 0u && z2 > pc.lag_z * pc.lag_z && B > 0.0;
-            if (shifted) shift = B / (B + max(lag.a, TINY)) * lag.rgb;
+            if (shifted) shift = B / (B + max(lag.a, VARIANCE_FLOOR)) * lag.rgb;
             x += shift;
             Q += dot(shift, shift) / 3.0;
-            // A shared residual beyond outlier_z standard errors is a jump, announced or
-            // not (below).
-            jump = z2 > pc.outlier_z * pc.outlier_z;
+            // A shared residual beyond jump_z standard errors is a jump, announced or not
+            // (below).
+            jump = z2 > pc.jump_z * pc.jump_z;
         }
         float P_prior = P + Q;
 
@@ -242,11 +240,12 @@ void main() {
         // small while the estimate still shows the light that left. A higher one is
         // averaged in as usual (a single frame's high measurement would shut the gain).
         float R_now = fresh_noise(sums);
-        R = max(shifted && R_now < R ? R_now : R + P_prior / (P_prior + R) * (R_now - R), TINY);
-        float nu2 = e2 / max(P_prior + R, TINY);
-        float z2 = pc.outlier_z * pc.outlier_z;
+        R = max(shifted && R_now < R ? R_now : R + P_prior / (P_prior + R) * (R_now - R),
+                VARIANCE_FLOOR);
+        float nu2 = e2 / max(P_prior + R, VARIANCE_FLOOR);
+        float z2 = pc.clip_z * pc.clip_z;
         bool far = nu2 > z2;
-        // A spike's step falls as 1 / |e| beyond outlier_z deviations (redescending).
+        // A spike's step falls as 1 / |e| beyond clip_z deviations (redescending).
         float R_eff = far ? R * nu2 / z2 : R;
         P = P_prior;
         float K = P / (P + R_eff);

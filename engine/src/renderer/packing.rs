@@ -6,9 +6,8 @@
 use super::uploads::{BrickRanges, ChannelUpload, VolumeFormat, VolumeUpload};
 use crate::volume::{Volume, VolumeData};
 
+// The scene's own limit, so a scene refuses what the device cannot hold.
 pub use crate::shaders::frame::MAX_CHANNELS;
-// The scene refuses what the device cannot hold.
-const _: () = assert!(crate::scene::MAX_CHANNELS == MAX_CHANNELS);
 
 /// Texel components for `channels` fields: RG for two, RGBA for three or four.
 pub fn components(channels: u32) -> u32 {

@@ -1,4 +1,4 @@
-//! From a scene (engine/src/scene) to what the renderer takes: the volume as a texture
+//! From a scene (engine/scene) to what the renderer takes: the volume as a texture
 //! upload with its brick ranges, the render settings the scene asks for (what the path
 //! tracer is specialised for), the environment map, and per frame the camera, the lights
 //! as GPU structs and the transfer function as LUTs, from a [`View`]. The CLI, the explorer and the tests
@@ -226,7 +226,7 @@ impl SceneSetup {
         scene.tf_b = scene.tf_b.map(|b| b.in_density(volume.window));
         let mut settings = scene.render;
         if let Some(spp) = spp {
-            settings.set_spp(spp)?;
+            settings.set_spp(spp).map_err(EngineError::from)?;
         }
         let config = renderer_config(&scene, size);
         let environment = load_environment(&scene.lights)?.map(Arc::new);

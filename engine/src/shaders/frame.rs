@@ -23,10 +23,10 @@ macro_rules! glsl_defines {
 
 glsl_defines! {
     "frame.glsl" {
-        /// Lights the frame block holds.
-        MAX_LIGHTS: usize = 4,
-        /// Clip planes the frame block holds.
-        MAX_CLIP_PLANES: usize = 6,
+        /// Lights the frame block holds: as many as a scene may have.
+        MAX_LIGHTS: usize = crate::scene::MAX_LIGHTS,
+        /// Clip planes the frame block holds: as many as a scene's cut may have.
+        MAX_CLIP_PLANES: usize = crate::scene::MAX_CLIP_PLANES,
         /// Entries of a channel's opacity row in the frame block: the LUTs' own.
         LUT_SIZE: usize = crate::transfer::LUT_SIZE,
         /// `GpuLight::position_kind.w`: what the light is.
@@ -156,8 +156,8 @@ pub struct FrameParams<'a> {
 }
 
 /// Most channels one medium holds: a volume texel's four components (and the lanes of
-/// [`ChannelOpacity`]).
-pub const MAX_CHANNELS: usize = 4;
+/// [`ChannelOpacity`]), as many as a scene may have.
+pub use crate::scene::MAX_CHANNELS;
 
 /// The channels' opacity rows interleaved, as the frame block holds them: entry i, lane
 /// c is channel c's opacity at density `i / (LUT_SIZE − 1)`.

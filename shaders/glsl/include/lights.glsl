@@ -6,6 +6,14 @@
 #include "frame.glsl"
 #include "specialization.glsl"
 
+// Squared distance to a light below which it is taken as this (no division by zero at a
+// light's own position).
+const float LIGHT_DIST2_MIN = 1e-8;
+// The solid angle of the whole sphere (an environment light's directions).
+const float SPHERE_SOLID_ANGLE = 4.0 * PI;
+// An area light spans ±u and ±v about its centre: its area is four times |u × v|.
+const float QUAD_AREA_PER_CROSS = 4.0;
+
 layout(binding = 6) uniform sampler2D environment_map;  // equirectangular, rgb radiance
 
 struct LightSample {
@@ -54,22 +62,22 @@ LightSample sample_light(vec3 p, inout Rng rng) {
     if (kind == LIGHT_ENV) {
         s.dir = uniform_sphere(rng_next(rng), rng_next(rng));
         s.dist = FLT_BIG;
-        s.radiance = environment_radiance(l, s.dir) * (4.0 * PI) * choice;
+        s.radiance = environment_radiance(l, s.dir) * SPHERE_SOLID_ANGLE * choice;
     } else if (kind == LIGHT_AREA) {
         vec3 q = l.position_kind.xyz + (2.0 * rng_next(rng) - 1.0) * l.u_axis.xyz
                  + (2.0 * rng_next(rng) - 1.0) * l.v_axis.xyz;
         vec3 to = q - p;
-        float d2 = max(dot(to, to), 1e-8);
+        float d2 = max(dot(to, to), LIGHT_DIST2_MIN);
         s.dist = sqrt(d2);
         s.dir = to / s.dist;
         vec3 n = cross(l.u_axis.xyz, l.v_axis.xyz);
-        float area = 4.0 * length(n);
+        float area = QUAD_AREA_PER_CROSS * length(n);
         // One-sided: emits from the side its normal (u × v) faces.
         float cos_l = max(dot(normalize(n), -s.dir), 0.0);
         s.radiance = l.radiance.rgb * cos_l * area / d2 * choice;
     } else {
         vec3 to = l.position_kind.xyz - p;
-        float d2 = max(dot(to, to), 1e-8);
+        float d2 = max(dot(to, to), LIGHT_DIST2_MIN);
         s.dist = sqrt(d2);
         s.dir = to / s.dist;
         s.radiance = l.radiance.rgb / d2 * choice;

@@ -13,6 +13,16 @@
 #include "transport.glsl"
 #include "phase.glsl"
 
+// Exposure Render's hybrid scattering: P_brdf = opacity (1 − exp(−|∇| · scale)), with the
+// normalised gradient magnitude below the floor taken as no surface.
+const float HYBRID_GRADIENT_SCALE = 25.0;
+const float HYBRID_GRADIENT_MIN = 1e-5;
+// Russian roulette's survival probability is the throughput's largest channel, at most this
+// (a path always has some chance to end).
+const float RR_SURVIVAL_MAX = 0.95;
+// The Gaussian pixel filter's uniform is kept above this (log(0) is -inf).
+const float FILTER_U_MIN = 1e-7;
+
 // Direction of the camera ray through `pixel` (continuous pixel coordinates) of an image
 // of `size` pixels, for a camera with inverse view-projection `inv_view_proj`.
 vec3 camera_ray_dir(vec2 pixel, vec2 size, mat4 inv_view_proj) {
@@ -52,8 +62,8 @@ vec3 trace_path(vec3 o, vec3 d, inout Rng rng, out float first_t) {
             // Exposure Render: P_brdf grows with opacity and normalised gradient magnitude
             // (several channels' opacities sum, and may pass 1).
             float opacity = CHANNELS > 1 ? min(ao.a, 1.0) : ao.a;
-            float p_brdf = opacity * (1.0 - exp(-gm * 25.0));
-            if (gm > 1e-5 && rng_next(rng) < p_brdf) {
+            float p_brdf = opacity * (1.0 - exp(-gm * HYBRID_GRADIENT_SCALE));
+            if (gm > HYBRID_GRADIENT_MIN && rng_next(rng) < p_brdf) {
                 surface = true;
                 n = -g / gm;
                 if (dot(n, d) > 0.0) n = -n;
@@ -94,7 +104,7 @@ vec3 trace_path(vec3 o, vec3 d, inout Rng rng, out float first_t) {
             throughput *= albedo;
         }
         if (bounce >= int(frame.seeds.z)) {
-            float q = min(max(throughput.r, max(throughput.g, throughput.b)), 0.95);
+            float q = min(max(throughput.r, max(throughput.g, throughput.b)), RR_SURVIVAL_MAX);
             if (rng_next(rng) >= q) break;
             throughput /= q;
         }
@@ -106,7 +116,7 @@ vec3 trace_path(vec3 o, vec3 d, inout Rng rng, out float first_t) {
 
 // Gaussian pixel filter by importance sampling: offsets drawn from N(0, sigma²).
 vec2 gaussian_offset(inout Rng rng) {
-    float u1 = max(rng_next(rng), 1e-7);
+    float u1 = max(rng_next(rng), FILTER_U_MIN);
     float u2 = rng_next(rng);
     float r = frame.params.w * sqrt(-2.0 * log(u1));
     return vec2(r * cos(2.0 * PI * u2), r * sin(2.0 * PI * u2));

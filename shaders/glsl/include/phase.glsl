@@ -7,13 +7,22 @@
 #include "common.glsl"
 #include "specialization.glsl"
 
+// Henyey–Greenstein: the denominator's floor (g → ±1 at cos θ = ±1), and |g| below which
+// it samples as isotropic (its closed form divides by g).
+const float HG_DENOM_MIN = 1e-12;
+const float HG_ISOTROPIC_G = 1e-3;
+// |n.x| above which the frame around n is built from the y axis, not the x axis.
+const float FRAME_AXIS_SWITCH = 0.9;
+// Roughness below this is taken as this (the Blinn-Phong exponent grows as 1 / r⁴).
+const float ROUGHNESS_MIN = 0.02;
+
 float hg_eval(float cos_theta, float g) {
     float denom = 1.0 + g * g - 2.0 * g * cos_theta;
-    return INV_4PI * (1.0 - g * g) / (denom * sqrt(max(denom, 1e-12)));
+    return INV_4PI * (1.0 - g * g) / (denom * sqrt(max(denom, HG_DENOM_MIN)));
 }
 
 vec3 orthonormal_dir(vec3 n, vec3 local) {
-    vec3 t = abs(n.x) > 0.9 ? vec3(0, 1, 0) : vec3(1, 0, 0);
+    vec3 t = abs(n.x) > FRAME_AXIS_SWITCH ? vec3(0, 1, 0) : vec3(1, 0, 0);
     vec3 b = normalize(cross(n, t));
     t = cross(b, n);
     return local.x * t + local.y * b + local.z * n;
@@ -23,7 +32,7 @@ vec3 orthonormal_dir(vec3 n, vec3 local) {
 // ray); HG's g > 0 scatters forward. The phase/pdf ratio is 1 for these samplers.
 vec3 hg_sample(vec3 wi, float g, float u1, float u2) {
     float cos_theta;
-    if (abs(g) < 1e-3) {
+    if (abs(g) < HG_ISOTROPIC_G) {
         cos_theta = 1.0 - 2.0 * u1;
     } else {
         float s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u1);
@@ -36,7 +45,7 @@ vec3 hg_sample(vec3 wi, float g, float u1, float u2) {
 
 // Blinn-Phong exponent from roughness (0 = mirror-like, 1 = very rough).
 float phong_exponent(float roughness) {
-    float r = clamp(roughness, 0.02, 1.0);
+    float r = clamp(roughness, ROUGHNESS_MIN, 1.0);
     return 2.0 / (r * r * r * r) - 2.0;
 }
 

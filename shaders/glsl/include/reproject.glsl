@@ -8,6 +8,9 @@
 #include "common.glsl"
 #include "frame.glsl"
 
+// A clip-space w below this is taken as this (a point at or behind the camera's plane).
+const float CLIP_W_MIN = 1e-6;
+
 // Motion in pixels: xy from the closest first real collision, zw from the surface features.
 layout(binding = 20, rgba32f) uniform readonly image2D motion;
 // This frame's and last frame's world positions (w > 0 where something was hit), from
@@ -29,7 +32,7 @@ struct Reprojection {
 
 vec2 to_pixel(mat4 view_proj, vec3 world, ivec2 size) {
     vec4 clip = view_proj * vec4(world, 1.0);
-    return (clip.xy / max(clip.w, 1e-6) * 0.5 + 0.5) * vec2(size);
+    return (clip.xy / max(clip.w, CLIP_W_MIN) * 0.5 + 0.5) * vec2(size);
 }
 
 // Whether last frame's texel `tap` showed this pixel's surface: a screen-space round

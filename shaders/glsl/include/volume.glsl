@@ -319,6 +319,8 @@ vec2 intersect_medium(vec3 o, vec3 d) {
 // through a cut, what it met is the cut face: it takes the cut's normal, not the
 // density gradient (which belongs to structures the cut passes through).
 const float CUT_FACE_STEPS = 2.0;
+// A ray direction's component below this is taken as this (the grid walk divides by it).
+const float DIR_MIN = 1e-12;
 
 // Majorant grid traversal (Amanatides–Woo). Cell c is brick c of the volume: bricks are
 // a whole number of voxels, so when a dimension is not a multiple of the brick the grid
@@ -339,7 +341,7 @@ GridWalk grid_walk_begin(vec3 o, vec3 d, float t) {
     vec3 g = (p - frame.box_min.xyz) / cell_size;
     w.cell = clamp(ivec3(floor(g)), ivec3(0), w.grid - 1);
     w.step_dir = ivec3(sign(d));
-    vec3 inv = 1.0 / max(abs(d), vec3(1e-12));
+    vec3 inv = 1.0 / max(abs(d), vec3(DIR_MIN));
     w.t_delta = cell_size * inv;
     vec3 next_boundary = frame.box_min.xyz + (vec3(w.cell) + step(vec3(0.0), d)) * cell_size;
     w.t_next = t + (next_boundary - p) * sign(d) * inv;

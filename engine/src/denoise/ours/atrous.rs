@@ -42,7 +42,7 @@ impl Ours {
             };
             let level = Level {
                 step: 1 << i,
-                kappa: self.params.outlier_z,
+                kappa: self.params.kappa,
                 keep: self.params.keep,
                 last,
             };

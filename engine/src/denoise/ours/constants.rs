@@ -1,66 +1,169 @@
-//! ours' fixed constants live in one place per language: the shaders' in
+//! ours' fixed constants each have one home: the shaders' in
 //! `shaders/glsl/include/ours_constants.glsl` (a few in the shader they belong to, as
 //! `const` declarations), the Rust side's beside [`super::OursParams`] (`LAG_RADIUS`,
-//! [`super::ATROUS_LEVELS`], [`super::prior::PRIOR_STRIDE`]). The test here reads ours'
-//! shaders and fails on any numeric literal outside a named declaration that is not
-//! structural (0–3, the channel count among them, and the Catmull-Rom weights' halves),
-//! so a number that changes the output cannot enter without a name.
+//! [`super::ATROUS_LEVELS`], [`super::prior::PRIOR_STRIDE`]). The tests here read every
+//! shader and include ours' passes read (the path tracer's shared code that its gradient
+//! pass re-traces with, the reprojection, the à-trous it shares with the paper's models)
+//! and ours' Rust, and fail
+//! - on a numeric literal outside a named declaration that is not structural (0–4, halves,
+//!   an index), in any of those shaders: a number that changes the output cannot enter
+//!   without a name;
+//! - on a name given a value in two places (a shader and the Rust, or two shaders);
+//! - on a name of ours' own (its shaders and includes, the shared à-trous, its Rust) with
+//!   no row in the denoisers page's tables, and on a row that names nothing.
 
-/// The shaders ours runs, and the includes only ours reads.
-const SOURCES: [(&str, &str); 13] = [
-    (
-        "ours_gradient.comp",
-        include_str!("../../../../shaders/glsl/ours_gradient.comp"),
-    ),
-    (
-        "ours_gradient_pool.comp",
-        include_str!("../../../../shaders/glsl/ours_gradient_pool.comp"),
-    ),
-    (
-        "ours_guide.comp",
-        include_str!("../../../../shaders/glsl/ours_guide.comp"),
-    ),
-    (
-        "ours_lag.comp",
-        include_str!("../../../../shaders/glsl/ours_lag.comp"),
-    ),
-    (
-        "ours_noise.comp",
-        include_str!("../../../../shaders/glsl/ours_noise.comp"),
-    ),
-    (
-        "ours_prior.comp",
-        include_str!("../../../../shaders/glsl/ours_prior.comp"),
-    ),
-    (
-        "ours_prior_fit.comp",
-        include_str!("../../../../shaders/glsl/ours_prior_fit.comp"),
-    ),
-    (
-        "ours_prior_sums.comp",
-        include_str!("../../../../shaders/glsl/ours_prior_sums.comp"),
-    ),
-    (
-        "ours_update.comp",
-        include_str!("../../../../shaders/glsl/ours_update.comp"),
-    ),
-    (
-        "variance_atrous.comp",
-        include_str!("../../../../shaders/glsl/variance_atrous.comp"),
-    ),
-    (
-        "include/ours_change.glsl",
-        include_str!("../../../../shaders/glsl/include/ours_change.glsl"),
-    ),
-    (
-        "include/ours_prior.glsl",
-        include_str!("../../../../shaders/glsl/include/ours_prior.glsl"),
-    ),
-    (
-        "include/ours_constants.glsl",
-        include_str!("../../../../shaders/glsl/include/ours_constants.glsl"),
-    ),
-];
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// ours' Rust: its module (but this file, whose tables are the test's) and the shared
+/// à-trous module it runs, as (file, source).
+fn rust_sources() -> Vec<(String, String)> {
+    let denoise = root().join("engine/src/denoise");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(denoise.join("ours"))
+        .expect("ours' module folder")
+        .map(|e| e.expect("a folder entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "rs"))
+        .filter(|p| !p.ends_with("constants.rs"))
+        .collect();
+    files.push(denoise.join("variance_atrous.rs"));
+    files.sort();
+    let name = |p: &Path| p.strip_prefix(root()).unwrap_or(p).display().to_string();
+    files.iter().map(|p| (name(p), read(p))).collect()
+}
+
+/// The shaders ours' Rust builds pipelines from (`ctx.pipeline("name"`), and every
+/// include they read, transitively, as (path under shaders/glsl, source).
+fn shader_sources(rust: &[(String, String)]) -> Vec<(String, String)> {
+    let glsl = root().join("shaders/glsl");
+    let mut todo: Vec<String> = Vec::new();
+    for (_, src) in rust {
+        for piece in src.split("pipeline(").skip(1) {
+            let piece = piece.trim_start();
+            if let Some(rest) = piece.strip_prefix('"') {
+                let name = rest.split('"').next().unwrap_or_default();
+                if !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+                    todo.push(format!("{name}.comp"));
+                }
+            }
+        }
+    }
+    let mut out: Vec<(String, String)> = Vec::new();
+    while let Some(file) = todo.pop() {
+        if out.iter().any(|(f, _)| *f == file) {
+            continue;
+        }
+        let src = read(&glsl.join(&file));
+        for line in src.lines() {
+            if let Some(inc) = line.trim().strip_prefix("#include") {
+                todo.push(format!("include/{}", inc.trim().trim_matches('"')));
+            }
+        }
+        out.push((file, src));
+    }
+    out.sort();
+    out
+}
+
+/// Whether a shader is ours' own (its passes and includes, and the à-trous it shares
+/// with the paper's models) rather than code it shares with the path tracer.
+fn own_shader(file: &str) -> bool {
+    let name = file.trim_start_matches("include/");
+    name.starts_with("ours_") || name.starts_with("variance_atrous")
+}
+
+/// File-scope constants given a value: GLSL's `const T NAME = …` (a specialisation
+/// constant is the engine's to set, so its default is no home) and Rust's numeric
+/// `const NAME: T = …` whose value has a literal (one read from a shader's text names its
+/// home there). Each as (name, where).
+fn declarations(file: &str, src: &str) -> Vec<(String, String)> {
+    let rust = file.ends_with(".rs");
+    let mut out = Vec::new();
+    let lines: Vec<&str> = src.lines().collect();
+    for (i, line) in lines.iter().enumerate() {
+        // Indented declarations are locals (`const int D = PRIOR_FEATURES;`) or the
+        // tests' own tables.
+        if line.starts_with(' ') {
+            continue;
+        }
+        // The whole statement: a value may continue on the next lines.
+        let end = (i..lines.len())
+            .find(|&j| lines[j].contains(';'))
+            .unwrap_or(i);
+        let statement = lines[i..=end].join(" ");
+        let decl = statement
+            .trim_start_matches("pub ")
+            .trim_start_matches("pub(crate) ")
+            .trim_start_matches("pub(super) ");
+        let Some(rest) = decl.strip_prefix("const ") else {
+            continue;
+        };
+        let name = if rust {
+            let Some((name, rest)) = rest.split_once(':') else {
+                continue;
+            };
+            let Some((ty, value)) = rest.split_once('=') else {
+                continue;
+            };
+            let numeric = ["u32", "i32", "f32", "u64", "f64", "usize"].contains(&ty.trim());
+            if !numeric || !value.chars().any(|c| c.is_ascii_digit()) {
+                continue;
+            }
+            name.trim()
+        } else {
+            let Some((head, _)) = rest.split_once('=') else {
+                continue;
+            };
+            let name = head.split_whitespace().nth(1).unwrap_or_default();
+            name.split('[').next().unwrap_or_default()
+        };
+        out.push((name.to_string(), format!("{file}:{}", i + 1)));
+    }
+    out
+}
+
+/// The names in the first column of ours' two tables on the denoisers page (the knobs,
+/// after "**Its parameters**", and the fixed constants, after "**Fixed constants.**"),
+/// each a backticked word.
+fn table_names() -> Vec<String> {
+    let page = read(&root().join("docs/src/denoisers.md"));
+    let mut names = Vec::new();
+    let (mut armed, mut in_table) = (false, false);
+    for line in page.lines() {
+        if line.contains("**Its parameters**") || line.contains("**Fixed constants.**") {
+            armed = true;
+            continue;
+        }
+        if !armed {
+            continue;
+        }
+        if !line.starts_with('|') {
+            if in_table {
+                (armed, in_table) = (false, false);
+            }
+            continue;
+        }
+        in_table = true;
+        let cell = line[1..].split(" | ").next().unwrap_or_default();
+        for (i, piece) in cell.split('`').enumerate() {
+            if i % 2 == 1 {
+                names.push(piece.to_string());
+            }
+        }
+    }
+    assert!(
+        names.len() > 20,
+        "the denoisers page's two tables were not found"
+    );
+    names
+}
 
 /// Numbers that are structure, not choices: the mean over three channels, halves (a
 /// pixel's centre, the Catmull-Rom weights), and small integers (indices, the four
@@ -176,9 +279,20 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_output_changing_number_in_ours_shaders_is_named() {
+    fn every_output_changing_number_in_the_shaders_ours_reads_is_named() {
+        let shaders = shader_sources(&rust_sources());
+        for must in [
+            "ours_update.comp",
+            "include/path.glsl",
+            "include/reproject.glsl",
+        ] {
+            assert!(
+                shaders.iter().any(|(f, _)| f == must),
+                "the scan misses {must}"
+            );
+        }
         let mut unnamed = Vec::new();
-        for (file, src) in SOURCES {
+        for (file, src) in &shaders {
             for (line, code) in code_lines(src) {
                 let header = code.starts_with("for ") || code.starts_with("for(");
                 for (lit, negated, indexing) in literals(&code) {
@@ -193,6 +307,63 @@ mod tests {
             "unnamed constants:\n{}",
             unnamed.join("\n")
         );
+    }
+
+    #[test]
+    fn every_constant_has_one_home_and_a_row() {
+        let rust = rust_sources();
+        let shaders = shader_sources(&rust);
+        let mut homes: BTreeMap<String, Vec<String>> = BTreeMap::new();
+        let mut own: Vec<String> = Vec::new();
+        for (file, src) in shaders.iter().chain(&rust) {
+            let mine = file.ends_with(".rs") || own_shader(file);
+            for (name, at) in declarations(file, src) {
+                if mine {
+                    own.push(name.clone());
+                }
+                homes.entry(name).or_default().push(at);
+            }
+        }
+        let twice: Vec<String> = homes
+            .iter()
+            .filter(|(_, at)| at.len() > 1)
+            .map(|(name, at)| format!("{name}: {}", at.join(", ")))
+            .collect();
+        assert!(
+            twice.is_empty(),
+            "given a value twice:\n{}",
+            twice.join("\n")
+        );
+        let rows = table_names();
+        let mut missing: Vec<&String> = own.iter().filter(|n| !rows.contains(n)).collect();
+        missing.dedup();
+        assert!(
+            missing.is_empty(),
+            "no row in docs/src/denoisers.md: {missing:?}"
+        );
+        // The knobs' rows name OursParams' fields.
+        let knobs: Vec<&str> = super::super::OVERRIDABLE.iter().map(|o| o.0).collect();
+        let stale: Vec<&String> = rows
+            .iter()
+            .filter(|n| !homes.contains_key(*n) && !knobs.contains(&n.as_str()))
+            .collect();
+        assert!(stale.is_empty(), "rows that name no constant: {stale:?}");
+    }
+
+    #[test]
+    fn declarations_are_found_in_both_languages() {
+        let glsl = "const float A = 1e-3;\nlayout(constant_id = 0) const int S = 4;\n    const int D = A;\nconst float B3[3] = float[](1.0, 2.0, 3.0);";
+        let names: Vec<String> = declarations("x.glsl", glsl)
+            .into_iter()
+            .map(|d| d.0)
+            .collect();
+        assert_eq!(names, ["A", "B3"]);
+        let rust = "pub const N: u32 = 4;\nconst F: u32 = glsl_int(SRC, \"F\");\nconst T: [&str; 2] = [\"a\", \"b\"];";
+        let names: Vec<String> = declarations("x.rs", rust)
+            .into_iter()
+            .map(|d| d.0)
+            .collect();
+        assert_eq!(names, ["N"]);
     }
 
     #[test]

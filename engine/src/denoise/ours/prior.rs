@@ -24,9 +24,36 @@ const FITS: [&str; 6] = [
     "fit_r_lo", "fit_r_hi", "fit_g_lo", "fit_g_hi", "fit_b_lo", "fit_b_hi",
 ];
 
-/// The fit's features (`PRIOR_FEATURES` in include/ours_prior.glsl): 1, the albedo's r,
-/// g, b, the normal's x, y, z.
-const PRIOR_FEATURES: u32 = 7;
+/// The prior's include, whose `PRIOR_FEATURES` is the one home of the feature count.
+const PRIOR_GLSL: &str = include_str!("../../../../shaders/glsl/include/ours_prior.glsl");
+
+/// The fit's features (`PRIOR_FEATURES` in include/ours_prior.glsl, read from its text):
+/// 1, the albedo's r, g, b, the normal's x, y, z.
+const PRIOR_FEATURES: u32 = glsl_int(PRIOR_GLSL, "const int PRIOR_FEATURES = ");
+
+/// The decimal integer that follows `prefix` in `src` (a GLSL declaration), at compile
+/// time: a missing declaration fails the build.
+const fn glsl_int(src: &str, prefix: &str) -> u32 {
+    let (s, p) = (src.as_bytes(), prefix.as_bytes());
+    let mut i = 0;
+    while i + p.len() <= s.len() {
+        let mut k = 0;
+        while k < p.len() && s[i + k] == p[k] {
+            k += 1;
+        }
+        if k == p.len() {
+            let (mut j, mut v) = (i + k, 0u32);
+            while j < s.len() && s[j].is_ascii_digit() {
+                v = v * 10 + (s[j] - b'0') as u32;
+                j += 1;
+            }
+            assert!(j > i + k, "no integer after the prefix");
+            return v;
+        }
+        i += 1;
+    }
+    panic!("the prefix is not in the source")
+}
 
 /// Texels (rgba32f) of one block's sums, `PRIOR_SUM_TEXELS` in include/ours_prior.glsl:
 /// the lower triangle of Σ f fᵀ, Σ f x per channel and Σ x² per channel, four to a texel.
@@ -190,8 +217,11 @@ mod tests {
 
     #[test]
     fn shader_constants_match() {
-        let glsl = include_str!("../../../../shaders/glsl/include/ours_prior.glsl");
-        assert!(glsl.contains(&format!("const int PRIOR_FEATURES = {PRIOR_FEATURES};")));
+        let glsl = PRIOR_GLSL;
+        assert_eq!(
+            PRIOR_FEATURES, 7,
+            "1, the albedo's r, g, b, the normal's x, y, z"
+        );
         assert!(glsl.contains("const int PRIOR_SUM_TEXELS = (SUM_XX + 3 + 3) / 4;"));
         assert!(glsl.contains("const int SUM_B = PRIOR_FEATURES * (PRIOR_FEATURES + 1) / 2;"));
         assert!(glsl.contains("const int SUM_XX = SUM_B + 3 * PRIOR_FEATURES;"));

@@ -25,10 +25,10 @@ use serde::{Deserialize, Serialize};
 
 use super::error::{Ctx, SceneError};
 
-/// Lights the path tracer takes (the size of the light array in
-/// `shaders/glsl/include/frame.glsl`, declared with its GLSL twin in
-/// [`crate::shaders::frame`]); a scene with more is an error, never truncated.
-pub use crate::shaders::frame::MAX_LIGHTS;
+/// Lights the path tracer takes: the size of the light array in
+/// `shaders/glsl/include/frame.glsl`, whose twin the engine's shader layer takes from
+/// here (its test compares the two). A scene with more is an error, never truncated.
+pub const MAX_LIGHTS: usize = 4;
 
 /// Largest light intensity: lit surfaces of order 1 need 1–200; past this the
 /// radiance overflows f32 on its way through a path and the image turns black.
@@ -194,7 +194,7 @@ impl Light {
             }
             Self::Environment(e) => match &e.source {
                 EnvSource::Constant { .. } => {}
-                EnvSource::Map { path } => match crate::files::not_a_regular_file(path) {
+                EnvSource::Map { path } => match dvr_volume::files::not_a_regular_file(path) {
                     Ok(None) => {}
                     Ok(Some(what)) => {
                         return Err(ctx.invalid(

@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use super::error::{Ctx, SceneError};
-use crate::volume::labels::Look;
+use dvr_volume::labels::Look;
 
 /// How labelled medium is shown.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]

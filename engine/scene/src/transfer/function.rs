@@ -51,12 +51,10 @@ impl TransferFunction {
     /// Reads and checks a TF file; its name defaults to the file stem.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, TransferError> {
         let path = path.as_ref();
-        let text =
-            crate::files::read_text(path, crate::files::MAX_TEXT_FILE_BYTES).map_err(|source| {
-                TransferError::Io {
-                    path: path.to_path_buf(),
-                    source,
-                }
+        let text = dvr_volume::files::read_text(path, dvr_volume::files::MAX_TEXT_FILE_BYTES)
+            .map_err(|source| TransferError::Io {
+                path: path.to_path_buf(),
+                source,
             })?;
         Self::from_toml_str(&text, &path.display().to_string())
     }

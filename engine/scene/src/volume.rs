@@ -10,7 +10,7 @@
 //! per world unit. At the default of 100, an opacity-1 voxel has a mean free path of
 //! 0.01 world units, about one voxel of a 128³ volume.
 
-use crate::volume::RawFormat;
+use dvr_volume::RawFormat;
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
@@ -144,8 +144,8 @@ impl VolumeSpec {
                     ctx.in_range(
                         "volume.spacing",
                         s,
-                        crate::volume::MIN_SPACING_MM,
-                        crate::volume::MAX_SPACING_MM,
+                        dvr_volume::MIN_SPACING_MM,
+                        dvr_volume::MAX_SPACING_MM,
                         " mm",
                     )?;
                 }

@@ -1,6 +1,13 @@
 //! Scenes: what to render (volume, transfer functions, camera, lights, render settings)
 //! and how it moves over a scripted sequence of frames.
 //!
+//! No GPU: this crate builds and tests without a Vulkan loader (`cargo test -p
+//! dvr-scene`), and the engine re-exports it as `dvr_engine::scene`, with its
+//! [`transfer`] module (transfer functions and their presets) as `dvr_engine::transfer`.
+//! The limits the GPU's frame block is sized by ([`MAX_LIGHTS`], [`MAX_CLIP_PLANES`],
+//! [`MAX_CHANNELS`], [`transfer::LUT_SIZE`]) are declared here, where scenes are
+//! checked against them; the engine's shader layer takes them from here.
+//!
 //! A scene is a TOML file, or one of the 30 built-in scenes (`<dataset>/<animation>`,
 //! see [`builtin`]). The renderer never reads the file itself: it asks a [`Scene`] for
 //! the [`FrameState`] of each frame (camera with its matrices, lights, TF blend),
@@ -46,6 +53,7 @@ pub mod frame;
 pub mod labels;
 pub mod light;
 pub mod render;
+pub mod transfer;
 pub mod transfer_ref;
 pub mod view;
 pub mod volume;
@@ -55,7 +63,6 @@ mod tests;
 
 use std::path::Path;
 
-pub use crate::bytes::parse_memory_size;
 pub use animation::{
     Animation, CameraKey, ChannelKey, ClipKey, CropKey, Interpolation, LabelKey, LightKey, Orbit,
     TfKey, TimeKey, DEFAULT_FRAMES,
@@ -63,11 +70,13 @@ pub use animation::{
 pub use camera::{Camera, CameraSpec, CAMERA_FAR, CAMERA_NEAR, MAX_CAMERA_DISTANCE};
 pub use channel::{ChannelFile, ChannelSpec, ChannelView, MAX_CHANNELS};
 pub use cut::{ClipPlane, CropBox, CropUnits, Cut, MAX_CLIP_PLANES};
-pub use error::SceneError;
+pub use dvr_volume::bytes::parse_memory_size;
+pub use error::{SceneError, SettingError};
 pub use frame::{changed, Change, FrameState};
 pub use labels::{LabelFile, LabelMode, LabelView, LabelsSpec};
 pub use light::{
     AreaLight, EnvMode, EnvSource, EnvironmentLight, Facing, Light, LightKind, PointLight,
+    MAX_LIGHTS,
 };
 pub use render::{parse_gpu_memory, Estimator, Phase, PipelineKey, RenderSettings, MAX_BOUNCES};
 pub use transfer_ref::TransferSpec;
@@ -116,7 +125,7 @@ pub struct Scene {
     pub label_views: Vec<LabelView>,
 }
 
-/// Longest scene name, in bytes (see [`Scene::check`]).
+/// Longest scene name, in bytes (checked with the rest of a scene by `Scene::check`).
 pub const MAX_NAME_BYTES: usize = 200;
 
 impl Scene {
@@ -124,12 +133,10 @@ impl Scene {
     /// folder.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, SceneError> {
         let path = path.as_ref();
-        let text =
-            crate::files::read_text(path, crate::files::MAX_TEXT_FILE_BYTES).map_err(|source| {
-                SceneError::Io {
-                    path: path.to_path_buf(),
-                    source,
-                }
+        let text = dvr_volume::files::read_text(path, dvr_volume::files::MAX_TEXT_FILE_BYTES)
+            .map_err(|source| SceneError::Io {
+                path: path.to_path_buf(),
+                source,
             })?;
         file::parse(&text, &path.display().to_string(), path.parent())
     }

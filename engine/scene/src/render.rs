@@ -8,9 +8,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::error::{num, Ctx, SceneError};
-use crate::bytes::parse_memory_size;
-use crate::error::{EngineError, Result};
+use super::error::{num, Ctx, SceneError, SettingError};
+use dvr_volume::bytes::parse_memory_size;
+
+/// What a setter returns: `Err` names the setting, the value and its range.
+type Result<T, E = SettingError> = std::result::Result<T, E>;
 
 /// How free paths and transmittance are estimated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
@@ -53,7 +55,7 @@ pub struct PipelineKey {
 /// `[render]` section deserialises into it (every field optional), the renderer runs
 /// with it and the explorer edits it. Fields are private; each setter states its
 /// setting's allowed range, the only place it is stated, and a scene file is checked by
-/// the same code ([`RenderSettings::check`]). Defaults: 2 spp, 4 bounces, delta
+/// the same code (`RenderSettings::check`). Defaults: 2 spp, 4 bounces, delta
 /// tracking, isotropic phase, Russian roulette from bounce 3, ray-march step 0.5 voxel,
 /// no emission, seed 1, a 0.5-pixel Gaussian pixel filter, features at opacity 0.5.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -163,12 +165,12 @@ fn ser_memory_size<S: serde::Serializer>(v: &Option<u64>, s: S) -> Result<S::Ok,
     }
 }
 
-/// `Ok(())` when `ok`, else the setting's [`EngineError::InvalidSetting`].
+/// `Ok(())` when `ok`, else the setting's [`SettingError`].
 fn allow(name: &'static str, value: impl std::fmt::Display, ok: bool, allowed: &str) -> Result<()> {
     if ok {
         Ok(())
     } else {
-        Err(EngineError::InvalidSetting {
+        Err(SettingError {
             name,
             value: value.to_string(),
             allowed: allowed.to_string(),
@@ -208,8 +210,8 @@ impl RenderSettings {
         self.gpu_memory
     }
     /// The volume's memory budget on the device (see [`parse_memory_size`]): at least
-    /// 64 KiB (one 8-bit brick and a little more). Renderers read it when they are made (it is their
-    /// [`RendererConfig::gpu_memory`](crate::renderer::RendererConfig::gpu_memory)).
+    /// 64 KiB (one 8-bit brick and a little more). Renderers read it when they are made (it is
+    /// the engine's `RendererConfig::gpu_memory`).
     pub fn set_gpu_memory(&mut self, bytes: Option<u64>) -> Result<()> {
         if let Some(b) = bytes {
             allow(
@@ -346,13 +348,11 @@ impl RenderSettings {
             .and_then(|_| copy.set_filter_sigma(self.filter_sigma))
             .and_then(|_| copy.set_feature_threshold(self.feature_threshold))
             .and_then(|_| copy.set_gpu_memory(self.gpu_memory))
-            .map_err(|e| match e {
-                EngineError::InvalidSetting {
-                    name,
-                    value,
-                    allowed,
-                } => ctx.invalid(format!("render.{name}"), format!("{value}: {allowed}")),
-                other => ctx.invalid("render", other.to_string()),
+            .map_err(|e| {
+                ctx.invalid(
+                    format!("render.{}", e.name),
+                    format!("{}: {}", e.value, e.allowed),
+                )
             })
     }
 }

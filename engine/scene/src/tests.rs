@@ -3,14 +3,14 @@
 use glam::DVec3;
 
 use super::*;
-use crate::volume::RawFormat;
+use dvr_volume::RawFormat;
 
 fn builtin(name: &str) -> Scene {
     Scene::builtin(name).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn example_path() -> std::path::PathBuf {
-    crate::assets::assets_dir()
+    dvr_volume::assets::assets_dir()
         .join("scenes")
         .join("example.toml")
 }

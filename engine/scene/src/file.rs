@@ -119,7 +119,7 @@ pub(crate) fn write(scene: &Scene) -> Result<String, SceneError> {
         source: Box::new(source),
     })?;
     Ok(format!(
-        "# dvr scene {:?} (format: engine/src/scene/mod.rs, example: assets/scenes/example.toml)\n\n{body}",
+        "# dvr scene {:?} (format: engine/scene/src/lib.rs, example: assets/scenes/example.toml)\n\n{body}",
         scene.name
     ))
 }

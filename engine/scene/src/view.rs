@@ -198,7 +198,7 @@ pub fn check_render(render: &RenderSettings, origin: &str) -> Result<(), SceneEr
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Scene;
+    use crate::Scene;
 
     #[test]
     fn a_scenes_view_round_trips_through_its_sections() {
@@ -216,7 +216,7 @@ mod tests {
                 crop: Some(CropBox {
                     min: glam::DVec3::splat(-0.4),
                     max: glam::DVec3::splat(0.3),
-                    units: crate::scene::CropUnits::Box,
+                    units: crate::CropUnits::Box,
                     enabled: true,
                 }),
             },

@@ -1,7 +1,7 @@
 //! Named presets: `assets/transfer/<name>.toml`, one file per TF.
 //!
 //! Presets are files, not code, so they can be tuned without a rebuild and a user can
-//! copy one as a starting point. Where the folder is: [`crate::assets`].
+//! copy one as a starting point. Where the folder is: [`dvr_volume::assets`].
 
 use super::{TransferError, TransferFunction};
 
@@ -9,7 +9,7 @@ impl TransferFunction {
     /// Loads the preset `name` (`assets/transfer/<name>.toml`). An unknown name lists
     /// the available ones.
     pub fn preset(name: &str) -> Result<Self, TransferError> {
-        let dir = crate::assets::transfer_presets();
+        let dir = dvr_volume::assets::transfer_presets();
         let plain = !name.is_empty() && !name.contains(['/', '\\']) && name != "." && name != "..";
         let path = dir.join(format!("{name}.toml"));
         if !plain || !path.is_file() {
@@ -29,7 +29,7 @@ impl TransferFunction {
 
     /// The names of all presets (file stems in `assets/transfer/`), sorted.
     pub fn preset_names() -> Result<Vec<String>, TransferError> {
-        let dir = crate::assets::transfer_presets();
+        let dir = dvr_volume::assets::transfer_presets();
         let io = |source| TransferError::Io {
             path: dir.clone(),
             source,

@@ -17,7 +17,7 @@
 //!
 //! Units: `opacity` is in `[0, 1]` and is turned into extinction by the scene's
 //! `density_scale` (`μt = opacity × density_scale`, per world unit; see
-//! [`crate::scene`]). `diffuse` is the scattering albedo (and the diffuse colour of the
+//! [`crate`]). `diffuse` is the scattering albedo (and the diffuse colour of the
 //! hybrid BRDF), `specular` and `roughness` parameterise the hybrid BRDF's specular lobe,
 //! and `emissive` is radiance the medium emits at that density (added where a path
 //! collides with the medium, as in Exposure Render; only used when the scene turns

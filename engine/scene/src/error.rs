@@ -50,6 +50,19 @@ pub enum SceneError {
     },
 }
 
+/// A render setting outside its allowed range: what each `RenderSettings` setter
+/// returns. The engine's error takes it as its `InvalidSetting`, with the same message.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{name} = {value} is not allowed; {allowed}")]
+pub struct SettingError {
+    /// The setting, as a scene file's `[render]` field names it.
+    pub name: &'static str,
+    /// The value refused, as written.
+    pub value: String,
+    /// The range the setting allows.
+    pub allowed: String,
+}
+
 /// Largest colour channel: colours scale radiance (with a light's intensity), and
 /// colour × intensity must stay far inside f32 through a path's products.
 pub const MAX_COLOUR: f64 = 1e6;
