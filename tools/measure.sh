@@ -338,6 +338,23 @@ EOF2
           done
           printf '%s\t%s\t%s\n' "$scene" "$key" "$what" >> "$out/views.tsv"
         done
+        if [ "$name" = mri ]; then
+          # What the grey-matter-hidden view shows, as data: the T1 with its grey-matter and
+          # rest voxels set to 0, no label map (its rays go as deep; no label is read).
+          "$py" - "$out/mri-white.nii.gz" <<'EOF3'
+import sys
+import nibabel as nib
+import numpy as np
+t1 = nib.load("assets/volumes/mni152_t1.nii.gz")
+labels = np.asarray(nib.load("assets/volumes/mni152_labels.nii.gz").dataobj)
+data = np.asarray(t1.dataobj).copy()
+data[(labels == 2) | (labels == 3)] = 0
+nib.save(nib.Nifti1Image(data, t1.affine, t1.header), sys.argv[1])
+EOF3
+          sed "0,/^builtin = \"mri\"\$/s||file = \"$PWD/$out/mri-white.nii.gz\"|" "$out/mri-none.toml" > "$out/mri-data.toml"
+          keys+=(data)
+          printf '%s\tdata\tgrey matter and the rest removed from the data (no label map)\n' "$scene" >> "$out/views.tsv"
+        fi
         for run in 1 2; do
           for key in "${keys[@]}"; do
             "$dvr" profile --scene "$out/$name-$key.toml" --frames 20 --size 256x256 --denoiser ours \
@@ -361,7 +378,7 @@ with open("assets/results/labels-cost/profile.csv", "w", newline="") as f:
                 pt = next(x["median_ms"] for x in p["passes"] if x["pass"] == "path_trace")
                 w.writerow([scene, what, run, f"{pt:.3f}", f"{p['total']['median_ms']:.3f}"])
 EOF2
-      meta labels-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit and mri/point-light without a label map, with [labels] builtin = the dataset and every label shown, and with labels hidden from the outside in until every one is, alternating, two runs each"
+      meta labels-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit and mri/point-light without a label map, with [labels] builtin = the dataset and every label shown, with labels hidden from the outside in until every one is, and (mri) the T1 with its grey matter and rest set to 0 in the data, alternating, two runs each"
       ;;
     *)
       echo "measure: unknown set '$set' (demo static development validation paper suite cost rae cuts cut-cost labels labels-cost channels-cost statmap)" >&2

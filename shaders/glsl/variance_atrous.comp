@@ -1,7 +1,7 @@
 #version 460
 // One à-trous iteration (a 5×5 B3-spline kernel with taps `step` pixels apart) over
 // per-pixel estimates that carry their own variance, dispatched with step 1, 2, 4, …: ours'
-// spatial filter over its Kalman estimates (three levels) and the one 5×5 level of the
+// spatial filter over its Kalman estimates (ATROUS_LEVELS) and the one 5×5 level of the
 // paper's p = [1] models (`wrls-nf`, `rls-nf`, keep 0). A neighbour is weighted by how far
 // its estimate lies from this pixel's in units of their standard errors, so converged
 // estimates keep the detail they resolved while young ones (after a change or a
