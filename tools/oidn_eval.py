@@ -143,22 +143,12 @@ def score_sequence(out, scene, frames, images):
     return rows
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("out", help="a dvr eval folder (with metrics.csv)")
-    ap.add_argument("--quality", default="high", choices=["high", "balanced", "fast"])
-    ap.add_argument("--check", action="store_true", help="first verify the Python metrics against the `none` rows")
-    args = ap.parse_args()
-
-    need("OpenEXR", "OpenEXR")
-    need("PIL", "pillow")
-    pyoidn = need("pyoidn", "pyoidn")
-
-    metrics_path = os.path.join(args.out, "metrics.csv")
-    summary_path = os.path.join(args.out, "summary.csv")
+def read_metrics(metrics_path):
+    """The eval's metrics.csv: its rows, the scenes with `none` rows (in file order) and
+    each scene's `none` frames; exits with a message if the file is not one."""
     with open(metrics_path, newline="") as fh:
         text = fh.read()
-    if text.splitlines()[0] != METRICS_HEADER:
+    if not text.splitlines() or text.splitlines()[0] != METRICS_HEADER:
         sys.exit(f"oidn_eval: {metrics_path} does not start with {METRICS_HEADER!r}")
     rows = list(csv.DictReader(io.StringIO(text)))
     scenes = []
@@ -168,6 +158,70 @@ def main():
     if not scenes:
         sys.exit(f"oidn_eval: {metrics_path} has no `none` rows (run dvr eval with --denoiser none,...)")
     frames = {s: sorted(int(r["frame"]) for r in rows if r["scene"] == s and r["method"] == "none") for s in scenes}
+    return rows, scenes, frames
+
+
+def has_aux(scene_dir, frames):
+    """Whether the eval kept the albedo and normal images of every frame (`--aux`)."""
+    aux_dir = os.path.join(scene_dir, "aux")
+    return all(
+        os.path.exists(os.path.join(aux_dir, f"{f:04d}_{kind}.exr")) for f in frames for kind in ("albedo", "normal")
+    )
+
+
+def event_frame(scene, events, n_frames):
+    """The scene's event frame: index.html's, else the middle frame for a `tf-jump` or
+    `light-jump` scene, else None."""
+    event = events.get(scene)
+    if event is None and any(scene.endswith(a) for a in ("/tf-jump", "/light-jump")):
+        event = n_frames // 2
+    return event
+
+
+def metric_row(scene, method, r):
+    """One metrics.csv row for a scored frame."""
+    return [scene, method, str(r["frame"]), f"{r['psnr']:.6f}", f"{r['ssim']:.6f}", fmt(r["flip"], 6), fmt(r["temporal_error"], 6), ""]
+
+
+def summary_row(scene, method, scored, event):
+    """One summary.csv row: the means over the scored frames and frames_to_recover
+    (empty without an event, `never` if PSNR does not recover)."""
+    mean = lambda xs: sum(xs) / len(xs) if xs else None
+    te = [r["temporal_error"] for r in scored if r["temporal_error"] is not None]
+    fl = [r["flip"] for r in scored if r["flip"] is not None]
+    rec = ""
+    if event is not None:
+        n = frames_to_recover([r["psnr"] for r in scored], event, RECOVERY_TOLERANCE_DB)
+        rec = "never" if n is None else str(n)
+    return [scene, method, f"{mean([r['psnr'] for r in scored]):.4f}", f"{mean([r['ssim'] for r in scored]):.6f}", fmt(mean(fl), 6), fmt(mean(te), 6), "", rec]
+
+
+def rewrite(path, header, extra):
+    """Rewrites a CSV with `extra` in place of its earlier `oidn` and `oidn-aux` rows."""
+    with open(path, newline="") as fh:
+        lines = list(csv.reader(fh))
+    kept = [l for l in lines[1:] if len(l) > 1 and l[1] not in (METHOD, METHOD_AUX)]
+    with open(path + ".partial", "w", newline="") as fh:
+        wr = csv.writer(fh, lineterminator="\n")
+        fh.write(header + "\n")
+        wr.writerows(kept + extra)
+    os.replace(path + ".partial", path)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("out", help="a dvr eval folder (with metrics.csv)")
+    ap.add_argument("--quality", default="high", choices=["high", "balanced", "fast"])
+    ap.add_argument("--check", action="store_true", help="first verify the Python metrics against the `none` rows")
+    args = ap.parse_args(argv)
+
+    need("OpenEXR", "OpenEXR")
+    need("PIL", "pillow")
+    pyoidn = need("pyoidn", "pyoidn")
+
+    metrics_path = os.path.join(args.out, "metrics.csv")
+    summary_path = os.path.join(args.out, "summary.csv")
+    rows, scenes, frames = read_metrics(metrics_path)
     events = event_frames(args.out)
 
     if args.check:
@@ -188,10 +242,7 @@ def main():
     for s in scenes:
         d = os.path.join(args.out, dir_name(s))
         aux_dir = os.path.join(d, "aux")
-        has_aux = all(
-            os.path.exists(os.path.join(aux_dir, f"{f:04d}_{kind}.exr")) for f in frames[s] for kind in ("albedo", "normal")
-        )
-        for method in [METHOD] + ([METHOD_AUX] if has_aux else []):
+        for method in [METHOD] + ([METHOD_AUX] if has_aux(d, frames[s]) else []):
             os.makedirs(os.path.join(d, method), exist_ok=True)
 
             def denoised(f, method=method):
@@ -211,34 +262,10 @@ def main():
             scored = score_sequence(args.out, s, frames[s], denoised)
             for r in scored:
                 write_png(os.path.join(d, method, f"{r['frame']:04d}.png"), r["display"])
-                new_rows.append(
-                    [s, method, str(r["frame"]), f"{r['psnr']:.6f}", f"{r['ssim']:.6f}", fmt(r["flip"], 6), fmt(r["temporal_error"], 6), ""]
-                )
-            mean = lambda xs: sum(xs) / len(xs) if xs else None
-            te = [r["temporal_error"] for r in scored if r["temporal_error"] is not None]
-            fl = [r["flip"] for r in scored if r["flip"] is not None]
-            event = events.get(s)
-            if event is None and any(s.endswith(a) for a in ("/tf-jump", "/light-jump")):
-                event = len(scored) // 2
-            rec = ""
-            if event is not None:
-                n = frames_to_recover([r["psnr"] for r in scored], event, RECOVERY_TOLERANCE_DB)
-                rec = "never" if n is None else str(n)
-            new_summary.append(
-                [s, method, f"{mean([r['psnr'] for r in scored]):.4f}", f"{mean([r['ssim'] for r in scored]):.6f}", fmt(mean(fl), 6), fmt(mean(te), 6), "", rec]
-            )
+                new_rows.append(metric_row(s, method, r))
+            new_summary.append(summary_row(s, method, scored, event_frame(s, events, len(scored))))
             r = new_summary[-1]
-            print(f"{s:<24} {method:<9} PSNR {r[2]} dB  SSIM {r[3]}  FLIP {r[4]}  temporal {r[5]}  recover {rec}")
-
-    def rewrite(path, header, extra):
-        with open(path, newline="") as fh:
-            lines = list(csv.reader(fh))
-        kept = [l for l in lines[1:] if len(l) > 1 and l[1] not in (METHOD, METHOD_AUX)]
-        with open(path + ".partial", "w", newline="") as fh:
-            wr = csv.writer(fh, lineterminator="\n")
-            fh.write(header + "\n")
-            wr.writerows(kept + extra)
-        os.replace(path + ".partial", path)
+            print(f"{s:<24} {method:<9} PSNR {r[2]} dB  SSIM {r[3]}  FLIP {r[4]}  temporal {r[5]}  recover {r[7]}")
 
     rewrite(metrics_path, METRICS_HEADER, new_rows)
     if os.path.exists(summary_path):

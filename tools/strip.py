@@ -16,8 +16,55 @@ import shutil
 
 from PIL import Image, ImageDraw
 
+LABEL = 16  # pixels above each tile for its label
+BACKGROUND = (24, 26, 32)
+TEXT = (230, 230, 230)
 
-def main():
+
+def scenes_of(eval_dir):
+    """The eval's scene folders (those with a `reference/` folder), sorted by name."""
+    scenes = sorted(p for p in pathlib.Path(eval_dir).iterdir() if (p / "reference").is_dir())
+    if not scenes:
+        raise SystemExit(f"strip: {eval_dir} has no scene folders (none holds a reference/ folder)")
+    return scenes
+
+
+def strip(eval_dir, frame, methods, scale=2):
+    """The strip image: one row per scene, the reference then `methods` as columns, each
+    tile `scale`x its frame's PNG under a label. A missing frame is an error naming it."""
+    methods = ["reference"] + list(methods)
+    scenes = scenes_of(eval_dir)
+    name = f"{frame:04d}.png"
+    missing = [str(s / m / name) for s in scenes for m in methods if not (s / m / name).is_file()]
+    if missing:
+        raise SystemExit("strip: missing frame(s): " + ", ".join(missing))
+    tiles = [[Image.open(s / m / name).convert("RGB") for m in methods] for s in scenes]
+    w, h = tiles[0][0].size
+    w, h = w * scale, h * scale
+    out = Image.new("RGB", (w * len(methods), (h + LABEL) * len(scenes)), BACKGROUND)
+    draw = ImageDraw.Draw(out)
+    for r, (scene, row) in enumerate(zip(scenes, tiles)):
+        for c, (m, img) in enumerate(zip(methods, row)):
+            x, y = c * w, r * (h + LABEL)
+            out.paste(img.resize((w, h), Image.NEAREST), (x, y + LABEL))
+            draw.text((x + 3, y + 2), f"{scene.name} · {m}" if c == 0 else m, fill=TEXT)
+    return out
+
+
+def copy_plots(eval_dir, prefix):
+    """Copies each scene's `plots/psnr.png` to `<prefix>-<scene>-psnr.png`; returns the copies."""
+    written = []
+    for s in scenes_of(eval_dir):
+        src = s / "plots" / "psnr.png"
+        if not src.is_file():
+            raise SystemExit(f"strip: missing PSNR chart: {src}")
+        dest = pathlib.Path(f"{prefix}-{s.name}-psnr.png")
+        shutil.copyfile(src, dest)
+        written.append(dest)
+    return written
+
+
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("eval_dir", type=pathlib.Path)
     ap.add_argument("--frame", type=int, required=True)
@@ -25,27 +72,13 @@ def main():
     ap.add_argument("--strip", type=pathlib.Path, required=True)
     ap.add_argument("--plots", type=pathlib.Path, help="prefix: copies <prefix>-<scene>-psnr.png")
     ap.add_argument("--scale", type=int, default=2)
-    args = ap.parse_args()
-    methods = ["reference"] + args.methods.split(",")
-    scenes = sorted(p for p in args.eval_dir.iterdir() if (p / "reference").is_dir())
-    name = f"{args.frame:04d}.png"
-    tiles = [[Image.open(s / m / name).convert("RGB") for m in methods] for s in scenes]
-    w, h = tiles[0][0].size
-    w, h, label = w * args.scale, h * args.scale, 16
-    out = Image.new("RGB", (w * len(methods), (h + label) * len(scenes)), (24, 26, 32))
-    draw = ImageDraw.Draw(out)
-    for r, (scene, row) in enumerate(zip(scenes, tiles)):
-        for c, (m, img) in enumerate(zip(methods, row)):
-            x, y = c * w, r * (h + label)
-            out.paste(img.resize((w, h), Image.NEAREST), (x, y + label))
-            draw.text((x + 3, y + 2), f"{scene.name} · {m}" if c == 0 else m, fill=(230, 230, 230))
+    args = ap.parse_args(argv)
+    out = strip(args.eval_dir, args.frame, args.methods.split(","), args.scale)
     args.strip.parent.mkdir(parents=True, exist_ok=True)
     out.save(args.strip, optimize=True)
     print(f"wrote {args.strip}")
     if args.plots:
-        for s in scenes:
-            dest = pathlib.Path(f"{args.plots}-{s.name}-psnr.png")
-            shutil.copyfile(s / "plots" / "psnr.png", dest)
+        for dest in copy_plots(args.eval_dir, args.plots):
             print(f"wrote {dest}")
 
 

@@ -1,11 +1,15 @@
 """The Python tools that make and check the book: `tools/results_io.py`'s formatting and
 tables, `tools/check_docs.py`'s anchors, its rule that OVERVIEW.md names each source
 file by a path that resolves to it alone and its rule that a built book's images are in
-it, `tools/book_images.py`'s images linked into the book, and `tools/ct_views.py`'s CT
-in Hounsfield units. Imported from the checkout's tools/ folder; no GPU. And the validation set's
-README: one row per frozen scene file with the day it was frozen."""
+it, `tools/book_images.py`'s images linked into the book, `tools/ct_views.py`'s CT
+in Hounsfield units, `tools/strip.py`'s strip of one frame per scene and method, and
+`tools/oidn_eval.py`'s OIDN rows in an eval folder (with a stand-in for OIDN). Imported
+from the checkout's tools/ folder; no GPU. And the validation set's README: one row per
+frozen scene file with the day it was frozen."""
 
+import csv
 import importlib
+import json
 import re
 import sys
 
@@ -155,3 +159,265 @@ def test_the_validation_sets_readme_lists_each_scene_file_with_the_day_it_was_fr
     # Rows in the order the scenes were frozen, so a new scene adds the last row.
     dates = [date for _, date in rows]
     assert dates == sorted(dates)
+
+
+def _tool(root, name):
+    sys.path.insert(0, str(root / "tools"))
+    try:
+        return importlib.import_module(name)
+    finally:
+        sys.path.remove(str(root / "tools"))
+
+
+# tools/strip.py: the results page's strip of one frame per scene and method.
+
+STRIP_COLOURS = {
+    ("brain", "reference"): (200, 0, 0),
+    ("brain", "ours"): (0, 200, 0),
+    ("brain", "svgf"): (0, 0, 200),
+    ("head", "reference"): (200, 200, 0),
+    ("head", "ours"): (0, 200, 200),
+    ("head", "svgf"): (200, 0, 200),
+}
+
+
+def _fake_eval_for_strip(folder, frame, size=(20, 6)):
+    """A `dvr eval` folder as strip.py reads it: per scene `reference/` and one folder a
+    method of NNNN.png frames (one solid colour each, a grey decoy one frame earlier)
+    and `plots/psnr.png`; plus a folder that is no scene."""
+    from PIL import Image
+
+    for (scene, method), colour in STRIP_COLOURS.items():
+        d = folder / scene / method
+        d.mkdir(parents=True, exist_ok=True)
+        Image.new("RGB", size, colour).save(d / f"{frame:04d}.png")
+        Image.new("RGB", size, (128, 128, 128)).save(d / f"{frame - 1:04d}.png")
+    for scene in ("brain", "head"):
+        (folder / scene / "plots").mkdir()
+        (folder / scene / "plots" / "psnr.png").write_bytes(f"chart of {scene}".encode())
+    (folder / "plots").mkdir()
+
+
+def test_the_strip_has_a_labelled_tile_per_scene_and_method_holding_that_frame(root, tmp_path):
+    from PIL import Image
+
+    strip = _tool(root, "strip")
+    _fake_eval_for_strip(tmp_path / "eval", 7)
+    out = tmp_path / "gallery" / "strip.png"
+    strip.main([str(tmp_path / "eval"), "--frame", "7", "--methods", "ours,svgf", "--strip", str(out), "--scale", "2"])
+    img = np.asarray(Image.open(out).convert("RGB"))
+    w, h, label = 20 * 2, 6 * 2, strip.LABEL
+    # Columns: the reference then the methods; rows: the scenes by name.
+    assert img.shape == (2 * (h + label), 3 * w, 3)
+    for r, scene in enumerate(("brain", "head")):
+        for c, method in enumerate(("reference", "ours", "svgf")):
+            x, y = c * w, r * (h + label)
+            tile = img[y + label : y + label + h, x : x + w]
+            assert (tile == STRIP_COLOURS[scene, method]).all(), (scene, method)
+            # A label above each tile: text on the background.
+            band = img[y : y + label, x : x + w]
+            assert (band != strip.BACKGROUND).any(axis=-1).sum() > 5, (scene, method)
+            assert ((band == strip.BACKGROUND).all(axis=-1)).mean() > 0.3, (scene, method)
+
+
+def test_a_missing_method_frame_is_an_error_naming_it(root, tmp_path):
+    strip = _tool(root, "strip")
+    _fake_eval_for_strip(tmp_path, 3)
+    (tmp_path / "head" / "svgf" / "0003.png").unlink()
+    with pytest.raises(SystemExit, match=r"head/svgf/0003\.png"):
+        strip.strip(tmp_path, 3, ["ours", "svgf"])
+    with pytest.raises(SystemExit, match=r"brain/taa/0003\.png"):
+        strip.strip(tmp_path, 3, ["taa"])
+    with pytest.raises(SystemExit, match="no scene folders"):
+        strip.strip(tmp_path / "plots", 3, ["ours"])
+
+
+def test_the_psnr_charts_are_copied_per_scene_and_a_missing_one_is_named(root, tmp_path):
+    strip = _tool(root, "strip")
+    _fake_eval_for_strip(tmp_path / "eval", 1)
+    written = strip.copy_plots(tmp_path / "eval", tmp_path / "cuts")
+    assert [p.name for p in written] == ["cuts-brain-psnr.png", "cuts-head-psnr.png"]
+    assert (tmp_path / "cuts-head-psnr.png").read_bytes() == b"chart of head"
+    (tmp_path / "eval" / "head" / "plots" / "psnr.png").unlink()
+    with pytest.raises(SystemExit, match=r"head/plots/psnr\.png"):
+        strip.copy_plots(tmp_path / "eval", tmp_path / "cuts")
+
+
+# tools/oidn_eval.py: OIDN's rows in an eval folder. OIDN itself (pyoidn) is replaced by
+# a stand-in that records its arguments and returns the noisy frame.
+
+
+def test_frames_to_recover_counts_frames_after_the_event_until_psnr_stays_within_1db(root):
+    o = _tool(root, "oidn_eval")
+    before = [30.0, 31.0, 30.0, 29.0, 30.0]  # mean 30: recovered at >= 29
+    assert o.frames_to_recover(before + [20.0, 25.0, 29.5, 30.0], 5, 1.0) == 2
+    assert o.frames_to_recover(before + [29.0, 30.0], 5, 1.0) == 0
+    # A dip after a recovery counts; one that lasts to the end is `never` (None).
+    assert o.frames_to_recover(before + [20.0, 30.0, 28.0, 30.0], 5, 1.0) == 3
+    assert o.frames_to_recover(before + [20.0, 30.0, 20.0], 5, 1.0) is None
+    # Only the 5 frames before the event are the baseline; PSNR is capped at 100 dB.
+    assert o.frames_to_recover([0.0] + before + [29.0], 6, 1.0) == 0
+    assert o.frames_to_recover([float("inf")] * 2 + [98.0, 99.5], 2, 1.0) == 1
+    # No event inside the series: no count.
+    assert o.frames_to_recover(before, 0, 1.0) is None
+    assert o.frames_to_recover(before, 5, 1.0) is None
+
+
+def test_the_event_frame_is_read_from_index_html_else_the_middle_of_a_jump_scene(root, tmp_path):
+    o = _tool(root, "oidn_eval")
+    assert o.event_frames(str(tmp_path)) == {}
+    data = {"scenes": [{"name": "head/tf-jump", "event_frame": 12}, {"name": "head/orbit"}]}
+    (tmp_path / "index.html").write_text(
+        f'<html><script type="application/json" id="data">\n{json.dumps(data)}\n</script></html>'
+    )
+    events = o.event_frames(str(tmp_path))
+    assert events == {"head/tf-jump": 12, "head/orbit": None}
+    assert o.event_frame("head/tf-jump", events, 40) == 12
+    assert o.event_frame("head/orbit", events, 40) is None
+    assert o.event_frame("brain/light-jump", events, 40) == 20
+    (tmp_path / "index.html").write_text('<script type="application/json" id="data">{not json</script>')
+    assert o.event_frames(str(tmp_path)) == {}
+
+
+def test_scene_names_become_dvrs_folder_names(root):
+    o = _tool(root, "oidn_eval")
+    assert o.dir_name("head/tf-jump") == "head_tf-jump"
+    assert o.dir_name("ct.v2 scan") == "ct.v2_scan"
+    assert o.dir_name("..x..") == "x"
+    assert o.dir_name("é") == "_"
+    assert o.dir_name("..") == "scene"
+
+
+def test_metrics_csv_gives_the_scenes_and_frames_of_the_none_method(root, tmp_path):
+    o = _tool(root, "oidn_eval")
+    path = tmp_path / "metrics.csv"
+    path.write_text(
+        o.METRICS_HEADER + "\n"
+        "b,none,1,30,0.9,0.1,,\nb,none,0,30,0.9,0.1,,\na,ours,0,31,0.9,0.1,,\na,none,0,30,0.9,0.1,,\n"
+    )
+    rows, scenes, frames = o.read_metrics(str(path))
+    assert len(rows) == 4
+    assert scenes == ["b", "a"]
+    assert frames == {"b": [0, 1], "a": [0]}
+    path.write_text(o.METRICS_HEADER + "\na,ours,0,31,0.9,0.1,,\n")
+    with pytest.raises(SystemExit, match="no `none` rows"):
+        o.read_metrics(str(path))
+    path.write_text("scene,method,frame\n")
+    with pytest.raises(SystemExit, match="does not start with"):
+        o.read_metrics(str(path))
+
+
+def test_rewriting_a_csv_replaces_earlier_oidn_rows_and_keeps_the_others(root, tmp_path):
+    o = _tool(root, "oidn_eval")
+    path = tmp_path / "summary.csv"
+    path.write_text(
+        "old,header\n"
+        "a,ours,31\na,oidn,1\na,oidn-aux,2\nb,none,20\n\n"
+    )
+    o.rewrite(str(path), "scene,method,psnr", [["a", "oidn", "29"]])
+    assert path.read_text() == "scene,method,psnr\na,ours,31\nb,none,20\na,oidn,29\n"
+    assert not (tmp_path / "summary.csv.partial").exists()
+
+
+def test_a_summary_row_holds_the_means_and_frames_to_recover(root):
+    o = _tool(root, "oidn_eval")
+    psnr = [30.0] * 5 + [20.0, 29.5, 30.0]
+    scored = [
+        {"frame": i, "psnr": p, "ssim": 0.5 + 0.01 * i, "flip": 0.1, "temporal_error": None if i == 0 else 0.2}
+        for i, p in enumerate(psnr)
+    ]
+    row = o.summary_row("s", "oidn", scored, 5)
+    assert row == ["s", "oidn", f"{sum(psnr) / 8:.4f}", f"{0.535:.6f}", "0.100000", "0.200000", "", "1"]
+    assert o.summary_row("s", "oidn", scored, None)[7] == ""
+    assert o.summary_row("s", "oidn", scored[:6], 5)[7] == "never"
+    assert o.metric_row("s", "oidn", scored[0]) == ["s", "oidn", "0", "30.000000", "0.500000", "0.100000", "", ""]
+
+
+def _write_exr(path, image):
+    import OpenEXR
+
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    OpenEXR.File(header, {"RGB": np.ascontiguousarray(image, dtype=np.float32)}).write(str(path))
+
+
+def test_oidn_rows_replace_earlier_ones_with_the_evals_metrics_of_each_frame(root, tmp_path, monkeypatch, capsys):
+    import types
+
+    import dvr
+    from PIL import Image
+
+    o = _tool(root, "oidn_eval")
+    rng = np.random.default_rng(1)
+    out = tmp_path / "eval"
+    scenes = {"head/tf-jump": "head_tf-jump", "brain": "brain"}
+    refs, noisy, lines = {}, {}, [o.METRICS_HEADER]
+    for scene, folder in scenes.items():
+        for sub in ("reference", "none", "aux"):
+            (out / folder / sub).mkdir(parents=True)
+        prev = None
+        for f in range(2):
+            ref = rng.uniform(0.0, 2.0, (8, 8, 3)).astype(np.float32)
+            test = (ref + rng.normal(0.0, 0.3, ref.shape)).clip(0.0).astype(np.float32)
+            refs[scene, f], noisy[scene, f] = ref, test
+            _write_exr(out / folder / "reference" / f"{f:04d}.exr", ref)
+            _write_exr(out / folder / "none" / f"{f:04d}.exr", test)
+            te = "" if prev is None else f"{dvr.metrics.temporal_error(prev[0], test, prev[1], ref):.6f}"
+            lines.append(
+                f"{scene},none,{f},{dvr.metrics.psnr(ref, test):.6f},{dvr.metrics.ssim(ref, test):.6f},"
+                f"{dvr.metrics.flip(ref, test):.6f},{te},1.5"
+            )
+            prev = (test, ref)
+            if scene == "brain":  # only brain's eval ran with --aux
+                _write_exr(out / folder / "aux" / f"{f:04d}_albedo.exr", np.full((8, 8, 3), 1.5))
+                _write_exr(out / folder / "aux" / f"{f:04d}_normal.exr", np.full((8, 8, 3), -2.0))
+    lines.append("brain,oidn,0,1.0,0.1,0.9,,")  # from an earlier run: replaced
+    (out / "metrics.csv").write_text("\n".join(lines) + "\n")
+    (out / "summary.csv").write_text(o.SUMMARY_HEADER + "\nbrain,none,20,0.5,0.2,0.1,1.5,\nbrain,oidn-aux,1,0.1,0.9,,,\n")
+
+    calls = []
+
+    def denoise(image, **kw):
+        calls.append((image.copy(), kw))
+        return image
+
+    monkeypatch.setitem(sys.modules, "pyoidn", types.SimpleNamespace(denoise=denoise))
+    o.main([str(out), "--quality", "fast", "--check"])
+
+    # --check: the Python metrics of the `none` frames are metrics.csv's to its rounding.
+    check = re.search(r"largest \|python - dvr\| on `none`: (.*)", capsys.readouterr().out).group(1)
+    assert all(float(v) <= 1e-6 for v in re.findall(r"\d\.\d+e[-+]\d+", check)), check
+    # OIDN gets each noisy frame as HDR at the quality asked; brain's also its clean guides, clipped.
+    assert len(calls) == 2 * 2 + 2
+    for image, kw in calls:
+        assert kw["hdr"] is True and kw["quality"] == "fast"
+    aux = [kw for _, kw in calls if "albedo" in kw]
+    assert len(aux) == 2
+    for kw in aux:
+        assert kw["clean_aux"] is True
+        assert (kw["albedo"] == 1.0).all() and (kw["normal"] == -1.0).all()
+    assert any(np.array_equal(image, noisy["brain", 1]) for image, _ in calls)
+
+    rows = list(csv.DictReader((out / "metrics.csv").open()))
+    assert [r["method"] for r in rows[:4]] == ["none"] * 4
+    new = {(r["scene"], r["method"], int(r["frame"])): r for r in rows[4:]}
+    assert sorted(new) == sorted(
+        [(s, "oidn", f) for s in scenes for f in range(2)] + [("brain", "oidn-aux", f) for f in range(2)]
+    )
+    for (scene, method, f), r in new.items():
+        psnr = float(r["psnr"])
+        assert np.isfinite(psnr) and abs(psnr - dvr.metrics.psnr(refs[scene, f], noisy[scene, f])) < 1e-5
+        assert (r["temporal_error"] == "") == (f == 0) and r["gpu_ms"] == ""
+        png = np.asarray(Image.open(out / scenes[scene] / method / f"{f:04d}.png"))
+        want = (np.clip(dvr.metrics.tonemap(noisy[scene, f]), 0, 1) * 255 + 0.5).astype(np.uint8)
+        assert np.array_equal(png, want)
+
+    summary = list(csv.DictReader((out / "summary.csv").open()))
+    assert [(r["scene"], r["method"]) for r in summary] == [
+        ("brain", "none"), ("head/tf-jump", "oidn"), ("brain", "oidn"), ("brain", "oidn-aux")
+    ]
+    # head/tf-jump has no index.html event, so its event is the middle frame (1): recovered
+    # at once if frame 1 is within 1 dB of frame 0, else never. brain has no event.
+    p0, p1 = (float(new["head/tf-jump", "oidn", f]["psnr"]) for f in range(2))
+    assert summary[1]["frames_to_recover"] == ("0" if p1 >= p0 - 1.0 else "never")
+    assert summary[2]["frames_to_recover"] == ""
+    assert float(summary[3]["psnr"]) == pytest.approx(np.mean([float(new["brain", "oidn-aux", f]["psnr"]) for f in range(2)]), abs=1e-4)
