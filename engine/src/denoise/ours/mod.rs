@@ -175,11 +175,10 @@ pub struct Ours {
 /// The pooled lag test's window radius (5×5).
 const LAG_RADIUS: i32 = 2;
 
-/// À-trous levels (steps 1, 2, 4: up to 17×17 pixels). Converged pixels are kept as they
-/// are, so the third level acts where the history is young: the first frames after a
-/// change, where it narrows the gap to single-frame denoisers; a fourth bought nothing
-/// (the experiments page of the book, docs/src/experiments.md).
-pub const ATROUS_LEVELS: u32 = 3;
+/// À-trous levels (steps 1, 2: up to 9×9 pixels). Fixed, not tuned: a third level (step
+/// 4) bought little on the development suite for a large share of ours' cost (the
+/// experiments page of the book, docs/src/experiments.md).
+pub const ATROUS_LEVELS: u32 = 2;
 
 impl Ours {
     pub fn new(
