@@ -177,32 +177,40 @@ def b_labels_cost():
                 if r["labels"] == labels}
 
     base, shown = by_run("no label map"), by_run("every label shown (tint)")
-    # A view whose hidden tissue is also removed from the data (no label map): "X hidden"
-    # beside "X removed from the data (no label map)".
-    removed = " removed from the data (no label map)"
-    data = {(r["scene"], r["run"], r["labels"][:-len(removed)]): num(r["path_trace_ms"])
-            for r in rows if r["labels"].endswith(removed)}
+    # A view whose hidden tissue is also removed from the data: "X hidden" beside "X
+    # removed from the data (no label map)" and "X removed from the data, every label
+    # shown" (the same tissue through the label path).
+    def removed(suffix):
+        return {(r["scene"], r["run"], r["labels"][:-len(suffix)]): num(r["path_trace_ms"])
+                for r in rows if r["labels"].endswith(suffix)}
+
+    data = removed(" removed from the data (no label map)")
+    same = removed(" removed from the data, every label shown")
 
     def ratio(r, to):
         return f"{num(r['path_trace_ms']) / to[(r['scene'], r['run'])]:.2f}×"
 
-    def to_data(r):
-        key = (r["scene"], r["run"], r["labels"].removesuffix(" hidden"))
-        return f"{num(r['path_trace_ms']) / data[key]:.2f}×" if key in data else ""
+    def to(control):
+        def cell(r):
+            key = (r["scene"], r["run"], r["labels"].removesuffix(" hidden"))
+            return f"{num(r['path_trace_ms']) / control[key]:.2f}×" if key in control else ""
+        return cell
 
+    to_data, to_same = to(data), to(same)
     body = [[r["scene"], r["labels"], r["run"], fmt(num(r["path_trace_ms"]), 1),
              ratio(r, base), ratio(r, shown) if r["labels"] != "no label map" else "",
-             to_data(r), fmt(num(r["frame_ms"]), 1)]
+             to_data(r), to_same(r), fmt(num(r["frame_ms"]), 1)]
             for r in rows]
     return "\n".join([
         "Median GPU ms per frame of the path-tracing pass and of the whole frame at 256×256, "
         "the same view without a label map, with every label shown, and with labels hidden "
         "from the outside in until every one is, runs alternating (× is to the same scene's "
         "run without a label map, or with every label shown; × data is to the tissue the "
-        "view shows with the hidden tissue removed from the data and no label map):",
+        "view shows with the hidden tissue removed from the data and no label map, × same "
+        "to that data with the label map and every label shown):",
         "",
         table(["scene", "labels", "run", "`path_trace`", "× none", "× shown", "× data",
-               "frame"], body),
+               "× same", "frame"], body),
         "",
         source("labels-cost", ["profile.csv"]),
     ])
