@@ -47,6 +47,7 @@ impl Renderer {
             crop,
             clip: &clip,
             channel_opacity: &self.channel_opacity,
+            label_opacity: inputs.labels.as_ref().map_or(0.0, |l| l.0.shown_opacity),
         })
     }
 

@@ -88,6 +88,8 @@ gpu_block! {
         pub crop_max: Vec4,
         /// `counts.z` planes: xyz unit normal, w offset (kept where `n·x + w >= 0`).
         pub clip: [Vec4; MAX_CLIP_PLANES],
+        /// With a label map: x the one opacity every shown label has, 0 when they differ.
+        pub labels: Vec4,
         /// Several channels: entry i, lane c is channel c's opacity at density
         /// `i / (LUT_SIZE − 1)`.
         pub channel_opacity: ChannelOpacity,
@@ -153,6 +155,9 @@ pub struct FrameParams<'a> {
     pub clip: &'a [Vec4],
     /// Several channels: their opacity rows, lane by lane.
     pub channel_opacity: &'a ChannelOpacity,
+    /// With a label map: the one opacity every shown label has, 0 when they differ (see
+    /// `LabelLook::shown_opacity`).
+    pub label_opacity: f32,
 }
 
 /// Most channels one medium holds: a volume texel's four components (and the lanes of
@@ -218,6 +223,7 @@ impl FrameBlock {
             crop_min: p.crop.0.extend(0.0),
             crop_max: p.crop.1.extend(0.0),
             clip,
+            labels: Vec4::new(p.label_opacity, 0.0, 0.0, 0.0),
             channel_opacity: *p.channel_opacity,
         }
     }
@@ -227,7 +233,7 @@ impl FrameBlock {
 pub const FRAME_BLOCK: &str = "FrameBlock";
 
 const _: () = assert!(std::mem::size_of::<GpuLight>() == 64);
-const _: () = assert!(<FrameBlock as GpuBlock>::FIELDS.len() == 15);
+const _: () = assert!(<FrameBlock as GpuBlock>::FIELDS.len() == 16);
 
 #[cfg(test)]
 mod tests {
@@ -327,7 +333,9 @@ mod tests {
             crop: (Vec3::splat(-0.25), Vec3::splat(0.5)),
             clip: &[Vec4::new(0.0, 0.0, 1.0, -0.1)],
             channel_opacity: &ChannelOpacity::from_rows(&rows),
+            label_opacity: 0.75,
         });
+        assert_eq!(b.labels, Vec4::new(0.75, 0.0, 0.0, 0.0));
         assert_eq!(b.channel_opacity.0[3], Vec4::new(3.0, 1003.0, 0.0, 0.0));
         assert_eq!(
             b.channel_opacity.0[LUT_SIZE - 1].y,

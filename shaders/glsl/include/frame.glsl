@@ -38,6 +38,9 @@ layout(binding = 0, std140) uniform FrameBlock {
     vec4 crop_min;
     vec4 crop_max;
     vec4 clip[MAX_CLIP_PLANES];
+    // With a label map: x the one opacity every shown label has, 0 when they differ
+    // (volume.glsl, label_mask); yzw unused.
+    vec4 labels;
     // Several channels: entry i, lane c is channel c's opacity at density i/(LUT_SIZE-1)
     // (its LUT's alpha, 0 where hidden). The extinction reads it rather than the LUT
     // textures: on lavapipe a sampler call per channel at every delta-tracking step costs

@@ -130,6 +130,23 @@ vec3 label_gradient(vec3 p) {
 // the cut's.
 const float LABEL_EDGE = 0.05;
 
+// A trilinear read of the mask ramps across a hidden label's face over a whole voxel: a
+// soft layer at a fraction of the tissue's extinction, which rays cross in many null
+// collisions and into which they scatter. When every shown label has the same opacity a
+// (frame.labels.x; 0 when they differ), the read is a times the share of shown voxels
+// around p, and that share is sharpened to this window about its half. The window is
+// symmetric about 1/2, so across a flat face it moves no medium, and a face still lies
+// on the trilinear surface rather than a voxel's facet; the normals come from the
+// filtered shape either way.
+const float LABEL_FACE_LOW = 0.4;
+const float LABEL_FACE_HIGH = 0.6;
+
+// The mask at p from its trilinear read m (tint: the extinction's factor).
+float label_mask(float m) {
+    float a = frame.labels.x;
+    return a > 0.0 ? a * smoothstep(LABEL_FACE_LOW, LABEL_FACE_HIGH, m / a) : m;
+}
+
 // With a label map and one channel, the mask rides in the volume texture's second
 // component (engine/src/renderer/packing.rs, with_mask): the extinction, evaluated at
 // every step of delta tracking, takes one fetch for density and mask.
@@ -141,7 +158,7 @@ float extinction_at(vec3 p) {
     if (mask_in_volume()) {
         vec2 dm = texture(volume_density, to_uvw(p)).rg;
         float o = LABELS == LABELS_SOLID ? 1.0 : tf_albedo_opacity(dm.r).a;
-        return o * dm.g * frame.box_min.w;
+        return o * (LABELS == LABELS_SOLID ? dm.g : label_mask(dm.g)) * frame.box_min.w;
     }
     if (LABELS == LABELS_SOLID) return label_look_at(p).a * frame.box_min.w;
     float opacity;
@@ -154,7 +171,7 @@ float extinction_at(vec3 p) {
     } else {
         opacity = tf_albedo_opacity(density_at(p)).a;
     }
-    if (LABELS == LABELS_TINT) opacity *= label_look_at(p).a;
+    if (LABELS == LABELS_TINT) opacity *= label_mask(label_look_at(p).a);
     return opacity * frame.box_min.w;
 }
 
@@ -206,7 +223,7 @@ MediumPoint medium_point(vec3 p) {
         m.look = label_look_at(p);
         m.albedo_opacity = LABELS == LABELS_SOLID
             ? m.look
-            : vec4(m.albedo_opacity.rgb * m.look.rgb, m.albedo_opacity.a * m.look.a);
+            : vec4(m.albedo_opacity.rgb * m.look.rgb, m.albedo_opacity.a * label_mask(m.look.a));
     }
     return m;
 }

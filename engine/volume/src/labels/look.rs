@@ -7,7 +7,9 @@
 //! interpolated instead: a hidden label's voxels are empty at their centres, with the
 //! half-voxel ramp a trilinear read of the density has too, and a label one voxel thin
 //! still shows or hides. Across a flat boundary the ramp is symmetric, so it moves no
-//! medium: a ray through a hidden slab loses exactly the slab's optical depth. The
+//! medium: a ray through a hidden slab loses exactly the slab's optical depth. When every
+//! shown label has one opacity ([`LabelLook::shown_opacity`]), the renderer narrows the
+//! ramp symmetrically, so a hidden label's face is no soft layer that rays wander in. The
 //! normals come from the filtered shape because the raw indicator's gradient is a voxel
 //! facet's (a sphere's normals stray by tens of degrees); filtering the mask itself
 //! would smooth the normals too, but leaves a ghost of a hidden label's outer layer and
@@ -51,6 +53,10 @@ pub struct LabelLook {
     pub brick: u32,
     pub grid: [u32; 3],
     pub brick_max: Vec<f32>,
+    /// The one opacity every shown label in the map has, 0 when they differ or none is
+    /// shown. Then a trilinear read of the mask is that opacity times the share of shown
+    /// voxels around it, and the renderer sharpens that share (volume.glsl, `label_mask`).
+    pub shown_opacity: f32,
 }
 
 fn kernel(sigma: f32) -> [f32; 2 * RADIUS + 1] {
@@ -145,6 +151,12 @@ impl LabelLook {
             _ => rgba,
         };
         let brick_max = brick_maxima(&rgba, map.dims, brick, grid);
+        // The table holds the labels the map has.
+        let mut shown = table.iter().flatten().map(mask_of).filter(|&m| m > 0);
+        let shown_opacity = match shown.next() {
+            Some(m) if shown.all(|n| n == m) => f32::from(m) / 255.0,
+            _ => 0.0,
+        };
         Self {
             dims: map.dims,
             rgba,
@@ -152,6 +164,7 @@ impl LabelLook {
             brick,
             grid,
             brick_max,
+            shown_opacity,
         }
     }
 }

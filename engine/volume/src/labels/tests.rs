@@ -303,3 +303,47 @@ fn empty_voxels_take_their_tissue_neighbours_lowest_mask() {
         "a mis-sized mask"
     );
 }
+
+#[test]
+fn the_shown_opacity_is_the_one_every_shown_label_of_the_map_has() {
+    // Labels 1–3 on a small grid; label 4 is in no voxel, so its look does not count.
+    let dims = [6u32, 1, 1];
+    let map = LabelMap {
+        name: "row".into(),
+        path: "row.nii".into(),
+        dims,
+        to_patient: crate::orientation::PatientTransform::aligned([1.0; 3]),
+        values: vec![1, 1, 2, 2, 3, 3],
+    };
+    let shown_opacity =
+        |look: &dyn Fn(u16) -> Look| LabelLook::new(&map, look, 4, [2, 1, 1]).shown_opacity;
+    let look = |opacity: [f32; 5], visible: [bool; 5]| {
+        move |v: u16| Look {
+            colour: [1.0; 3],
+            opacity: opacity[usize::from(v)],
+            visible: visible[usize::from(v)],
+        }
+    };
+    let all = [true; 5];
+    assert_eq!(shown_opacity(&look([1.0; 5], all)), 1.0);
+    // A label the map does not hold may differ.
+    assert_eq!(shown_opacity(&look([1.0, 1.0, 1.0, 1.0, 0.2], all)), 1.0);
+    // Hidden labels do not count; the opacity is the mask's 8 bits.
+    let hide_2 = [true, true, false, true, true];
+    assert_eq!(
+        shown_opacity(&look([1.0, 0.6, 0.1, 0.6, 1.0], hide_2)),
+        153.0 / 255.0
+    );
+    // Two shown opacities, or none shown: 0, the mask read as it is.
+    assert_eq!(shown_opacity(&look([1.0, 1.0, 0.5, 1.0, 1.0], all)), 0.0);
+    assert_eq!(shown_opacity(&look([1.0; 5], [false; 5])), 0.0);
+    // A shown label of opacity 0 is empty, as a hidden one.
+    assert_eq!(
+        shown_opacity(&look([1.0, 0.7, 0.0, 0.7, 1.0], all)),
+        unorm_f(0.7)
+    );
+}
+
+fn unorm_f(x: f32) -> f32 {
+    f32::from((x * 255.0).round() as u8) / 255.0
+}
