@@ -1,7 +1,8 @@
 //! The book's command-line page, `docs/src/cli.md`, is `dvr --help` and every
-//! subcommand's `--help`, rendered by this test from the built binary. The test fails
-//! when the committed page differs from what the binary says; with `DVR_BLESS=1` it
-//! writes the page instead, so it is also the page's one generator:
+//! subcommand's `--help`, rendered by this test from the built binary
+//! (`common/cli_page.rs` lays the page out and compares it). The test fails when the
+//! committed page differs from what the binary says; with `DVR_BLESS=1` it writes the
+//! page instead, so it is also the page's one generator:
 //!
 //! ```sh
 //! DVR_BLESS=1 cargo test --test cli_doc
@@ -9,10 +10,10 @@
 //!
 //! Needs no Vulkan device: `--help` exits before anything opens one.
 
-use std::path::Path;
-use std::process::Command;
+mod common;
 
-const PAGE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/src/cli.md");
+use common::cli_page::{compare, render, subcommands, PAGE};
+use std::process::Command;
 
 /// `dvr [SUBCOMMAND] --help`, as a user's terminal would show it (no colour: not a tty).
 fn help(sub: Option<&str>) -> String {
@@ -28,69 +29,15 @@ fn help(sub: Option<&str>) -> String {
     String::from_utf8(out.stdout).expect("help is UTF-8")
 }
 
-/// The subcommands the top-level help lists under `Commands:`, `help` left out.
-fn subcommands(top: &str) -> Vec<String> {
-    top.lines()
-        .skip_while(|l| l.trim() != "Commands:")
-        .skip(1)
-        .take_while(|l| !l.trim().is_empty())
-        .filter(|l| l.starts_with("  ") && !l.starts_with("   "))
-        .filter_map(|l| l.split_whitespace().next().map(str::to_string))
-        .filter(|name| name != "help")
-        .collect()
-}
-
-fn render() -> String {
-    let top = help(None);
-    let subs = subcommands(&top);
-    assert!(
-        subs.len() >= 8,
-        "expected the eight commands in `dvr --help`, found {subs:?}"
-    );
-    let mut page = String::from(
-        "# The command line\n\n\
-         <!-- Generated from `dvr --help` by tests/cli_doc.rs: do not edit. \
-         `DVR_BLESS=1 cargo test --test cli_doc` rewrites it. -->\n\n\
-         Every command's `--help`, as the binary prints it. What the commands are for is in \
-         [Getting started](getting-started.md#commands); exit statuses and environment \
-         variables are there too.\n\n\
-         Commands:",
-    );
-    for s in &subs {
-        page.push_str(&format!(" [`{s}`](#dvr-{s})"));
-        page.push(if s == subs.last().unwrap() { '.' } else { ',' });
-    }
-    page.push_str("\n\n## dvr\n\n```text\n");
-    page.push_str(&top);
-    page.push_str("```\n");
-    for s in &subs {
-        page.push_str(&format!("\n## dvr {s}\n\n```text\n"));
-        page.push_str(&help(Some(s)));
-        page.push_str("```\n");
-    }
-    page
-}
-
 #[test]
 fn cli_page_matches_help() {
-    let page = render();
+    let page = render(help);
     if std::env::var("DVR_BLESS").is_ok_and(|v| v == "1") {
         std::fs::write(PAGE, &page).expect("write docs/src/cli.md");
         return;
     }
-    let committed = std::fs::read_to_string(Path::new(PAGE)).unwrap_or_default();
-    if committed != page {
-        let line = committed
-            .lines()
-            .zip(page.lines())
-            .position(|(a, b)| a != b)
-            .unwrap_or_else(|| committed.lines().count().min(page.lines().count()));
-        panic!(
-            "docs/src/cli.md differs from `dvr --help` (first at line {}): \
-             run `DVR_BLESS=1 cargo test --test cli_doc` and commit the page",
-            line + 1
-        );
-    }
+    let committed = std::fs::read_to_string(PAGE).unwrap_or_default();
+    compare(&committed, &page).unwrap_or_else(|e| panic!("{e}"));
 }
 
 #[test]
@@ -99,4 +46,18 @@ fn subcommands_are_read_from_the_help() {
                explore  Open a window:\n           continued\n  help     Print this\n\n\
                Options:\n  -h, --help\n";
     assert_eq!(subcommands(top), ["demo", "explore"]);
+}
+
+#[test]
+fn a_page_missing_a_command_names_it() {
+    let page = "## dvr\n\n## dvr demo\n\n## dvr toy\n";
+    let e = compare("## dvr\n\n## dvr demo\n\n## dvr old\n", page).expect_err("differs");
+    assert!(e.contains("no section for `dvr toy`"), "{e}");
+    assert!(e.contains("a section for `dvr old`"), "{e}");
+    let e = compare(
+        "## dvr\n\n## dvr demo\nold\n",
+        "## dvr\n\n## dvr demo\nnew\n",
+    )
+    .expect_err("differs");
+    assert!(e.contains("first at line 4"), "{e}");
 }

@@ -1,12 +1,24 @@
-//! A toy denoiser added the way a real one is: one registry row ([`Registry::with`]),
-//! which the renderer finds by name, builds and runs in the frame like any built-in
-//! method. The row's flags reach the frame (the features and guides it asks for are
-//! rendered for it), its pass is counted as its own, and a name no row has is refused.
-//! (The toy volume format is `engine/volume/src/formats.rs`' `a_new_format_is_one_row`.)
+//! Toys added the way OVERVIEW.md's "Extending dvr" adds a real one of their kind.
+//!
+//! A toy denoiser: one registry row ([`Registry::with`]), which the renderer finds by
+//! name, builds and runs in the frame like any built-in method. The row's flags reach the
+//! frame (the features and guides it asks for are rendered for it), its pass is counted
+//! as its own, and a name no row has is refused.
+//!
+//! A toy command: its module (arguments and `run`), a variant beside dvr's [`Command`]
+//! whose doc comment is its help, and its arm in the dispatch. It parses and runs, dvr's
+//! commands parse, help and dispatch as before, and the book's command-line page check
+//! names it as missing from the page. Needs no GPU.
+//!
+//! (The toy volume format is `engine/volume/src/formats.rs`' `a_new_format_is_one_row`,
+//! the toy scene field `engine/scene/tests/toy_field.rs`.)
 
 mod common;
 
+use clap::{Parser, Subcommand};
+use common::cli_page;
 use common::*;
+use dvr::cli::{self, Cli, Command};
 use dvr_engine::denoise::{Built, DenoiseFrame, Denoiser, DenoiserConfig, DenoiserInfo};
 use dvr_engine::denoise::{FeatureUse, Registry};
 use dvr_engine::error::{EngineError, Result};
@@ -105,4 +117,122 @@ fn a_toy_denoiser_is_one_row() {
     }
     drop(r);
     assert_validation_clean();
+}
+
+/// The toy command's module, as `src/<command>.rs` would be: its arguments and `run`.
+mod toy {
+    use std::sync::atomic::{AtomicU32, Ordering};
+
+    /// The `--n` the toy last ran with: how the test sees the dispatch reach it.
+    pub static RAN_WITH: AtomicU32 = AtomicU32::new(0);
+
+    #[derive(clap::Args)]
+    pub struct ToyArgs {
+        /// How far to count.
+        #[arg(long)]
+        pub n: u32,
+    }
+
+    pub fn run(args: &ToyArgs) -> anyhow::Result<()> {
+        RAN_WITH.store(args.n, Ordering::SeqCst);
+        Ok(())
+    }
+}
+
+/// dvr's commands and the toy's variant, as `src/cli.rs`' `Command` would be with it
+/// (dvr's boxed: clippy's `large_enum_variant` beside the toy's few bytes).
+#[derive(Subcommand)]
+enum WithToy {
+    #[command(flatten)]
+    Dvr(Box<Command>),
+    /// Count to N: a toy command, added the way a real one is.
+    Toy(toy::ToyArgs),
+}
+
+/// `cli::run` with the toy's arm.
+fn run_with_toy(command: WithToy) -> anyhow::Result<()> {
+    match command {
+        WithToy::Dvr(command) => cli::run(*command),
+        WithToy::Toy(args) => toy::run(&args),
+    }
+}
+
+/// `dvr [SUB] --help` of the command set `C`, rendered in this process as the binary
+/// prints it.
+fn help<C: Subcommand>(sub: Option<&str>) -> String {
+    let argv = ["dvr"].into_iter().chain(sub).chain(["--help"]);
+    match Cli::<C>::try_parse_from(argv) {
+        Err(e) if e.kind() == clap::error::ErrorKind::DisplayHelp => e.render().to_string(),
+        Err(e) => panic!("dvr {sub:?} --help: {e}"),
+        Ok(_) => panic!("dvr {sub:?} --help parsed as a command"),
+    }
+}
+
+#[test]
+fn a_toy_command_is_one_variant() {
+    // Parsed, global options included, and dispatched to the toy's `run`.
+    let cli = Cli::<WithToy>::try_parse_from(["dvr", "--quiet", "toy", "--n", "3"])
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(cli.quiet);
+    run_with_toy(cli.command).expect("the toy runs");
+    assert_eq!(toy::RAN_WITH.load(std::sync::atomic::Ordering::SeqCst), 3);
+
+    // Its doc comment is its help: its line in `dvr --help`, the head of `dvr toy --help`.
+    let about = "Count to N: a toy command, added the way a real one is";
+    let top = help::<WithToy>(None);
+    assert!(
+        top.lines()
+            .any(|l| l.trim_start().starts_with("toy ") && l.ends_with(about)),
+        "no `toy  {about}` line in dvr --help:\n{top}"
+    );
+    let own = help::<WithToy>(Some("toy"));
+    assert!(own.starts_with(about), "dvr toy --help:\n{own}");
+
+    // dvr's own commands parse with the same help beside it...
+    let dvr_commands = cli_page::subcommands(&help::<Command>(None));
+    assert!(dvr_commands.len() >= 8, "{dvr_commands:?}");
+    for sub in &dvr_commands {
+        assert_eq!(
+            help::<WithToy>(Some(sub)),
+            help::<Command>(Some(sub)),
+            "dvr {sub} --help"
+        );
+    }
+    // ...and reach the same command: each fails alike on an input it refuses before any
+    // device opens.
+    for argv in [
+        &["scenes", "--dump", "no/such-scene"][..],
+        &["info", "/no/such-volume.nrrd"],
+        &["capture", "--scene", "no/such-scene"],
+        &["reference", "--scene", "no/such-scene"],
+        &["eval", "--scene", "no/such-scene"],
+    ] {
+        let argv = || ["dvr"].iter().chain(argv);
+        let theirs = cli::run(<Cli>::try_parse_from(argv()).expect("parses").command);
+        let ours = run_with_toy(
+            Cli::<WithToy>::try_parse_from(argv())
+                .expect("parses")
+                .command,
+        );
+        let (theirs, ours) = (theirs.expect_err("refused"), ours.expect_err("refused"));
+        assert_eq!(
+            ours.to_string(),
+            theirs.to_string(),
+            "{argv:?}",
+            argv = argv()
+        );
+        assert!(ours.to_string().contains("no/such-"), "{ours}");
+    }
+
+    // The page check: dvr's commands rendered here give the committed page; with the toy
+    // it names the toy's missing section (the recipe regenerates the page).
+    let committed = std::fs::read_to_string(cli_page::PAGE).expect("docs/src/cli.md");
+    cli_page::compare(&committed, &cli_page::render(help::<Command>))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let missing = cli_page::compare(&committed, &cli_page::render(help::<WithToy>))
+        .expect_err("the page has no section for the toy");
+    assert!(
+        missing.contains("no section for `dvr toy`") && !missing.contains("a section for"),
+        "{missing}"
+    );
 }

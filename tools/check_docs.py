@@ -36,7 +36,7 @@ import urllib.parse
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 MARKDOWN = ["README.md", "OVERVIEW.md", "CHANGELOG.md", "python/README.md"]
 # Tracked files OVERVIEW.md must name: source, shaders, tests, tools, the Python package.
-SOURCE_DIRS = ["src", "engine/src", "engine/volume/src", "engine/scene/src", "engine/metrics/src", "engine/glsl-build", "engine/tests",
+SOURCE_DIRS = ["src", "engine/src", "engine/volume/src", "engine/scene/src", "engine/scene/tests", "engine/metrics/src", "engine/glsl-build", "engine/tests",
                "shaders", "tests", "tools", "python/src", "python/dvr", "python/tests",
                "python/examples", "fuzz/src"]
 SOURCE_EXCLUDE = ["tests/fixtures/"]

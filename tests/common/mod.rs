@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod cli_page;
 pub mod eval;
 
 use dvr_engine::gpu::{validation, GpuContext};
