@@ -66,6 +66,7 @@ from results_sets import (
     b_labels_line,
     b_labels_cost,
     b_interaction,
+    b_setup_times,
 )
 from results_experiments import b_experiments_prior, b_experiments_strata
 
@@ -546,6 +547,7 @@ BLOCKS = {
     "suite-scenes": (b_suite_scenes, ["suite/summary.csv"]),
     "ablations": (b_ablations, ["validation/summary.csv"]),
     "demo": (b_demo, ["demo/summary.csv"]),
+    "setup-times": (b_setup_times, ["setup-times/steps.csv", "setup-times/meta.json"]),
     "development": (b_development, ["development/summary.csv"]),
     "validation": (b_validation, ["validation/summary.csv"]),
     "validation-frames": (b_validation_frames, ["validation/metrics.csv"]),

@@ -1,6 +1,7 @@
 """The results blocks of the eval sets beside the validation set (the cut scenes, the
-channel and time scenes, the label-map scenes) and of what a cut or a label map costs
-(`tools/results.py` lists every block)."""
+channel and time scenes, the label-map scenes), of what a cut or a label map costs, and
+the time of each step of the two commands on a fresh machine (`tools/results.py` lists
+every block)."""
 
 from results_io import (
     read_csv,
@@ -255,4 +256,40 @@ def b_cut_cost():
         table(["scene", "cut", "run", "`path_trace`", "frame"], body),
         "",
         source("cut-cost", ["profile.csv"]),
+    ])
+
+
+def duration(s):
+    """Seconds as `42 s` or `4 min 05 s`."""
+    t = round(s)
+    return f"{t} s" if t < 60 else f"{t // 60} min {t % 60:02d} s"
+
+
+def b_setup_times():
+    """The time of each step of tools/run.sh and tools/test.sh on a fresh machine, wall
+    and CPU, with each command's total; a step that failed is named under the table."""
+    rows = read_csv("setup-times", "steps.csv")
+    meta = read_json("setup-times", "meta.json")
+    body, notes = [], []
+    for command in dict.fromkeys(r["command"] for r in rows):
+        sel = [r for r in rows if r["command"] == command]
+        for r in sel:
+            step = ", ".join(f"`{c}`" for c in r["step"].split(", "))
+            body.append([step, r["what"], duration(num(r["wall_s"])), duration(num(r["cpu_s"])),
+                         f"{num(r['load_start']):.2f} → {num(r['load_end']):.2f}"])
+            if r["note"]:
+                notes.append(f"{step} ({r['what']}): {r['note']}.")
+        body.append([f"**`{command}`, in all**", "",
+                     f"**{duration(sum(num(r['wall_s']) for r in sel))}**",
+                     f"**{duration(sum(num(r['cpu_s']) for r in sel))}**", ""])
+    return "\n".join([
+        table(["step", "what it does", "wall", "CPU (user + system)",
+               "load average (1 min), start → end"], body),
+        "",
+        *([" ".join(notes), ""] if notes else []),
+        f"On {meta['machine']}, with {meta['rustc']} from rustup and an empty cargo registry. "
+        "Wall time includes the downloads (Debian packages, crates, Python packages); CPU time "
+        f"is that of every process of the step, summed over the {meta['nproc']} cores.",
+        "",
+        source("setup-times", ["steps.csv", "meta.json"]),
     ])

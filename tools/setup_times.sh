@@ -219,7 +219,7 @@ rustc=$("${env_run[@]}" rustc --version)
 cargo_v=$("${env_run[@]}" cargo --version)
 cpu_model=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
 mem_gib=$(awk '/MemTotal/ { printf "%.0f", $2 / 1048576 }' /proc/meminfo)
-device=$(grep -m1 -o 'llvmpipe ([^)]*)' "$logs/demo.log" 2>/dev/null || true)
+device=$(grep -m1 -o "llvmpipe ([^)]*)" "$root/root/dvr/out/demo/index.html" 2>/dev/null || true)
 python3 - "$out/meta.json" <<EOF
 import json, sys
 meta = {

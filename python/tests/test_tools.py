@@ -1,5 +1,5 @@
 """The Python tools that make and check the book: `tools/results_io.py`'s formatting and
-tables, `tools/check_docs.py`'s anchors, its rule that OVERVIEW.md names each source
+tables, `tools/results_sets.py`'s table of setup times with each command's totals, `tools/check_docs.py`'s anchors, its rule that OVERVIEW.md names each source
 file by a path that resolves to it alone and its rule that a built book's images are in
 it, `tools/book_images.py`'s images linked into the book, `tools/ct_views.py`'s CT
 in Hounsfield units, `tools/strip.py`'s strip of one frame per scene and method, and
@@ -21,7 +21,7 @@ import pytest
 def tools(root):
     sys.path.insert(0, str(root / "tools"))
     try:
-        yield {name: importlib.import_module(name) for name in ("results_io", "check_docs", "book_images")}
+        yield {name: importlib.import_module(name) for name in ("results_io", "results_sets", "check_docs", "book_images")}
     finally:
         sys.path.remove(str(root / "tools"))
 
@@ -48,6 +48,31 @@ def test_a_missing_run_file_is_a_named_error(tools):
     r = tools["results_io"]
     with pytest.raises(r.Missing, match="no-such-set"):
         r.read_csv("no-such-set", "summary.csv")
+
+
+def test_the_setup_times_have_a_total_per_command_and_name_a_failed_step(tools, tmp_path, monkeypatch):
+    r, sets = tools["results_io"], tools["results_sets"]
+    assert [sets.duration(s) for s in (4.4, 59.6, 65, 3600)] == ["4 s", "1 min 00 s", "1 min 05 s", "60 min 00 s"]
+    folder = tmp_path / "setup-times"
+    folder.mkdir()
+    header = "command,step,what,wall_s,cpu_s,user_s,sys_s,load_start,load_end,waited_s,exit,note"
+    lines = [header,
+             'tools/run.sh,"bash tools/setup.sh","Debian packages",40.4,12,10,2,0.1,0.9,0,0,""',
+             'tools/run.sh,"cargo build --release","the build",100,190,180,10,0.5,1.9,0,0,""',
+             'tools/test.sh,"cargo fmt --check, cargo clippy","lints",30,50,45,5,0.7,1.2,0,1,"failed (exit 1)"']
+    (folder / "steps.csv").write_text("\n".join(lines) + "\n")
+    (folder / "meta.json").write_text(json.dumps({
+        "command": "tools/setup_times.sh", "commit": "abc1234", "date": "2026-12-07",
+        "machine": "2 cores", "nproc": 2, "rustc": "rustc 1.95.0"}))
+    monkeypatch.setattr(r, "RESULTS", str(tmp_path))
+    text = sets.b_setup_times()
+    rows = [line for line in text.splitlines() if line.startswith("| ")][2:]
+    assert rows[0] == "| `bash tools/setup.sh` | Debian packages | 40 s | 12 s | 0.10 → 0.90 |"
+    assert rows[2] == "| **`tools/run.sh`, in all** |  | **2 min 20 s** | **3 min 22 s** |  |"
+    assert rows[3].startswith("| `cargo fmt --check`, `cargo clippy` | lints | 30 s | 50 s |")
+    assert rows[4] == "| **`tools/test.sh`, in all** |  | **30 s** | **50 s** |  |"
+    assert "`cargo fmt --check`, `cargo clippy` (lints): failed (exit 1)." in text
+    assert "Source: `assets/results/setup-times/steps.csv`" in text
 
 
 def test_headings_become_the_anchors_mdbook_makes(tools):
