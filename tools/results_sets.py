@@ -265,6 +265,18 @@ def duration(s):
     return f"{t} s" if t < 60 else f"{t // 60} min {t % 60:02d} s"
 
 
+def busy_note(rows, busy=1.0):
+    """The steps that started at a 1-minute load average of `busy` or more: other work
+    shared the cores, so their wall times are longer than on an idle machine."""
+    names = [", ".join(f"`{c}`" for c in r["step"].split(", ")) + f" ({r['what'].split(':')[0]})"
+             for r in rows if num(r["load_start"]) >= busy]
+    if not names:
+        return ""
+    return (f" The load average is the machine's; {' and '.join(names)} started at "
+            f"{busy:g} or more: other work shared the cores, and the wall time is longer than on "
+            "an idle machine.")
+
+
 def b_setup_times():
     """The time of each step of tools/run.sh and tools/test.sh on a fresh machine, wall
     and CPU, with each command's total; a step that failed is named under the table."""
@@ -287,9 +299,9 @@ def b_setup_times():
                "load average (1 min), start → end"], body),
         "",
         *([" ".join(notes), ""] if notes else []),
-        f"On {meta['machine']}, with {meta['rustc']} from rustup and an empty cargo registry. "
-        "Wall time includes the downloads (Debian packages, crates, Python packages); CPU time "
-        f"is that of every process of the step, summed over the {meta['nproc']} cores.",
+        f"Rust: {meta['rustc']}, from rustup, with an empty cargo registry. Wall time includes "
+        "the downloads (Debian packages, crates, Python packages); CPU time is that of every "
+        f"process of the step, summed over the {meta['nproc']} cores.{busy_note(rows)}",
         "",
         source("setup-times", ["steps.csv", "meta.json"]),
     ])

@@ -171,7 +171,7 @@ plan=(
   "tools/run.sh|target/release/dvr demo --out out/demo|demo|the main job on lavapipe, references included"
   "tools/test.sh|bash tools/setup.sh --tests|setup-tests-apt|Debian packages: the validation layers, Xvfb, Chromium, python3-venv, iproute2"
   "tools/test.sh|bash tools/setup.sh --tests|setup-tests-mdbook|mdBook: cargo install mdbook, from crates.io"
-  "tools/test.sh|cargo fmt --check, cargo clippy|lint|clippy builds the workspace, dev profile"
+  "tools/test.sh|cargo fmt --check, cargo clippy|lint|formatting; clippy checks the workspace, dev profile"
   "tools/test.sh|DVR_VALIDATION=1 cargo test --workspace|test|the tests' build and run, validation layer on"
   "tools/test.sh|tools/results.py --check, mdbook build docs, cargo doc|docs|the book and the Rust API reference"
   "tools/test.sh|python3 -m venv, pip install, maturin build, pdoc, tools/check_docs.py|python|the test packages downloaded into target/py, the wheel built, the Python reference, the book's links"
@@ -219,7 +219,7 @@ rustc=$("${env_run[@]}" rustc --version)
 cargo_v=$("${env_run[@]}" cargo --version)
 cpu_model=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
 mem_gib=$(awk '/MemTotal/ { printf "%.0f", $2 / 1048576 }' /proc/meminfo)
-device=$(grep -m1 -o "llvmpipe ([^)]*)" "$root/root/dvr/out/demo/index.html" 2>/dev/null || true)
+device=$(grep -o "llvmpipe ([^)]*)" "$root/root/dvr/out/demo/index.html" 2>/dev/null | head -n 1 || true)
 python3 - "$out/meta.json" <<EOF
 import json, sys
 meta = {
