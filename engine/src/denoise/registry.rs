@@ -102,6 +102,11 @@ pub const DENOISERS: &[DenoiserInfo] = &[
         "ours without the à-trous filter (the per-pixel estimates)",
         &OursVariant { atrous: false, ..OURS },
     ),
+    ours(
+        "ours-no-feedback",
+        "ours without the first à-trous level fed back into the states that restarted",
+        &OursVariant { feedback: false, ..OURS },
+    ),
     wrls(
         "wrls-paper",
         "the paper's weighted RLS denoiser (TVCG §5–6) as published",
@@ -259,7 +264,7 @@ mod tests {
 
     #[test]
     fn each_ablation_of_ours_switches_one_part_off() {
-        let parts = |v: OursVariant| [v.gradients, v.lag, v.prior, v.atrous];
+        let parts = |v: OursVariant| [v.gradients, v.lag, v.prior, v.atrous, v.feedback];
         let ours = parts(OURS);
         assert!(ours.iter().all(|&on| on), "ours has every part");
         let mut ablations = 0;
@@ -271,7 +276,7 @@ mod tests {
                 ablations += expected;
             }
         }
-        assert_eq!(ablations, 4, "one ablation per part");
+        assert_eq!(ablations, 5, "one ablation per part");
     }
 
     #[test]

@@ -72,6 +72,11 @@ impl Bindings {
     pub fn write(&mut self, var: &'static str, h: impl Into<Res>) -> &mut Self {
         self.add(var, h.into(), Access::StorageWrite, false)
     }
+    /// A storage image the shader reads and writes in place (`image2D` without a
+    /// qualifier).
+    pub fn read_write(&mut self, var: &'static str, h: impl Into<Res>) -> &mut Self {
+        self.add(var, h.into(), Access::StorageReadWrite, false)
+    }
     /// An image the shader samples with the linear clamp sampler.
     pub fn sampled(&mut self, var: &'static str, h: ImageHandle) -> &mut Self {
         self.add(var, Res::Image(h), Access::Sampled, false)

@@ -51,4 +51,8 @@ const float RIDGE = 1e-3;
 // Smallest pivot of the prior's Cholesky solve: below it the window has no fit.
 const float PIVOT_MIN = 1e-20;
 
+// The feedback (ours_feedback.comp): a state whose effective history R / P is under this
+// many frames restarted this frame and takes the first à-trous level's estimate.
+const float FEEDBACK_HISTORY = 1.5;
+
 #endif

@@ -16,6 +16,7 @@ impl Ours {
         f: &mut DenoiseFrame<'_, 'f>,
         estimate: ImageHandle,
         prediction: Option<ImageHandle>,
+        state: super::feedback::State,
     ) -> Result<ImageHandle> {
         let (ctx, graph, frame, input) = f.parts();
         let size = input.size;
@@ -56,6 +57,9 @@ impl Ours {
                 dst,
                 prediction,
             );
+            if i == 0 && !last && self.variant.feedback {
+                self.add_feedback(frame, size, dst, state);
+            }
             src = dst;
         }
         Ok(out)

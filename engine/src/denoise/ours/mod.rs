@@ -25,15 +25,19 @@
 //!   the spatial prior, on the guide albedo composited along each ray
 //!   (`aux_features.comp`, shared with svgf) and the surface's gradient normal
 //!   (`surface_features.comp`); a frame without them (synthetic inputs) goes without;
-//! - `<name>.atrous0..1` ([`atrous`], `variance_atrous.comp`): the à-trous spatial filter.
+//! - `<name>.atrous0..1` ([`atrous`], `variance_atrous.comp`): the à-trous spatial filter;
+//! - `<name>.feedback` ([`feedback`], `ours_feedback.comp`): the first level's estimate
+//!   into the states that restarted this frame, read by next frame's update.
 //!
-//! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-prior`, `ours-no-atrous`)
+//! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-prior`, `ours-no-atrous`,
+//! `ours-no-feedback`)
 //! switch one stage off each ([`OursVariant`]); every other pass runs as in `ours`, and
 //! `tests/ablations.rs` checks by the stages' images that only that stage changed.
 
 mod atrous;
 #[cfg(test)]
 mod constants;
+mod feedback;
 mod gradient;
 mod gradient_pool;
 mod lag;
@@ -143,6 +147,9 @@ pub struct OursVariant {
     /// (without it the estimates go to the à-trous as they are; the model is still
     /// fitted, and the à-trous still carries neighbours by it).
     pub prior: bool,
+    /// The feedback of the first à-trous level into states that restarted this frame
+    /// (without it next frame's update starts from the restarted state's own mean).
+    pub feedback: bool,
 }
 
 impl OursVariant {
@@ -151,6 +158,7 @@ impl OursVariant {
         lag: true,
         atrous: true,
         prior: true,
+        feedback: true,
     };
 }
 
@@ -166,6 +174,7 @@ pub struct Ours {
     noise: Pipeline<OursNoisePush>,
     update: Pipeline<OursUpdatePush>,
     lag: Pipeline<OursLagPush>,
+    feedback: Pipeline<feedback::OursFeedbackPush>,
     atrous: Option<Pipeline<VarianceAtrousPush>>,
     /// The à-trous that carries neighbours by the prior's prediction (where there is one).
     atrous_carry: Option<Pipeline<VarianceAtrousPush>>,
@@ -207,6 +216,7 @@ impl Ours {
             noise: ctx.pipeline("ours_noise", &[])?,
             update: ctx.pipeline("ours_update", &[motion_source])?,
             lag: ctx.pipeline("ours_lag", &[("LAG_RADIUS", SpecValue::I32(LAG_RADIUS))])?,
+            feedback: ctx.pipeline("ours_feedback", &[])?,
             atrous: variant
                 .atrous
                 .then(|| variance_atrous::pipeline(ctx, false, true))
@@ -238,7 +248,8 @@ impl Denoiser for Ours {
             pooled: graph.history(ctx, &format!("{n}.lag"), desc)?,
         };
         let gradients = self.add_gradients(&mut f)?;
-        let estimate = self.add_update(&mut f, &gradients, &lag)?;
+        let state = self.add_update(&mut f, &gradients, &lag)?;
+        let estimate = state.model;
         self.add_lag(f.frame, input.size, &lag);
         let normal = input.features.map(|f| f.normal);
         let (estimate, prediction) = match (input.guides, normal) {
@@ -249,7 +260,7 @@ impl Denoiser for Ours {
             }
             _ => (estimate, None),
         };
-        self.add_atrous(&mut f, estimate, prediction)
+        self.add_atrous(&mut f, estimate, prediction, state)
     }
 }
 

@@ -4,6 +4,7 @@
 //! update with this frame's noisy colour. State: `model` (rgb estimate, a its variance)
 //! and `noise` (the measurement noise R).
 
+use super::feedback::State;
 use super::gradient::Gradients;
 use super::lag::LagImages;
 use super::Ours;
@@ -11,7 +12,6 @@ use crate::denoise::DenoiseFrame;
 use crate::error::Result;
 use crate::gpu::ImageDesc;
 use crate::gpu_block;
-use crate::graph::ImageHandle;
 use ash::vk;
 use glam::Vec4;
 
@@ -50,14 +50,14 @@ gpu_block! {
 }
 
 impl Ours {
-    /// Adds the update; returns the filter's state, the estimate (rgb, unclamped: its
-    /// readers clamp it at zero) with its variance (a).
+    /// Adds the update; returns the filter's state: the estimate (rgb, unclamped: its
+    /// readers clamp it at zero) with its variance (a), and the noise state.
     pub(super) fn add_update<'f>(
         &'f self,
         f: &mut DenoiseFrame<'_, 'f>,
         gradients: &Gradients,
         lag: &LagImages,
-    ) -> Result<ImageHandle> {
+    ) -> Result<State> {
         let (ctx, graph, frame, input) = f.parts();
         let size = input.size;
         let desc = input.rgba32f();
@@ -116,6 +116,9 @@ impl Ours {
                 .sampled("noise_prev", noise.prev)
                 .write("noise_cur", noise.cur);
         });
-        Ok(model.cur)
+        Ok(State {
+            model: model.cur,
+            noise: noise.cur,
+        })
     }
 }
