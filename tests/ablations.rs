@@ -1,9 +1,12 @@
-//! Each ablation of ours switches exactly one stage off, checked by behaviour: ours and
-//! the ablation run in one renderer on the same noisy frames, and the stages' images
+//! Each ablation of ours switches exactly one stage off, checked by behaviour: a base
+//! (ours, or the ablation that differs from it in that stage alone) and the ablation run
+//! in one renderer on the same noisy frames, and the stages' images
 //! (`Renderer::read_back_images`: the filter's state, its running residual, the pooled lag
-//! test, the prior's prediction and combination) are compared bit for bit,
-//! frame by frame. What the switched stage does not reach must be identical; what it does
-//! must differ, and only where it acted.
+//! test, the prior's prediction and combination, the first à-trous level) are compared bit
+//! for bit, frame by frame. What the switched stage does not reach must be identical; what
+//! it does must differ, and only where it acted. The feedback carries the first à-trous
+//! level, and with it the prior's combination, into the states that restarted: the state
+//! is then downstream of every spatial stage.
 
 mod common;
 
@@ -33,15 +36,17 @@ fn frame(done: dvr_engine::renderer::FrameResult) -> Frame {
     }
 }
 
-/// `ours` and `ablation` on `scene`, every stage of both read back in every frame.
-fn run(scene: &str, ablation: &str) -> Run {
+/// `base` and `ablation` on `scene`, every stage of both read back in every frame, and
+/// `extra` images (full names) besides.
+fn run(scene: &str, base: &str, ablation: &str, extra: &[&str]) -> Run {
     let setup = builtin_setup(scene, FRAMES, SIZE);
     let mut r = setup
-        .renderer(context(), &["ours", ablation])
+        .renderer(context(), &[base, ablation])
         .expect("renderer");
-    let names: Vec<String> = ["ours", ablation]
+    let names: Vec<String> = [base, ablation]
         .iter()
         .flat_map(|m| STAGES.iter().map(move |s| format!("{m}.{s}")))
+        .chain(extra.iter().map(|e| e.to_string()))
         .collect();
     r.read_back_images(&names.iter().map(String::as_str).collect::<Vec<_>>());
     let request = FrameRequest {
@@ -59,8 +64,8 @@ fn run(scene: &str, ablation: &str) -> Run {
     frames
 }
 
-/// Whether `stage` of ours and of `ablation` are bit-identical in frame `f`.
-fn same(run: &Run, f: usize, ablation: &str, stage: &str) -> bool {
+/// Whether `stage` of `base` and of `ablation` are bit-identical in frame `f`.
+fn same(run: &Run, f: usize, base: &str, ablation: &str, stage: &str) -> bool {
     let key = |m: &str| {
         if stage.is_empty() {
             m.to_string()
@@ -68,73 +73,124 @@ fn same(run: &Run, f: usize, ablation: &str, stage: &str) -> bool {
             format!("{m}.{stage}")
         }
     };
-    let (a, b) = (&run[f].images[&key("ours")], &run[f].images[&key(ablation)]);
-    a.iter()
-        .zip(b)
-        .all(|(p, q)| p.iter().zip(q).all(|(x, y)| x.to_bits() == y.to_bits()))
+    let (a, b) = (&run[f].images[&key(base)], &run[f].images[&key(ablation)]);
+    a.iter().zip(b).all(|(p, q)| bits(p) == bits(q))
 }
 
-fn assert_same(run: &Run, ablation: &str, stage: &str, frames: std::ops::Range<usize>) {
+fn bits(p: &[f32; 4]) -> [u32; 4] {
+    p.map(f32::to_bits)
+}
+
+fn assert_same(
+    run: &Run,
+    (base, ablation): (&str, &str),
+    stage: &str,
+    frames: std::ops::Range<usize>,
+) {
     for f in frames {
         assert!(
-            same(run, f, ablation, stage),
-            "{ablation}: stage {stage:?} differs from ours' in frame {f}"
+            same(run, f, base, ablation, stage),
+            "{ablation}: stage {stage:?} differs from {base}'s in frame {f}"
         );
     }
 }
 
-fn differs_somewhere(run: &Run, ablation: &str, stage: &str) -> bool {
-    (0..run.len()).any(|f| !same(run, f, ablation, stage))
+fn differs_somewhere(run: &Run, base: &str, ablation: &str, stage: &str) -> bool {
+    (0..run.len()).any(|f| !same(run, f, base, ablation, stage))
+}
+
+/// Whether `method`'s state at pixel `i` of frame `f` is its first à-trous level's
+/// estimate (the feedback wrote it), with `variance` kept.
+fn fed_back(run: &Run, f: usize, method: &str, i: usize, variance: f32) -> bool {
+    let state = run[f].images[&format!("{method}.model")][i];
+    let level = run[f].images[&format!("{method}.atrous")][i];
+    bits(&state)[..3] == bits(&level)[..3] && state[3].to_bits() == variance.to_bits()
 }
 
 #[test]
 fn without_the_atrous_only_the_output_changes() {
-    let ablation = "ours-no-atrous";
-    let run = run("phantom/orbit", ablation);
+    // Against ours without the feedback, which carries the à-trous into the state.
+    let pair @ (base, ablation) = ("ours-no-feedback", "ours-no-atrous");
+    let run = run("phantom/orbit", base, ablation, &[]);
     for stage in STAGES {
-        assert_same(&run, ablation, stage, 0..run.len());
+        assert_same(&run, pair, stage, 0..run.len());
     }
-    // Its output is the prior's combination as ours computed it.
+    // Its output is the prior's combination as the base computed it.
     for (f, frame) in run.iter().enumerate() {
         assert_eq!(
-            frame.images[ablation], frame.images["ours.prior"],
+            frame.images[ablation],
+            frame.images[&format!("{base}.prior")],
             "frame {f}"
         );
     }
-    assert!(differs_somewhere(&run, ablation, ""));
+    assert!(differs_somewhere(&run, base, ablation, ""));
+}
+
+#[test]
+fn without_the_feedback_only_the_restarted_states_change() {
+    let pair @ (base, ablation) = ("ours", "ours-no-feedback");
+    let run = run("phantom/orbit", base, ablation, &["ours.atrous"]);
+    // In the first frame everything before the feedback is the same; every state
+    // restarted, and ours' holds its first à-trous level's estimate with the variance the
+    // update gave it, where the ablation's holds the update's own.
+    for stage in ["residual", "lag", "prior_pred", "prior"] {
+        assert_same(&run, pair, stage, 0..1);
+    }
+    let theirs = &run[0].images[&format!("{ablation}.model")];
+    let mut fed = 0;
+    for (i, t) in theirs.iter().enumerate() {
+        if fed_back(&run, 0, base, i, t[3]) {
+            fed += 1;
+        } else {
+            let ours = run[0].images["ours.model"][i];
+            assert_eq!(
+                bits(&ours),
+                bits(t),
+                "pixel {i}: neither fed back nor the update's"
+            );
+        }
+    }
+    assert!(fed > 0, "ours fed nothing back in its first frame");
+    assert!(differs_somewhere(&run, base, ablation, ""));
 }
 
 #[test]
 fn without_the_prior_only_its_combination_changes() {
-    let ablation = "ours-no-prior";
-    let run = run("phantom/orbit", ablation);
-    // The combination never feeds back into the filter, and the model is still fitted
-    // (the à-trous carries by it).
-    for stage in ["model", "residual", "lag", "prior_pred"] {
-        assert_same(&run, ablation, stage, 0..run.len());
+    let pair @ (base, ablation) = ("ours", "ours-no-prior");
+    let run = run("phantom/orbit", base, ablation, &["ours-no-prior.atrous"]);
+    // The model is still fitted (the à-trous carries by it). The combination reaches the
+    // filter only through the feedback, which follows it in the frame: in the first
+    // frame every stage before it is ours'.
+    for stage in ["residual", "lag", "prior_pred"] {
+        assert_same(&run, pair, stage, 0..1);
     }
-    // The combination passes each estimate through (its radiance clamped at zero).
+    // The combination passes each estimate through (its radiance clamped at zero), the
+    // state as the update left it: where the feedback replaced it, the state holds the
+    // first à-trous level's estimate instead.
     for (f, frame) in run.iter().enumerate() {
         let combined = &frame.images[&format!("{ablation}.prior")];
         let state = &frame.images[&format!("{ablation}.model")];
-        for (c, x) in combined.iter().zip(state) {
+        for (i, (c, x)) in combined.iter().zip(state).enumerate() {
+            if fed_back(&run, f, ablation, i, c[3]) {
+                continue;
+            }
             let want = [x[0].max(0.0), x[1].max(0.0), x[2].max(0.0), x[3]];
-            assert_eq!(*c, want, "frame {f}");
+            assert_eq!(*c, want, "frame {f}, pixel {i}");
         }
     }
-    assert!(differs_somewhere(&run, ablation, "prior"));
+    assert!(differs_somewhere(&run, base, ablation, "prior"));
 }
 
 #[test]
 fn without_the_lag_shift_the_state_differs_only_where_ours_shifted() {
     let ablation = "ours-no-lag";
-    let run = run("mri/point-light", ablation);
+    let run = run("mri/point-light", "ours", ablation, &[]);
     let first = (0..run.len())
-        .find(|&f| !same(&run, f, ablation, "model"))
+        .find(|&f| !same(&run, f, "ours", ablation, "model"))
         .expect("ours shifted its state somewhere (the light moves every frame)");
     // Up to that frame every stage is ours'; the lag test itself still runs.
     for stage in STAGES {
-        assert_same(&run, ablation, stage, 0..first);
+        assert_same(&run, ("ours", ablation), stage, 0..first);
     }
     // In it, the states differ only at pixels whose pooled residual in the frame before
     // was significant (the camera is still, so each pixel reads its own).
@@ -165,13 +221,13 @@ fn without_the_lag_shift_the_state_differs_only_where_ours_shifted() {
 fn without_gradients_nothing_changes_until_a_light_or_the_tf_does() {
     let ablation = "ours-no-gradient";
     // Only the camera moves: no gradients are traced, and the two are one filter.
-    let orbit = run("phantom/orbit", ablation);
+    let orbit = run("phantom/orbit", "ours", ablation, &[]);
     for stage in STAGES.iter().copied().chain([""]) {
-        assert_same(&orbit, ablation, stage, 0..orbit.len());
+        assert_same(&orbit, ("ours", ablation), stage, 0..orbit.len());
     }
     // The light moves every frame: the first frame is the same, the measured change
     // then reaches the state.
-    let light = run("mri/point-light", ablation);
+    let light = run("mri/point-light", "ours", ablation, &[]);
     assert!(!orbit.iter().any(|f| f.gradients));
     // The light moves every frame: until ours first traces gradients (it needs last
     // frame's radiance) the two are the same; from then on the measured change reaches
@@ -180,7 +236,7 @@ fn without_gradients_nothing_changes_until_a_light_or_the_tf_does() {
         .find(|&f| light[f].gradients)
         .expect("ours traced gradients");
     for stage in STAGES {
-        assert_same(&light, ablation, stage, 0..first);
+        assert_same(&light, ("ours", ablation), stage, 0..first);
     }
-    assert!(!same(&light, first, ablation, "model"));
+    assert!(!same(&light, first, "ours", ablation, "model"));
 }
