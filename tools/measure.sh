@@ -105,7 +105,7 @@ for set in "$@"; do
       ;;
     development)
       args=(--scene development --frames 48 --size 64x64 --ref-spp 1024 --aux
-        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,wrls-paper,rae)
+        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,wrls-paper,rae)
       timed "$dvr" eval "${args[@]}" --out "$out"
       oidn "$out"
       keep development "$out"
@@ -115,7 +115,7 @@ for set in "$@"; do
       # At 2 spp with every method, then ours at 1 spp, to set against oidn-aux at 2 spp:
       # into its own folder, on the same references (share_references).
       args=(--scene validation --size 128x128 --ref-spp 256 --aux
-        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,rae)
+        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,rae)
       timed "$dvr" eval "${args[@]}" --out "$out"
       total=$secs
       oidn "$out"
@@ -130,7 +130,7 @@ for set in "$@"; do
       ;;
     suite)
       args=(--scene suite --frames 48 --size 64x64 --ref-spp 1024 --aux
-        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,wrls-paper,rls-paper,wrls,rls,wrls-nf,rls-nf,rae)
+        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,wrls-paper,rls-paper,wrls,rls,wrls-nf,rls-nf,rae)
       timed "$dvr" eval "${args[@]}" --out "$out"
       oidn "$out"
       keep suite "$out"

@@ -147,7 +147,8 @@ def b_ablations():
     m = means(rows)
     base = m["ours"]
     body = []
-    for x in ["ours-no-gradient", "ours-no-lag", "ours-no-prior", "ours-no-atrous"]:
+    for x in ["ours-no-gradient", "ours-no-lag", "ours-no-prior", "ours-no-atrous",
+              "ours-no-feedback"]:
         if x in m:
             body.append([f"`{x}`", fmt(m[x]["psnr"], 2), f"{base['psnr'] - m[x]['psnr']:+.2f}",
                          fmt(m[x]["flip"], 4), f"{base['flip'] - m[x]['flip']:+.4f}"])
