@@ -7,6 +7,7 @@
 #   tools/measure.sh SET [SET ...]     SET: demo static development validation paper
 #                                           suite cost rae cuts cut-cost labels
 #                                           labels-cost channels-cost statmap interaction
+#                                           mechanisms
 #
 # Needs a release build (cargo build --release). The eval sets also add Intel OIDN with
 # tools/oidn_eval.py, which needs a Python with the dvr package, pyoidn, numpy, OpenEXR
@@ -294,6 +295,31 @@ EOF2
       oidn "$out"
       KEEP_METRICS=1 keep interaction "$out"
       meta interaction "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
+      ;;
+    mechanisms)
+      # Each of ours' mechanisms switched off alone, on the development set as ours is
+      # judged (128×128, 48 frames, 256-spp references): the stage ablations beside every
+      # method ours is judged against, then ours with each parameter-borne mechanism off
+      # (DVR_OURS), on the same references and the same noisy frames.
+      args=(--scene development --frames 48 --size 128x128 --ref-spp 256 --aux
+        --denoiser none,taa,svgf,rae,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback)
+      timed "$dvr" eval "${args[@]}" --out "$out"
+      total=$secs
+      oidn "$out"
+      KEEP_METRICS=1 keep mechanisms "$out"
+      overrides=("no-clip|clip_z=1000" "no-jump|jump_z=1000" "no-motion-q|motion_q=0"
+        "no-change-q|change_q=0" "no-keep|keep=0")
+      printf 'run,override\n' > "assets/results/mechanisms/overrides.csv"
+      for o in "${overrides[@]}"; do
+        IFS='|' read -r name spec <<< "$o"
+        share_references "$out" "$out-$name"
+        DVR_OURS=$spec timed "$dvr" eval --scene development --frames 48 --size 128x128 \
+          --ref-spp 256 --denoiser ours --out "$out-$name"
+        total=$(echo "$total + $secs" | bc)
+        cp "$out-$name/metrics.csv" "assets/results/mechanisms/$name.csv"
+        printf '%s,%s\n' "$name" "$spec" >> "assets/results/mechanisms/overrides.csv"
+      done
+      meta mechanisms "$out" "$total" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out; for each run,override of overrides.csv: DVR_OURS=override dvr eval --scene development --frames 48 --size 128x128 --ref-spp 256 --denoiser ours --out $out-run"
       ;;
     statmap)
       # The development two-channel head (the T1 and a statistical map over it) under a
