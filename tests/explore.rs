@@ -364,8 +364,9 @@ fn a_moving_view_renders_fewer_pixels_and_the_full_size_returns_when_still() {
     let Some(x) = xvfb() else { return };
     let dir = tempfile::tempdir().expect("temp dir");
     // A drag every frame from 6 to 10, F12 in the middle of it (frame 8) and after the
-    // view has settled (frame 15). A 1 ms target is below any frame's time on any
-    // device, so the motion renders at the largest divisor, 8: 16×16 for a 128² view.
+    // view has settled (frame 15). A 0.001 ms target puts any still frame slower than
+    // 0.064 ms past 8² times it, so the motion renders at the largest divisor, 8: 16×16
+    // for a 128² view (a 1 ms target chose 6 for a still frame under 36 ms).
     let out = dvr(
         Some(&x.display),
         &[
@@ -379,7 +380,7 @@ fn a_moving_view_renders_fewer_pixels_and_the_full_size_returns_when_still() {
             "--frames",
             "16",
             "--moving-ms",
-            "1",
+            "0.001",
             "--script",
             "orbit:6,0@6;orbit:6,0@7;orbit:6,0@8;orbit:6,0@9;orbit:6,0@10;key:f12@8;key:f12@15",
         ],
