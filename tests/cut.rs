@@ -226,3 +226,62 @@ fn cuts_that_remove_nothing_render_the_same_frames() {
     assert_ne!(frames(&plane(0.0, 1.0)), none);
     assert_validation_clean();
 }
+
+/// A crop shrunk under a still camera, motion from the features: the pixels whose ray hit
+/// the cube and now miss it (their features' position flips from hit to miss) restart
+/// the temporal methods' histories, and no other pixel does (svgf's history length, read
+/// back; the reprojection is every temporal method's).
+#[test]
+fn a_crop_shrunk_under_a_still_camera_restarts_the_histories_it_uncovers() {
+    let volume = constant_volume(16, 0.7);
+    let mut s = settings(24, 1);
+    s.config.motion_source = dvr_engine::denoise::MotionSource::Features;
+    let mut r = renderer(context(), s, &volume, &["svgf"]);
+    r.read_back_images(&["features.position", "svgf.moments"]);
+    let camera = dvr_engine::renderer::CameraMatrices::look_at(
+        Vec3::new(1.2, 1.0, 1.4),
+        Vec3::ZERO,
+        Vec3::Z,
+        40f32.to_radians(),
+        1.0,
+    );
+    let half = Cut {
+        planes: Vec::new(),
+        crop: Some(CropBox {
+            min: DVec3::new(-0.5, -0.5, -0.5),
+            max: DVec3::new(0.0, 0.5, 0.5),
+            units: CropUnits::Box,
+            enabled: true,
+        }),
+    };
+    let frames = (0..5).map(|f| FrameInputs {
+        cut: if f == 4 { half.clone() } else { Cut::default() },
+        ..inputs(
+            camera,
+            vec![point_light(Vec3::new(1.0, 1.5, 2.0), 8.0), environment(0.2)],
+            constant_lut(0.6, 0.8),
+        )
+    });
+    let out = render_frames(&mut r, frames, &readback());
+    let image = |f: usize, name: &str| {
+        out[f]
+            .images
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, px)| px.clone())
+            .expect(name)
+    };
+    let (before, after) = (image(3, "features.position"), image(4, "features.position"));
+    let (n3, n4) = (image(3, "svgf.moments"), image(4, "svgf.moments"));
+    let mut flipped = 0;
+    for i in 0..before.len() {
+        let flip = (before[i][3] > 0.0) != (after[i][3] > 0.0);
+        flipped += usize::from(flip);
+        if flip {
+            assert_eq!(n4[i][2], 1.0, "pixel {i}: its hit flipped, its history went on");
+        } else {
+            assert_eq!(n4[i][2], n3[i][2] + 1.0, "pixel {i}: restarted, its hit did not flip");
+        }
+    }
+    assert!(flipped > 20, "the crop uncovered {flipped} pixels");
+}

@@ -43,14 +43,19 @@ vec2 to_pixel(mat4 view_proj, vec3 world, ivec2 size) {
 // a depth error only changes it by its parallax), and it also tests pixels whose ray
 // missed this frame: a background pixel where the object was last frame compares the
 // object's motion with the background's, so no colour is dragged into the background.
-// Where last frame's ray missed but this one hit, only a still pixel keeps its history
-// (a semi-transparent pixel whose first collision comes and goes), anything moving is a
-// disocclusion.
+// Where last frame's ray missed but this one hit, only a still pixel of the first real
+// collision keeps its history (a semi-transparent pixel whose first collision comes and
+// goes), anything moving is a disocclusion.
 // `camera_still`: the two frames' cameras are the same, so every point's own motion is
 // zero (the round trip below, exactly) and the test needs no projections.
+// The features' position is deterministic: under a still camera a pixel whose ray hit
+// last frame and misses now, or the other way round, sees a medium that moved in place
+// (a cut toggled, a crop shrunk, a series' next time point, a TF that cleared a layer),
+// and its history is another surface's.
 bool same_surface(ivec2 tap, vec2 delta, bool hit_now, float tolerance, ivec2 size,
                   bool camera_still) {
     vec4 prev = texelFetch(position_prev, tap, 0);
+    if (camera_still && MOTION_SOURCE == 1 && (prev.w > 0.0) != hit_now) return false;
     if (prev.w > 0.0) {
         if (camera_still) return length(delta) <= tolerance;
         // Compare displacements, not places: that point's own motion must carry it from
