@@ -278,9 +278,16 @@ fn a_crop_shrunk_under_a_still_camera_restarts_the_histories_it_uncovers() {
         let flip = (before[i][3] > 0.0) != (after[i][3] > 0.0);
         flipped += usize::from(flip);
         if flip {
-            assert_eq!(n4[i][2], 1.0, "pixel {i}: its hit flipped, its history went on");
+            assert_eq!(
+                n4[i][2], 1.0,
+                "pixel {i}: its hit flipped, its history went on"
+            );
         } else {
-            assert_eq!(n4[i][2], n3[i][2] + 1.0, "pixel {i}: restarted, its hit did not flip");
+            assert_eq!(
+                n4[i][2],
+                n3[i][2] + 1.0,
+                "pixel {i}: restarted, its hit did not flip"
+            );
         }
     }
     assert!(flipped > 20, "the crop uncovered {flipped} pixels");
