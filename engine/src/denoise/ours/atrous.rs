@@ -1,5 +1,5 @@
-//! `<name>.atrous0..1` (variance_atrous.comp): the à-trous spatial filter over the
-//! filters' estimates, edge-stopped by their variances: steps 1 and 2 (`ATROUS_LEVELS`),
+//! `<name>.atrous0..2` (variance_atrous.comp): the à-trous spatial filter over the
+//! filters' estimates, edge-stopped by their variances: steps 1, 2 and 4 (`ATROUS_LEVELS`),
 //! ping-ponging between scratch images (never into the input, which is the filter's state
 //! where the prior did not run), the last level into the denoiser's output. Where the spatial prior ran, each neighbour is carried to the pixel
 //! by the prior's prediction first (`CARRY` in variance_atrous.comp).
