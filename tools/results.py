@@ -66,6 +66,8 @@ from results_sets import (
     b_labels_line,
     b_labels_cost,
     b_interaction,
+    b_mechanisms,
+    b_development_cost,
     b_setup_times,
 )
 from results_experiments import b_experiments_prior, b_experiments_strata
@@ -578,6 +580,8 @@ BLOCKS = {
                                     "labels/meta.json"]),
     "labels-cost": (b_labels_cost, ["labels-cost/profile.csv"]),
     "interaction": (b_interaction, ["interaction/metrics.csv", "interaction/meta.json"]),
+    "mechanisms": (b_mechanisms, ["mechanisms/*.csv", "mechanisms/meta.json"]),
+    "development-cost": (b_development_cost, ["mechanisms/metrics.csv", "mechanisms/meta.json"]),
     "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv",
                                                 "validation/metrics.csv"]),
     "experiments-strata": (b_experiments_strata, ["experiments-strata/*.csv",

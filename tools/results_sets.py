@@ -1,5 +1,6 @@
 """The results blocks of the eval sets beside the validation set (the cut scenes, the
-channel and time scenes, the label-map scenes), of what a cut or a label map costs, and
+channel and time scenes, the label-map scenes, ours' mechanisms switched off one at a
+time), of what a cut or a label map costs, and
 the time of each step of the two commands on a fresh machine (`tools/results.py` lists
 every block)."""
 
@@ -8,6 +9,7 @@ from results_io import (
     read_json,
     num,
     fmt,
+    mean,
     scenes_of,
     best,
     table,
@@ -304,4 +306,97 @@ def b_setup_times():
         f"process of the step, summed over the {meta['nproc']} cores.{busy_note(rows)}",
         "",
         source("setup-times", ["steps.csv", "meta.json"]),
+    ])
+
+
+# Ours' mechanisms, each switched off alone: the run (a method of the mechanisms set's
+# eval, or an override run of `overrides.csv`) and what it switches off.
+MECHANISMS = [
+    ("ours-no-gradient", "the temporal gradients (g = 1: no measured change)"),
+    ("no-change-q", "the process noise of a measured change"),
+    ("no-motion-q", "the process noise of a pixel that moved on screen"),
+    ("ours-no-lag", "the pooled lag test's shift of the state"),
+    ("no-jump", "the jump rule"),
+    ("no-clip", "the outliers' redescending weight"),
+    ("ours-no-prior", "the spatial prior's combination"),
+    ("ours-no-atrous", "the à-trous (and with it the feedback)"),
+    ("no-keep", "keeping converged estimates out of the prior and the à-trous"),
+    ("ours-no-feedback", "the feedback into restarted states"),
+]
+
+
+def b_mechanisms():
+    """Each of ours' mechanisms switched off alone on the development set: the mean
+    PSNR, the mean gap to the best single-frame method at frames 0 and 1, the frames from
+    2 on more than 1 dB below it, and whether the mechanism earns its place (switching it
+    off costs at least 0.05 dB on the mean, adds a frame below, or raises the mean FLIP by
+    0.001 or more)."""
+    metrics = read_csv("mechanisms", "metrics.csv")
+    overrides = {r["run"]: r["override"] for r in read_csv("mechanisms", "overrides.csv")}
+    rivals = [r for r in metrics if r["method"] in SINGLE_FRAME]
+
+    def score(rows):
+        rows = [dict(r, method="ours") for r in rows]
+        frames = frames_by_scene(rows + rivals)
+        gap = {f: mean(v[f]["ours"] - max(v[f][x] for x in SINGLE_FRAME if x in v[f])
+                       for v in frames.values() if f in v) for f in (0, 1)}
+        below = sum(below_best(v, SINGLE_FRAME, after=1)[0] for v in frames.values())
+        return mean(num(r["psnr"]) for r in rows), mean(num(r["flip"]) for r in rows), gap, below
+
+    def cells(psnr, flip, gap, below):
+        return [fmt(psnr, 2), fmt(flip, 4), f"{gap[0]:+.2f}", f"{gap[1]:+.2f}", str(below)]
+
+    base = score([r for r in metrics if r["method"] == "ours"])
+    body = [["nothing (`ours`)", "", *cells(*base), "", ""]]
+    for run, what in MECHANISMS:
+        if run in overrides:
+            rows, how = read_csv("mechanisms", f"{run}.csv"), f"`DVR_OURS={overrides[run]}`"
+        else:
+            rows, how = [r for r in metrics if r["method"] == run], f"`{run}`"
+        if not rows:
+            continue
+        psnr, flip, gap, below = score(rows)
+        cost = base[0] - psnr
+        earns = "yes" if cost >= 0.05 or below > base[3] or flip >= base[1] + 0.001 else "**no**"
+        body.append([what, how, *cells(psnr, flip, gap, below), f"{cost:+.2f}", earns])
+    n = len(frames_by_scene(metrics))
+    return "\n".join([
+        f"The development set ({n} scenes, 128×128, 48 frames, 256-spp references), `ours` "
+        "with one mechanism switched off at a time, on the same noisy frames. The gaps are "
+        "to the best of `oidn`, `oidn-aux` and `rae` in each frame, means over the scenes.",
+        "",
+        table(["switched off", "by", "PSNR dB", "FLIP", "gap at frame 0", "gap at frame 1",
+               "frames from 2 on > 1 dB below", "ours − it, dB", "earns its place"], body),
+        "",
+        source("mechanisms", ["metrics.csv", "overrides.csv", "<run>.csv"]),
+    ])
+
+
+def b_development_cost():
+    """Ours' and svgf's cost over the whole development set as `dvr eval` timed it: each
+    frame's GPU ms less the path trace's (`none`), so each method's own passes and the
+    features it needs, summed over every frame of every scene."""
+    rows = read_csv("mechanisms", "metrics.csv")
+    ms = {}
+    for r in rows:
+        ms.setdefault(r["method"], {})[(r["scene"], r["frame"])] = num(r["gpu_ms"])
+    base = ms["none"]
+
+    def total(method, scene=None):
+        return sum(v - base[k] for k, v in ms[method].items()
+                   if k in base and (scene is None or k[0] == scene))
+
+    body = []
+    for sc in scenes_of(rows):
+        o, s, n = total("ours", sc), total("svgf", sc), sum(k[0] == sc for k in base)
+        body.append([sc, fmt(o / n, 1), fmt(s / n, 1), f"{o / s:.2f}×"])
+    o, s = total("ours"), total("svgf")
+    body.append(["**the set**", fmt(o / len(base), 1), fmt(s / len(base), 1), f"**{o / s:.2f}×**"])
+    return "\n".join([
+        "Mean GPU ms per frame of each method's passes and the features it needs (the "
+        "frame's GPU ms in `dvr eval` less the path trace's), 128×128:",
+        "",
+        table(["scene", "`ours`", "`svgf`", "ours / svgf"], body),
+        "",
+        source("mechanisms", ["metrics.csv"]),
     ])
