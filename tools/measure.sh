@@ -307,7 +307,7 @@ EOF2
       total=$secs
       oidn "$out"
       KEEP_METRICS=1 keep mechanisms "$out"
-      overrides=("no-clip|clip_z=1000" "no-jump|jump_z=1000" "no-motion-q|motion_q=0"
+      overrides=("no-jump|jump_z=1000" "no-motion-q|motion_q=0"
         "no-change-q|change_q=0" "no-keep|keep=0")
       printf 'run,override\n' > "assets/results/mechanisms/overrides.csv"
       for o in "${overrides[@]}"; do

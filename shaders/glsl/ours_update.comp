@@ -28,14 +28,12 @@
 // Predict: x⁻ = g ∘ x, P⁻ = ḡ² P + Q. Update: K = P⁻ / (P⁻ + R), x = x⁻ + K (y − x⁻),
 // P = (1 − K) P⁻. With nothing changing Q = 0 and K = 1/n: the running mean, which only
 // improves.
-// Outliers from the normalised innovation ν² = |y − x⁻|² / 3 / (P⁻ + R): beyond
-// z = clip_z standard deviations R is raised to R ν² / z², so the step K (y − x⁻)
-// falls as 1 / |y − x⁻| (a redescending weight; the residual handed to the lag test is
-// clipped to z deviations, Huber's ψ). Jumps from the pooled lag test: a residual the
-// neighbourhood shares beyond jump_z standard errors of its mean is a moved level, and
-// its square is added to P⁻ so the filter follows it. A firefly, however often it repeats
-// in one pixel, is weighed down (heavy-tailed noise puts bright paths in a pixel in
-// successive frames); a change of the scene moves a region.
+// Jumps from the pooled lag test: a residual the neighbourhood shares beyond jump_z
+// standard errors of its mean is a moved level, and its square is added to P⁻ so the
+// filter follows it: a change of the scene moves a region, where a firefly is one
+// pixel's (the lag test pools 5×5 pixels, and R is measured over 5×5). A weight that
+// clipped a pixel's own outlying innovations changed nothing measurable on the
+// development set and no test (the book's results, "every mechanism").
 //
 // State, two images: model (rgba32f: rgb the estimate, a its variance P) and noise (rg32f:
 // the measurement noise R, and D, the part of P that process noise put there: the update
@@ -75,11 +73,11 @@ layout(push_constant) uniform OursUpdatePush {
     float change_q;       // share of a measured change the pixel's own may differ by
     float motion_q;       // process noise of a moving pixel, in units of R
     float lag_z;          // pooled residual, in standard errors, that is a shift
-    float clip_z;         // innovation, in standard deviations, beyond which it is clipped
     float jump_z;         // pooled residual, in standard errors, beyond which it is a jump
     uint shift;           // a significant pooled residual shifts the state (0: ours-no-lag)
     uint pad0;
     uint pad1;
+    uint pad2;
 } pc;
 
 // The lag test's running residual (LAG_BLEND of this frame's, the rest last frame's,
@@ -225,7 +223,7 @@ void main() {
         }
         float P_prior = P + Q;
 
-        // Update, with the innovation's outliers clipped and jumps followed.
+        // Update, with jumps followed.
         vec3 e = y - x;
         float e2 = dot(e, e) / 3.0;
         // At a jump the level moved by about the innovation: its square joins the
@@ -242,20 +240,13 @@ void main() {
         float R_now = fresh_noise(sums);
         R = max(shifted && R_now < R ? R_now : R + P_prior / (P_prior + R) * (R_now - R),
                 VARIANCE_FLOOR);
-        float nu2 = e2 / max(P_prior + R, VARIANCE_FLOOR);
-        float z2 = pc.clip_z * pc.clip_z;
-        bool far = nu2 > z2;
-        // A spike's step falls as 1 / |e| beyond clip_z deviations (redescending).
-        float R_eff = far ? R * nu2 / z2 : R;
         P = P_prior;
-        float K = P / (P + R_eff);
+        float K = P / (P + R);
         x += K * e;
         D = (1.0 - K) * (1.0 - K) * (D + P_prior - P_carried);
         P = (1.0 - K) * P;
-        // What the update left unexplained, with the clipped innovation (a spike must not
-        // look like a shared lag), for the pooled lag test.
-        float clip = far ? sqrt(z2 / nu2) : 1.0;
-        res = vec4((1.0 - K) * clip * e, (1.0 - K) * (1.0 - K) * (P_prior + R_eff));
+        // What the update left unexplained, for the pooled lag test.
+        res = vec4((1.0 - K) * e, (1.0 - K) * (1.0 - K) * (P_prior + R));
         vec4 prev = history_fetch(residual_prev, r);
         if (pc.lag_valid != 0u && !jump && prev.a > 0.0 && all_finite(prev.rgb)) {
             vec3 carried = prev.rgb * sc.ratio - shift;

@@ -76,10 +76,6 @@ pub struct OursParams {
     /// Pooled residual, in standard errors of its mean, below which it is noise; beyond,
     /// the positive-part shrinkage of it is taken as a shift of the state.
     pub lag_z: f32,
-    /// Innovation, in its standard deviations, beyond which it is an outlier: its
-    /// measurement noise is raised so its step falls as 1 / |innovation| (a firefly is
-    /// weighed down however often it repeats in one pixel).
-    pub clip_z: f32,
     /// Pooled residual, in standard errors of its mean, beyond which the level jumped:
     /// the innovation's square joins the prediction's variance, so the update follows a
     /// change nothing measured.
@@ -101,7 +97,6 @@ impl Default for OursParams {
             change_q: 3.5,
             motion_q: 0.01,
             lag_z: 1.5,
-            clip_z: 6.0,
             jump_z: 6.0,
             kappa: 6.0,
             keep: 0.02,
@@ -117,7 +112,6 @@ const OVERRIDABLE: &[Overridable<OursParams>] = &[
     ("change_q", 0.0, 1e3, |p, v| p.change_q = v),
     ("motion_q", 0.0, 1e3, |p, v| p.motion_q = v),
     ("lag_z", 0.0, 1e3, |p, v| p.lag_z = v),
-    ("clip_z", 0.5, 1e3, |p, v| p.clip_z = v),
     ("jump_z", 0.5, 1e3, |p, v| p.jump_z = v),
     ("kappa", 0.5, 1e3, |p, v| p.kappa = v),
     ("keep", 0.0, 1.0, |p, v| p.keep = v),
@@ -284,7 +278,7 @@ mod tests {
             &[
                 ("shrink=nan", "shrink must be in"),
                 ("keep=1e30", "keep must be in"),
-                ("clip_z=0.1", "clip_z must be in"),
+                ("jump_z=0.1", "jump_z must be in"),
                 ("lambda=0.9", "parameters: stratum"),
                 ("keep", "name=value"),
                 ("keep=x", "a number"),

@@ -40,12 +40,12 @@ gpu_block! {
         pub change_q: f32,
         pub motion_q: f32,
         pub lag_z: f32,
-        pub clip_z: f32,
         pub jump_z: f32,
         /// 1: a significant pooled residual shifts the state (0 in `ours-no-lag`).
         pub shift: u32,
         pub pad0: u32,
         pub pad1: u32,
+        pub pad2: u32,
     }
 }
 
@@ -85,11 +85,11 @@ impl Ours {
             change_q: p.change_q,
             motion_q: p.motion_q,
             lag_z: p.lag_z,
-            clip_z: p.clip_z,
             jump_z: p.jump_z,
             shift: self.variant.lag as u32,
             pad0: 0,
             pad1: 0,
+            pad2: 0,
         };
         let (noisy, moments, g, lag) = (input.noisy, input.moments, *gradients, *lag);
         let rows_push = OursNoisePush {
