@@ -63,6 +63,7 @@ keep() {
   mkdir -p "$dest"
   cp "$2/summary.csv" "$dest/summary.csv"
   [ -z "${KEEP_METRICS:-}" ] || cp "$2/metrics.csv" "$dest/metrics.csv"
+  [ ! -f "$2/oidn_ms.csv" ] || cp "$2/oidn_ms.csv" "$dest/oidn_ms.csv"
 }
 
 oidn() { "$py" tools/oidn_eval.py "$1"; }
@@ -113,21 +114,23 @@ for set in "$@"; do
       meta development "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
     validation)
-      # At 2 spp with every method, then ours at 1 spp, to set against oidn-aux at 2 spp:
-      # into its own folder, on the same references (share_references).
+      # At 2 spp with every method; then the methods of the speed-against-accuracy chart
+      # at 1 and 4 spp, each into its own folder on the same references (share_references).
       args=(--scene validation --size 128x128 --ref-spp 256 --aux
         --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,rae)
       timed "$dvr" eval "${args[@]}" --out "$out"
       total=$secs
       oidn "$out"
       KEEP_METRICS=1 keep validation "$out"
-      args1=(--scene validation --size 128x128 --ref-spp 256 --spp 1 --denoiser none,ours)
-      out1=$out-spp1
-      share_references "$out" "$out1"
-      timed "$dvr" eval "${args1[@]}" --out "$out1"
-      total=$(echo "$total + $secs" | bc)
-      KEEP_METRICS=1 keep validation "$out1" spp1
-      meta validation "$out" "$total" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out; dvr eval ${args1[*]} --out $out1"
+      for spp in 1 4; do
+        argsn=(--scene validation --size 128x128 --ref-spp 256 --spp $spp --aux --denoiser none,taa,svgf,ours,rae)
+        share_references "$out" "$out-spp$spp"
+        timed "$dvr" eval "${argsn[@]}" --out "$out-spp$spp"
+        total=$(echo "$total + $secs" | bc)
+        oidn "$out-spp$spp"
+        KEEP_METRICS=1 keep validation "$out-spp$spp" spp$spp
+      done
+      meta validation "$out" "$total" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out; for spp in 1 4: dvr eval --scene validation --size 128x128 --ref-spp 256 --spp \$spp --aux --denoiser none,taa,svgf,ours,rae --out $out-spp\$spp && tools/oidn_eval.py $out-spp\$spp"
       ;;
     suite)
       args=(--scene suite --frames 48 --size 64x64 --ref-spp 1024 --aux

@@ -20,7 +20,11 @@ Both denoise every frame independently (no temporal information).
 Metrics: `dvr.metrics` from the Python package (python/), i.e. the eval's own code
 (engine/src/metrics/): the same tone map, PSNR, SSIM, LDR-FLIP and temporal error, so
 the appended rows compare with the eval's to the last digit.
-  * gpu_ms: left empty (OIDN runs on the CPU here); the CPU time is printed.
+  * gpu_ms: left empty (OIDN runs on the CPU here). Its cost goes to `DIR/oidn_ms.csv`
+    instead: per frame, OIDN's CPU ms and the whole frame's ms, i.e. the eval's shared
+    passes (path trace, motion; `DIR/<scene>/timings.json`), plus for `oidn-aux` the
+    march that wrote its guide images, plus OIDN's CPU ms. On lavapipe the GPU passes run
+    on the same CPU cores as OIDN, so the sum is one machine's time.
   * frames_to_recover (summary.csv): for scenes with a sudden change (the event frame is
     read from the eval's index.html), frames after the event until PSNR stays within
     1 dB of its mean over the 5 frames before; `never` if it does not recover.
@@ -58,6 +62,7 @@ RECOVERY_TOLERANCE_DB = 1.0
 RECOVERY_BASELINE_FRAMES = 5
 METRICS_HEADER = "scene,method,frame,psnr,ssim,flip,temporal_error,gpu_ms"
 SUMMARY_HEADER = "scene,method,psnr,ssim,flip,temporal_error,gpu_ms,frames_to_recover"
+MS_HEADER = "scene,method,frame,oidn_cpu_ms,frame_ms"
 
 
 def need(module, pip_name):
@@ -196,6 +201,23 @@ def summary_row(scene, method, scored, event):
     return [scene, method, f"{mean([r['psnr'] for r in scored]):.4f}", f"{mean([r['ssim'] for r in scored]):.6f}", fmt(mean(fl), 6), fmt(mean(te), 6), "", rec]
 
 
+def frame_gpu_ms(scene_dir):
+    """Per frame of the eval's `timings.json`: (the shared passes' ms, the guide march's
+    ms). The march is the pass that several methods need (owner `methods`); it writes the
+    guide images `oidn-aux` reads. None where the eval kept no timings."""
+    p = os.path.join(scene_dir, "timings.json")
+    if not os.path.exists(p):
+        return None
+    with open(p) as fh:
+        frames = json.load(fh)["frames"]
+    out = []
+    for passes in frames:
+        shared = sum(t["ms"] for t in passes if t.get("owner", "shared") == "shared")
+        march = sum(t["ms"] for t in passes if isinstance(t.get("owner"), dict) and "methods" in t["owner"])
+        out.append((shared, march))
+    return out
+
+
 def rewrite(path, header, extra):
     """Rewrites a CSV with `extra` in place of its earlier `oidn` and `oidn-aux` rows."""
     with open(path, newline="") as fh:
@@ -237,11 +259,12 @@ def main(argv=None):
                         worst[k] = max(worst[k], abs(g[k] - float(w[k])))
         print("oidn_eval --check: largest |python - dvr| on `none`: " + ", ".join(f"{k} {v:.2e}" for k, v in worst.items()))
 
-    new_rows, new_summary = [], []
+    new_rows, new_summary, ms_rows = [], [], []
     cpu_ms = {METHOD: [], METHOD_AUX: []}
     for s in scenes:
         d = os.path.join(args.out, dir_name(s))
         aux_dir = os.path.join(d, "aux")
+        gpu = frame_gpu_ms(d)
         for method in [METHOD] + ([METHOD_AUX] if has_aux(d, frames[s]) else []):
             os.makedirs(os.path.join(d, method), exist_ok=True)
 
@@ -256,7 +279,12 @@ def main(argv=None):
                     }
                 t0 = time.perf_counter()
                 out = pyoidn.denoise(noisy, hdr=True, quality=args.quality, **aux)
-                cpu_ms[method].append(1e3 * (time.perf_counter() - t0))
+                ms = 1e3 * (time.perf_counter() - t0)
+                cpu_ms[method].append(ms)
+                if gpu is not None and f < len(gpu):
+                    shared, march = gpu[f]
+                    frame = shared + (march if method == METHOD_AUX else 0.0) + ms
+                    ms_rows.append([s, method, str(f), f"{ms:.4f}", f"{frame:.4f}"])
                 return np.asarray(out, dtype=np.float32)
 
             scored = score_sequence(args.out, s, frames[s], denoised)
@@ -270,6 +298,9 @@ def main(argv=None):
     rewrite(metrics_path, METRICS_HEADER, new_rows)
     if os.path.exists(summary_path):
         rewrite(summary_path, SUMMARY_HEADER, new_summary)
+    with open(os.path.join(args.out, "oidn_ms.csv"), "w", newline="") as fh:
+        fh.write(MS_HEADER + "\n")
+        csv.writer(fh, lineterminator="\n").writerows(ms_rows)
     for method, times in cpu_ms.items():
         if times:
             ms = sorted(times)

@@ -17,7 +17,8 @@ and this script rewrites every such block from its CSV:
     tools/results.py --list     # the block names and the files each reads
 
 A block whose name is unknown, or whose files are missing, is an error: a table is
-either generated from a run's files or not there.
+either generated from a run's files or not there. The charts the pages show are files
+drawn the same way (tools/results_figures.py: FIGURES), written and checked with the pages.
 """
 
 import argparse
@@ -71,6 +72,12 @@ from results_sets import (
     b_setup_times,
 )
 from results_experiments import b_experiments_prior, b_experiments_strata
+from results_figures import (
+    FIGURES,
+    b_speed_accuracy,
+    b_speed_accuracy_line,
+    b_interaction_curves,
+)
 
 
 # ---------------------------------------------------------------------------- blocks
@@ -580,6 +587,11 @@ BLOCKS = {
                                     "labels/meta.json"]),
     "labels-cost": (b_labels_cost, ["labels-cost/profile.csv"]),
     "interaction": (b_interaction, ["interaction/metrics.csv", "interaction/meta.json"]),
+    "interaction-curves": (b_interaction_curves, ["interaction/metrics.csv",
+                                                  "interaction/meta.json"]),
+    "speed-accuracy": (b_speed_accuracy, ["validation/{,spp1/,spp4/}{summary,metrics,oidn_ms}.csv"]),
+    "speed-accuracy-line": (b_speed_accuracy_line,
+                            ["validation/{,spp1/,spp4/}{summary,metrics,oidn_ms}.csv"]),
     "mechanisms": (b_mechanisms, ["mechanisms/*.csv", "mechanisms/meta.json"]),
     "development-cost": (b_development_cost, ["mechanisms/metrics.csv", "mechanisms/meta.json"]),
     "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv",
@@ -638,11 +650,28 @@ def main():
                 with open(p, "w", encoding="utf-8") as f:
                     f.write(new)
                 print(f"results: wrote {rel}")
+    for rel, draw in FIGURES.items():
+        p = os.path.join(ROOT, rel)
+        try:
+            svg = draw()
+        except Missing as e:
+            errors.append(f"{rel} needs {e}")
+            continue
+        old = open(p, encoding="utf-8").read() if os.path.exists(p) else None
+        if old != svg:
+            if args.check:
+                stale.append(rel)
+                print(f"results: {rel} is stale against its CSVs; run tools/results.py",
+                      file=sys.stderr)
+            else:
+                with open(p, "w", encoding="utf-8") as f:
+                    f.write(svg)
+                print(f"results: wrote {rel}")
     for e in errors:
         print(f"results: {e}", file=sys.stderr)
     if errors or stale:
         return 1
-    print(f"results: {found} blocks in {len(PAGES)} pages "
+    print(f"results: {found} blocks in {len(PAGES)} pages and {len(FIGURES)} figures "
           f"{'up to date' if args.check else 'rendered'}")
     return 0
 

@@ -399,6 +399,14 @@ def test_oidn_rows_replace_earlier_ones_with_the_evals_metrics_of_each_frame(roo
                 _write_exr(out / folder / "aux" / f"{f:04d}_albedo.exr", np.full((8, 8, 3), 1.5))
                 _write_exr(out / folder / "aux" / f"{f:04d}_normal.exr", np.full((8, 8, 3), -2.0))
     lines.append("brain,oidn,0,1.0,0.1,0.9,,")  # from an earlier run: replaced
+    # brain's GPU passes per frame: shared 10 + 1 ms, the guide march 3 ms, a method's own 5.
+    passes = [
+        {"pass": "path_trace", "owner": "shared", "ms": 10.0},
+        {"pass": "motion", "owner": "shared", "ms": 1.0},
+        {"pass": "aux_features", "owner": {"methods": ["svgf"]}, "ms": 3.0},
+        {"pass": "svgf.temporal", "owner": {"method": "svgf"}, "ms": 5.0},
+    ]
+    (out / "brain" / "timings.json").write_text(json.dumps({"frames": [passes, passes]}))
     (out / "metrics.csv").write_text("\n".join(lines) + "\n")
     (out / "summary.csv").write_text(o.SUMMARY_HEADER + "\nbrain,none,20,0.5,0.2,0.1,1.5,\nbrain,oidn-aux,1,0.1,0.9,,,\n")
 
@@ -449,3 +457,63 @@ def test_oidn_rows_replace_earlier_ones_with_the_evals_metrics_of_each_frame(roo
     assert summary[1]["frames_to_recover"] == ("0" if p1 >= p0 - 1.0 else "never")
     assert summary[2]["frames_to_recover"] == ""
     assert float(summary[3]["psnr"]) == pytest.approx(np.mean([float(new["brain", "oidn-aux", f]["psnr"]) for f in range(2)]), abs=1e-4)
+
+    # The whole frame's ms, where the eval kept timings (brain only): the shared passes,
+    # for oidn-aux the guide march, and OIDN's own CPU ms.
+    ms = list(csv.DictReader((out / "oidn_ms.csv").open()))
+    assert sorted((r["method"], int(r["frame"])) for r in ms) == [("oidn", 0), ("oidn", 1), ("oidn-aux", 0), ("oidn-aux", 1)]
+    for r in ms:
+        assert r["scene"] == "brain" and float(r["oidn_cpu_ms"]) >= 0.0
+        passes_ms = 11.0 + (3.0 if r["method"] == "oidn-aux" else 0.0)
+        assert float(r["frame_ms"]) == pytest.approx(passes_ms + float(r["oidn_cpu_ms"]), abs=1e-3)
+
+
+# tools/results_figures.py: the charts drawn from the runs' CSVs.
+
+
+def test_ours_is_off_the_front_only_where_another_point_is_cheaper_and_better(root):
+    f = _tool(root, "results_figures")
+    points = {
+        "ours": [(1, 50.0, 30.0), (2, 80.0, 32.0)],
+        "none": [(1, 30.0, 20.0)],  # cheaper than any point of ours
+        "svgf": [(1, 60.0, 31.0)],  # within 60 ms ours has 30 dB only
+        "oidn": [(1, 100.0, 31.5)],  # ours has 32 dB within 100 ms
+    }
+    assert f.front_gaps(points) == [("none", 1, 30.0, 20.0, None), ("svgf", 1, 60.0, 31.0, 30.0)]
+    assert f.front_gaps({"ours": points["ours"], "oidn": points["oidn"]}) == []
+    assert "every frame budget" in f._front_sentence({"ours": points["ours"]})
+    assert "`svgf` at 1 spp (60.0 ms, 31.00 dB" in f._front_sentence(points)
+
+
+def test_the_speed_chart_reads_each_spp_run_and_counts_oidns_cpu_time(root, tmp_path, monkeypatch):
+    import xml.etree.ElementTree as ET
+
+    f = _tool(root, "results_figures")
+    io = _tool(root, "results_io")
+    monkeypatch.setattr(io, "RESULTS", str(tmp_path))
+    for spp, folder in f.SPP_FOLDERS.items():
+        d = tmp_path / "validation" / folder
+        d.mkdir(parents=True, exist_ok=True)
+        (d / "summary.csv").write_text(
+            "scene,method,psnr,ssim,flip,temporal_error,gpu_ms,frames_to_recover\n"
+            f"a,ours,{30 + spp},,,,,\nb,ours,{32 + spp},,,,,\na,none,20,,,,,\nb,oidn,25,,,,,\n"
+        )
+        (d / "metrics.csv").write_text(
+            "scene,method,frame,psnr,ssim,flip,temporal_error,gpu_ms\n"
+            f"a,ours,0,1,,,,{10 * spp}\na,ours,1,1,,,,{10 * spp + 2}\na,none,0,1,,,,{5 * spp}\n"
+            "b,oidn,0,1,,,,\n"
+        )
+        (d / "oidn_ms.csv").write_text(f"scene,method,frame,oidn_cpu_ms,frame_ms\nb,oidn,0,40,{40 + 5 * spp}\n")
+    points = f.speed_points()
+    assert points["ours"] == [(1, 11.0, 32.0), (2, 21.0, 33.0), (4, 41.0, 35.0)]
+    assert points["oidn"] == [(1, 45.0, 25.0), (2, 50.0, 25.0), (4, 60.0, 25.0)]
+    assert [p[1] for p in points["none"]] == [5.0, 10.0, 20.0]
+    svg = f.speed_accuracy_svg()
+    root_el = ET.fromstring(svg)
+    assert root_el.tag.endswith("svg")
+    texts = {t.text for t in root_el.iter() if t.tag.endswith("text")}
+    assert {"ours", "oidn", "none"} <= texts
+    # Without a run's OIDN times the chart is not drawn: the file is named.
+    (tmp_path / "validation" / "spp4" / "oidn_ms.csv").unlink()
+    with pytest.raises(io.Missing, match=r"spp4/oidn_ms\.csv"):
+        f.speed_points()
