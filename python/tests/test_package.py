@@ -76,13 +76,7 @@ def test_the_built_book_shows_every_section_of_the_package_readme(root):
 def _copy_docs(root, dest):
     import shutil
 
-    for rel in (
-        "tools/results.py",
-        "tools/results_io.py",
-        "tools/results_sets.py",
-        "tools/results_experiments.py",
-        "README.md",
-    ):
+    for rel in [str(p.relative_to(root)) for p in sorted(root.glob("tools/results*.py"))] + ["README.md"]:
         (dest / rel).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy(root / rel, dest / rel)
     for rel in ("docs/src", "assets/results", "assets/rae", "assets/scenes/validation"):
@@ -108,3 +102,13 @@ def test_results_pages_are_current_and_a_changed_csv_makes_them_stale(root, tmp_
     stale = subprocess.run([sys.executable, str(script), "--check"], capture_output=True, text=True)
     assert stale.returncode == 1
     assert "stale" in stale.stderr and "README.md" in stale.stderr
+    # A chart is checked as a page is: a changed frame makes the interaction curves stale.
+    metrics = tmp_path / "assets/results/interaction/metrics.csv"
+    rows = metrics.read_text().splitlines()
+    i = next(i for i, r in enumerate(rows) if ",ours,3," in r)
+    cells = rows[i].split(",")
+    cells[3] = f"{float(cells[3]) - 3.0:.6f}"
+    rows[i] = ",".join(cells)
+    metrics.write_text("\n".join(rows) + "\n")
+    stale = subprocess.run([sys.executable, str(script), "--check"], capture_output=True, text=True)
+    assert "interaction/curves.svg is stale" in stale.stderr
