@@ -594,13 +594,12 @@ BLOCKS = {
                             ["validation/{,spp1/,spp4/}{summary,metrics,oidn_ms}.csv"]),
     "mechanisms": (b_mechanisms, ["mechanisms/*.csv", "mechanisms/meta.json"]),
     "development-cost": (b_development_cost, ["mechanisms/metrics.csv", "mechanisms/meta.json"]),
-    "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv",
-                                                "validation/metrics.csv"]),
+    "experiments-prior": (b_experiments_prior, ["experiments-prior/*.csv"]),
     "experiments-strata": (b_experiments_strata, ["experiments-strata/*.csv",
                                                   "experiments-strata/profile-*.json",
                                                   "experiments-prior/base-development.csv",
                                                   "experiments-prior/rivals-development.csv",
-                                                  "validation/metrics.csv"]),
+                                                  "experiments-prior/base-validation.csv"]),
 }
 
 

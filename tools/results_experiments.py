@@ -20,11 +20,13 @@ def experiment_runs(folder):
     and FLIP and its frames more than 1 dB below the best single-frame method.
     `folder/runs.csv` names each run (run, set, build, change, and optionally file: a CSV
     under assets/results another section keeps, such as a base run on the same code);
-    the validation set's base is ours' rows of the results' own validation run."""
+    the validation set's base is `experiments-prior/base-validation.csv`: ours' and the
+    single-frame methods' rows of the validation run these experiments were set against
+    (at 8d3f4b4, ours' code as at 2cb97d6), kept when the results' run moved on."""
+    base = read_csv("experiments-prior", "base-validation.csv")
     rivals = {"development": read_csv("experiments-prior", "rivals-development.csv"),
-              "validation": [r for r in read_csv("validation", "metrics.csv")
-                             if r["method"] in SINGLE_FRAME]}
-    base_val = [r for r in read_csv("validation", "metrics.csv") if r["method"] == "ours"]
+              "validation": [r for r in base if r["method"] in SINGLE_FRAME]}
+    base_val = [r for r in base if r["method"] == "ours"]
     runs = [("ours as on main", "validation", "main (2cb97d6 code)", base_val)]
     runs += [(r["change"], r["set"], r["build"],
               read_csv(*(r.get("file") or f"{folder}/{r['run']}-{r['set']}.csv").split("/")))
@@ -48,8 +50,8 @@ def b_experiments_prior():
     return "\n".join([
         experiment_runs("experiments-prior"),
         "",
-        f"Source: `assets/results/experiments-prior/` (`runs.csv`, each run's CSV) and "
-        f"`assets/results/validation/metrics.csv`, made by `{meta['command']}` from "
+        f"Source: `assets/results/experiments-prior/` (`runs.csv`, each run's CSV, and "
+        f"`base-validation.csv`, the validation run of 8d3f4b4), made by `{meta['command']}` from "
         f"commit {meta['commit']} ({meta['date']}) on {meta['machine']}.",
     ])
 
@@ -83,7 +85,7 @@ def b_experiments_strata():
         "",
         f"Source: `assets/results/experiments-strata/` (`runs.csv` and each run's CSV, "
         f"`profiles.csv` and the profiles it names), `assets/results/experiments-prior/` "
-        f"(the development set's base run and its rivals) and "
-        f"`assets/results/validation/metrics.csv`, made by `{meta['command']}` from commit "
+        f"(the development set's base run and its rivals, and the validation run of "
+        f"8d3f4b4), made by `{meta['command']}` from commit "
         f"{meta['commit']} ({meta['date']}) on {meta['machine']}.",
     ])
