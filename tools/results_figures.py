@@ -7,7 +7,7 @@ tools/results.py that show a figure also state what it shows in words."""
 import math
 from xml.sax.saxutils import escape
 
-from results_io import read_csv, num, frames_by_scene
+from results_io import read_csv, num, frames_by_scene, table, source
 
 # What the chart compares and in which colour; ours is red, as in the eval's charts.
 COLOURS = {
@@ -114,31 +114,28 @@ class _Plot:
         lo, hi = self.yr
         return self.y0 + self.h - (y - lo) / (hi - lo) * self.h
 
+    def text(self, x, y, s, size, anchor="middle", extra=""):
+        self.out.append(f'<text x="{x:.1f}" y="{y:.1f}" text-anchor="{anchor}" '
+                        f'font-size="{size}"{extra} {FONT}>{escape(str(s))}</text>')
+
     def axes(self, xticks, yticks, xlabel, ylabel, title, size=11):
-        o = self.out
-        o.append(f'<rect x="{self.x0}" y="{self.y0}" width="{self.w}" height="{self.h}" '
-                 'fill="none" stroke="#444"/>')
-        for t in xticks:
-            x = self.px(t)
-            o.append(f'<line x1="{x:.1f}" y1="{self.y0}" x2="{x:.1f}" y2="{self.y0 + self.h}" '
-                     'stroke="#ddd"/>')
-            o.append(f'<text x="{x:.1f}" y="{self.y0 + self.h + size + 3}" text-anchor="middle" '
-                     f'font-size="{size}" {FONT}>{t:g}</text>')
-        for t in yticks:
-            y = self.py(t)
-            o.append(f'<line x1="{self.x0}" y1="{y:.1f}" x2="{self.x0 + self.w}" y2="{y:.1f}" '
-                     'stroke="#ddd"/>')
-            o.append(f'<text x="{self.x0 - 4}" y="{y + size / 3:.1f}" text-anchor="end" '
-                     f'font-size="{size}" {FONT}>{t:g}</text>')
+        x0, y0, x1, y1 = self.x0, self.y0, self.x0 + self.w, self.y0 + self.h
+        self.out.append(f'<rect x="{x0}" y="{y0}" width="{self.w}" height="{self.h}" '
+                        'fill="none" stroke="#444"/>')
+        # Each tick: its grid line across the axes and its label outside them.
+        ticks = [((x, y0, x, y1), (x, y1 + size + 3, "middle"))
+                 for x in map(self.px, xticks)]
+        ticks += [((x0, y, x1, y), (x0 - 4, y + size / 3, "end")) for y in map(self.py, yticks)]
+        for ((ax, ay, bx, by), (tx, ty, anchor)), t in zip(ticks, list(xticks) + list(yticks)):
+            self.out.append(f'<line x1="{ax:.1f}" y1="{ay:.1f}" x2="{bx:.1f}" y2="{by:.1f}" '
+                            'stroke="#ddd"/>')
+            self.text(tx, ty, f"{t:g}", size, anchor)
         if xlabel:
-            o.append(f'<text x="{self.x0 + self.w / 2:.1f}" y="{self.y0 + self.h + 2 * size + 8}" '
-                     f'text-anchor="middle" font-size="{size + 1}" {FONT}>{escape(xlabel)}</text>')
+            self.text(x0 + self.w / 2, y1 + 2 * size + 8, xlabel, size + 1)
         if ylabel:
-            cx, cy = self.x0 - 3.2 * size, self.y0 + self.h / 2
-            o.append(f'<text x="{cx:.1f}" y="{cy:.1f}" text-anchor="middle" font-size="{size + 1}" '
-                     f'transform="rotate(-90 {cx:.1f} {cy:.1f})" {FONT}>{escape(ylabel)}</text>')
-        o.append(f'<text x="{self.x0 + self.w / 2:.1f}" y="{self.y0 - 6}" text-anchor="middle" '
-                 f'font-size="{size + 1}" {FONT}>{escape(title)}</text>')
+            cx, cy = x0 - 3.2 * size, y0 + self.h / 2
+            self.text(cx, cy, ylabel, size + 1, extra=f' transform="rotate(-90 {cx:.1f} {cy:.1f})"')
+        self.text(x0 + self.w / 2, y0 - 6, title, size + 1)
 
     def line(self, pts, colour, width=1.5):
         d = " ".join(f"{self.px(x):.1f},{self.py(y):.1f}" for x, y in pts)
@@ -253,7 +250,6 @@ def _front_sentence(points):
 
 def b_speed_accuracy():
     """The chart with its points as a table and where ours is not on the front."""
-    from results_io import table, source
     points = speed_points()
     body = []
     for m in SPEED_METHODS:
@@ -289,7 +285,6 @@ def b_speed_accuracy_line():
 
 
 def b_interaction_curves():
-    from results_io import source
     return "\n".join([
         "![Per-frame PSNR of svgf, oidn-aux and ours on each scene of the interaction "
         "set](../../assets/results/interaction/curves.svg)",

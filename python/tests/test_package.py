@@ -92,23 +92,21 @@ def test_results_pages_are_current_and_a_changed_csv_makes_them_stale(root, tmp_
     script = tmp_path / "tools/results.py"
     ok = subprocess.run([sys.executable, str(script), "--check"], capture_output=True, text=True)
     assert ok.returncode == 0, ok.stderr
-    csv = tmp_path / "assets/results/validation/summary.csv"  # README's headline
-    rows = csv.read_text().splitlines()
-    ours = next(i for i, r in enumerate(rows) if ",ours," in r)
-    cells = rows[ours].split(",")
-    cells[2] = f"{float(cells[2]) + 1.0:.4f}"
-    rows[ours] = ",".join(cells)
-    csv.write_text("\n".join(rows) + "\n")
-    stale = subprocess.run([sys.executable, str(script), "--check"], capture_output=True, text=True)
+
+    def stale_after(rel, key, column, delta):
+        """--check after adding `delta` to `column` of the first row of `rel` holding `key`."""
+        csv = tmp_path / "assets/results" / rel
+        rows = csv.read_text().splitlines()
+        i = next(i for i, r in enumerate(rows) if key in r)
+        cells = rows[i].split(",")
+        cells[column] = f"{float(cells[column]) + delta:.6f}"
+        rows[i] = ",".join(cells)
+        csv.write_text("\n".join(rows) + "\n")
+        return subprocess.run([sys.executable, str(script), "--check"], capture_output=True, text=True)
+
+    stale = stale_after("validation/summary.csv", ",ours,", 2, 1.0)  # README's headline
     assert stale.returncode == 1
     assert "stale" in stale.stderr and "README.md" in stale.stderr
     # A chart is checked as a page is: a changed frame makes the interaction curves stale.
-    metrics = tmp_path / "assets/results/interaction/metrics.csv"
-    rows = metrics.read_text().splitlines()
-    i = next(i for i, r in enumerate(rows) if ",ours,3," in r)
-    cells = rows[i].split(",")
-    cells[3] = f"{float(cells[3]) - 3.0:.6f}"
-    rows[i] = ",".join(cells)
-    metrics.write_text("\n".join(rows) + "\n")
-    stale = subprocess.run([sys.executable, str(script), "--check"], capture_output=True, text=True)
+    stale = stale_after("interaction/metrics.csv", ",ours,3,", 3, -3.0)
     assert "interaction/curves.svg is stale" in stale.stderr
