@@ -71,7 +71,7 @@ from results_sets import (
     b_development_cost,
     b_setup_times,
 )
-from results_experiments import b_experiments_prior, b_experiments_strata
+from results_experiments import b_experiments_prior, b_experiments_strata, b_experiments_motion
 from results_figures import (
     FIGURES,
     b_speed_accuracy,
@@ -600,6 +600,10 @@ BLOCKS = {
                                                   "experiments-prior/base-development.csv",
                                                   "experiments-prior/rivals-development.csv",
                                                   "experiments-prior/base-validation.csv"]),
+    "experiments-motion": (b_experiments_motion, ["experiments-motion/*.csv",
+                                                  "experiments-motion/meta.json",
+                                                  "mechanisms/no-clip.csv",
+                                                  "mechanisms/metrics.csv"]),
 }
 
 

@@ -15,19 +15,23 @@ from results_io import (
 )
 
 
-def experiment_runs(folder):
+def experiment_runs(folder, validation_base=True):
     """The table of an experiments section's runs of ours' variants: each run's mean PSNR
     and FLIP and its frames more than 1 dB below the best single-frame method.
     `folder/runs.csv` names each run (run, set, build, change, and optionally file: a CSV
     under assets/results another section keeps, such as a base run on the same code);
     the validation set's base is `experiments-prior/base-validation.csv`: ours' and the
     single-frame methods' rows of the validation run these experiments were set against
-    (at 8d3f4b4, ours' code as at 2cb97d6), kept when the results' run moved on."""
+    (at 8d3f4b4, ours' code as at 2cb97d6), kept when the results' run moved on; the
+    development set at 128² is set against the mechanisms run's single-frame rows."""
     base = read_csv("experiments-prior", "base-validation.csv")
     rivals = {"development": read_csv("experiments-prior", "rivals-development.csv"),
+              "development at 128²": [r for r in read_csv("mechanisms", "metrics.csv")
+                                      if r["method"] in SINGLE_FRAME],
               "validation": [r for r in base if r["method"] in SINGLE_FRAME]}
     base_val = [r for r in base if r["method"] == "ours"]
-    runs = [("ours as on main", "validation", "main (2cb97d6 code)", base_val)]
+    runs = ([("ours as on main", "validation", "main (2cb97d6 code)", base_val)]
+            if validation_base else [])
     runs += [(r["change"], r["set"], r["build"],
               read_csv(*(r.get("file") or f"{folder}/{r['run']}-{r['set']}.csv").split("/")))
              for r in read_csv(folder, "runs.csv")]
@@ -87,5 +91,19 @@ def b_experiments_strata():
         f"`profiles.csv` and the profiles it names), `assets/results/experiments-prior/` "
         f"(the development set's base run and its rivals, and the validation run of "
         f"8d3f4b4), made by `{meta['command']}` from commit "
+        f"{meta['commit']} ({meta['date']}) on {meta['machine']}.",
+    ])
+
+
+def b_experiments_motion():
+    """Process noise under camera motion (at 6b4e266): the resampling error and
+    `motion_q`, on the development set at 128²."""
+    meta = read_json("experiments-motion", "meta.json")
+    return "\n".join([
+        experiment_runs("experiments-motion", validation_base=False),
+        "",
+        f"Source: `assets/results/experiments-motion/` (`runs.csv`, each run's CSV; the "
+        f"base is `assets/results/mechanisms/no-clip.csv`, ours' code since) and the "
+        f"mechanisms run's single-frame rows, made by `{meta['command']}` from commit "
         f"{meta['commit']} ({meta['date']}) on {meta['machine']}.",
     ])
