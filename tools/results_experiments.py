@@ -12,6 +12,7 @@ from results_io import (
     frames_by_scene,
     below_best,
     SINGLE_FRAME,
+    own_ms,
 )
 
 
@@ -99,11 +100,23 @@ def b_experiments_motion():
     """Process noise under camera motion (at 6b4e266): the resampling error and
     `motion_q`, on the development set at 128²."""
     meta = read_json("experiments-motion", "meta.json")
+    body = []
+    for r in read_csv("experiments-motion", "costs.csv"):
+        ms = own_ms(read_csv("experiments-motion", r["file"]))
+        o, s, n = sum(ms["ours"].values()), sum(ms["svgf"].values()), len(ms["none"])
+        body.append([r["change"], fmt(o / n, 1), fmt(s / n, 1), f"{o / s:.2f}×"])
     return "\n".join([
         experiment_runs("experiments-motion", validation_base=False),
         "",
-        f"Source: `assets/results/experiments-motion/` (`runs.csv`, each run's CSV; the "
-        f"base is `assets/results/mechanisms/no-clip.csv`, ours' code since) and the "
+        "The cost over the whole development set, each run timing `none`, `svgf` and "
+        "`ours` together: mean GPU ms per frame of each method's passes and the features "
+        "it needs (the frame's GPU ms less the path trace's):",
+        "",
+        table(["ours", "`ours` ms", "`svgf` ms", "ours / svgf"], body),
+        "",
+        f"Source: `assets/results/experiments-motion/` (`runs.csv`, each run's CSV, "
+        f"`costs.csv` and the timed runs it names; the base is "
+        f"`assets/results/mechanisms/no-clip.csv`, ours' code of 387a560) and the "
         f"mechanisms run's single-frame rows, made by `{meta['command']}` from commit "
         f"{meta['commit']} ({meta['date']}) on {meta['machine']}.",
     ])

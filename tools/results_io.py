@@ -203,3 +203,21 @@ def below_best(frames, rivals, by=1.0, after=4):
         n += 1
         below += v["ours"] < max(have) - by
     return below, n
+
+
+# ------------------------------------------------------------- cost
+
+
+def own_ms(rows):
+    """{method: {(scene, frame): ms}} of a metrics.csv that timed `none` beside the
+    methods: each frame's GPU ms less the path trace's (`none`'s), so a method's own
+    passes and the features it needs (frames the eval did not time, such as OIDN's,
+    are left out)."""
+    ms = {}
+    for r in rows:
+        ms.setdefault(r["method"], {})[(r["scene"], r["frame"])] = num(r["gpu_ms"])
+    base = ms.get("none")
+    if base is None:
+        raise Missing("a `none` row per frame beside the methods timed")
+    return {m: {k: v - base[k] for k, v in d.items() if k in base and v is not None}
+            for m, d in ms.items()}

@@ -20,6 +20,7 @@ from results_io import (
     worst_margin,
     below_best,
     SINGLE_FRAME,
+    own_ms,
 )
 
 
@@ -377,21 +378,17 @@ def b_development_cost():
     frame's GPU ms less the path trace's (`none`), so each method's own passes and the
     features it needs, summed over every frame of every scene."""
     rows = read_csv("mechanisms", "metrics.csv")
-    ms = {}
-    for r in rows:
-        ms.setdefault(r["method"], {})[(r["scene"], r["frame"])] = num(r["gpu_ms"])
-    base = ms["none"]
+    ms = own_ms(rows)
 
     def total(method, scene=None):
-        return sum(v - base[k] for k, v in ms[method].items()
-                   if k in base and (scene is None or k[0] == scene))
+        return sum(v for k, v in ms[method].items() if scene is None or k[0] == scene)
 
     body = []
     for sc in scenes_of(rows):
-        o, s, n = total("ours", sc), total("svgf", sc), sum(k[0] == sc for k in base)
+        o, s, n = total("ours", sc), total("svgf", sc), sum(k[0] == sc for k in ms["none"])
         body.append([sc, fmt(o / n, 1), fmt(s / n, 1), f"{o / s:.2f}×"])
-    o, s = total("ours"), total("svgf")
-    body.append(["**the set**", fmt(o / len(base), 1), fmt(s / len(base), 1), f"**{o / s:.2f}×**"])
+    o, s, n = total("ours"), total("svgf"), len(ms["none"])
+    body.append(["**the set**", fmt(o / n, 1), fmt(s / n, 1), f"**{o / s:.2f}×**"])
     return "\n".join([
         "Mean GPU ms per frame of each method's passes and the features it needs (the "
         "frame's GPU ms in `dvr eval` less the path trace's), 128×128:",

@@ -92,10 +92,10 @@ pub struct OursParams {
 impl Default for OursParams {
     fn default() -> Self {
         Self {
-            stratum: 3,
+            stratum: 2,
             shrink: 4.0,
             change_q: 3.5,
-            motion_q: 0.01,
+            motion_q: 0.5,
             lag_z: 1.5,
             jump_z: 6.0,
             kappa: 6.0,
