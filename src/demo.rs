@@ -134,6 +134,7 @@ pub fn run(args: &DemoArgs) -> Result<()> {
             video_fps: video::DEFAULT_FPS,
         },
         aux: false,
+        no_baseline: false,
         note: Some(note),
         farm: Default::default(),
     })?;

@@ -243,6 +243,25 @@ fn tiny_eval_writes_tables_images_plots_and_reuses_references() {
     assert_eq!(before, after, "references were re-rendered");
     assert_eq!(read(&out.join("metrics.csv")).lines().count(), 1 + 6);
 
+    // Without the baseline: the same frames scored the same (the baseline runs after
+    // them), and baseline.csv keeps only its header.
+    let scores = |csv: &str| -> Vec<String> {
+        csv.lines()
+            .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+            .collect()
+    };
+    let with_baseline = scores(&read(&out.join("metrics.csv")));
+    let mut args = tiny_args(3, 16);
+    args.push("--no-baseline".into());
+    let without = common::eval::dvr_ok(&args.iter().map(String::as_str).collect::<Vec<_>>(), &out);
+    assert!(
+        stderr(&without).contains("reusing 3 reference frame(s)"),
+        "{}",
+        stderr(&without)
+    );
+    assert_eq!(scores(&read(&out.join("metrics.csv"))), with_baseline);
+    assert_eq!(read(&out.join("baseline.csv")).lines().count(), 1);
+
     // An interrupted run (frame 2 missing) renders only what is missing.
     std::fs::remove_file(&refs[2]).unwrap();
     let resumed = eval(&out, 3, 16);

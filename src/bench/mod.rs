@@ -181,6 +181,7 @@ fn run_eval<'a>(args: &'a BenchArgs, denoisers: &[String]) -> Result<EvalRecord<
             video_fps: crate::video::DEFAULT_FPS,
         },
         aux: false,
+        no_baseline: false,
         note: None,
         farm: Default::default(),
     };

@@ -186,10 +186,18 @@ pub struct ResultKey {
     pub spp: u32,
     pub motion: String,
     pub aux: bool,
+    /// Whether the accumulation baseline was measured (`--no-baseline` leaves it out);
+    /// results written before the option had it.
+    #[serde(default = "measured")]
+    pub baseline: bool,
     /// Every shader, so results of another build of dvr are not merged with these.
     pub shaders: String,
     /// The denoiser parameter overrides in the environment (`DVR_OURS`, …) that are set.
     pub overrides: Vec<(String, String)>,
+}
+
+fn measured() -> bool {
+    true
 }
 
 impl ResultKey {
@@ -200,6 +208,7 @@ impl ResultKey {
             spp,
             motion: args.render.motion.to_string(),
             aux: args.aux,
+            baseline: !args.no_baseline,
             shaders: shaders_hash(),
             overrides: dvr_engine::denoise::override_variables()
                 .into_iter()

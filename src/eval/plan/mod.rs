@@ -45,6 +45,8 @@ pub struct Plan {
     pub ref_spp: u32,
     /// How many methods run on every frame.
     pub methods: usize,
+    /// Whether the accumulation baseline is measured (not `--no-baseline`).
+    pub baseline: bool,
 }
 
 impl Plan {
@@ -76,6 +78,7 @@ impl Plan {
             scenes,
             ref_spp: args.ref_spp,
             methods: methods.len(),
+            baseline: !args.no_baseline,
         })
     }
 }

@@ -52,7 +52,11 @@ pub fn total_units(plan: &Plan, take: impl Fn(usize) -> bool) -> f64 {
         .map(|(_, s)| {
             ReferenceCache::of(s).missing().len() as f64 * f64::from(plan.ref_spp)
                 + f64::from(s.frames) * (f64::from(s.spp) + plan.methods as f64)
-                + baseline::units(s.frames, plan.ref_spp)
+                + if plan.baseline {
+                    baseline::units(s.frames, plan.ref_spp)
+                } else {
+                    0.0
+                }
         })
         .sum()
 }
@@ -337,6 +341,9 @@ pub fn evaluate_scene(
 
     let ms_per_spp = path_trace_ms_per_spp(&state.timings, setup.settings.spp());
     let baseline = timing.baseline.time(|| {
+        if args.no_baseline {
+            return Ok(Vec::new());
+        }
         baseline::measure(
             &mut session,
             &setup,
