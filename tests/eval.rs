@@ -53,9 +53,11 @@ fn out_dir(name: &str) -> PathBuf {
 
 /// Runs the tiny eval into `out`; fails the test if dvr fails (a validation message
 /// with DVR_VALIDATION=1 makes it exit with status 3).
-fn eval(out: &Path, frames: u32, ref_spp: u32) -> Output {
+fn eval(out: &Path, frames: u32, ref_spp: u32, extra: &[&str]) -> Output {
     let args = tiny_args(frames, ref_spp);
-    common::eval::dvr_ok(&args.iter().map(String::as_str).collect::<Vec<_>>(), out)
+    let mut args: Vec<&str> = args.iter().map(String::as_str).collect();
+    args.extend_from_slice(extra);
+    common::eval::dvr_ok(&args, out)
 }
 
 fn stderr(o: &Output) -> String {
@@ -96,7 +98,7 @@ fn num(s: &str, what: &str) -> f64 {
 #[test]
 fn tiny_eval_writes_tables_images_plots_and_reuses_references() {
     let out = out_dir("tiny");
-    let first = eval(&out, 3, 16);
+    let first = eval(&out, 3, 16, &[]);
     let scene = out.join("cloud_orbit");
 
     // metrics.csv: the exact header, one row per scene × method × frame, sane values.
@@ -233,7 +235,7 @@ fn tiny_eval_writes_tables_images_plots_and_reuses_references() {
         .collect();
     let before: Vec<SystemTime> = refs.iter().map(|p| mtime(p)).collect();
     std::thread::sleep(Duration::from_millis(20));
-    let second = eval(&out, 3, 16);
+    let second = eval(&out, 3, 16, &[]);
     assert!(
         stderr(&second).contains("reusing 3 reference frame(s)"),
         "{}",
@@ -251,9 +253,7 @@ fn tiny_eval_writes_tables_images_plots_and_reuses_references() {
             .collect()
     };
     let with_baseline = scores(&read(&out.join("metrics.csv")));
-    let mut args = tiny_args(3, 16);
-    args.push("--no-baseline".into());
-    let without = common::eval::dvr_ok(&args.iter().map(String::as_str).collect::<Vec<_>>(), &out);
+    let without = eval(&out, 3, 16, &["--no-baseline"]);
     assert!(
         stderr(&without).contains("reusing 3 reference frame(s)"),
         "{}",
@@ -264,7 +264,7 @@ fn tiny_eval_writes_tables_images_plots_and_reuses_references() {
 
     // An interrupted run (frame 2 missing) renders only what is missing.
     std::fs::remove_file(&refs[2]).unwrap();
-    let resumed = eval(&out, 3, 16);
+    let resumed = eval(&out, 3, 16, &[]);
     assert!(
         stderr(&resumed).contains("reusing 2 reference frame(s), rendering 1"),
         "{}",
@@ -274,7 +274,7 @@ fn tiny_eval_writes_tables_images_plots_and_reuses_references() {
     assert!(refs[2].is_file());
 
     // Different reference settings: all frames are re-rendered under the new key.
-    let changed = eval(&out, 3, 8);
+    let changed = eval(&out, 3, 8, &[]);
     assert!(
         stderr(&changed).contains("reference settings changed"),
         "{}",
@@ -390,7 +390,7 @@ fn results_page_works_in_headless_chromium() {
         return;
     };
     let out = out_dir("page");
-    eval(&out, 4, 16);
+    eval(&out, 4, 16, &[]);
     let url = |hash: &str| format!("file://{}#{hash}", out.join("index.html").display());
 
     // Without a hash: the last frame, the last method against the reference, side by
