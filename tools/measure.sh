@@ -5,9 +5,11 @@
 # book's results pages and README's headline table from those files.
 #
 #   tools/measure.sh SET [SET ...]     SET: demo static development validation paper
-#                                           suite cost rae cuts cut-cost labels
-#                                           labels-cost channels-cost statmap interaction
-#                                           mechanisms
+#                                           suite cost rae cut-cost labels-cost
+#                                           channels-cost interaction mechanisms
+#
+# The cut, channel-and-time and label-map scenes the results page shows by kind are the
+# development and validation sets' own: `mechanisms` and `validation` measure them.
 #
 # Needs a release build (cargo build --release). The eval sets also add Intel OIDN with
 # tools/oidn_eval.py, which needs a Python with the dvr package, pyoidn, numpy, OpenEXR
@@ -174,17 +176,6 @@ for set in "$@"; do
       done
       meta cost "$out" "$secs" "dvr profile --scene S --frames 30 --size 256x256 --denoiser ours,svgf --json out/cost/S.json, S = mri/point-light, phantom/orbit"
       ;;
-    cuts)
-      # The cut scenes: three development scenes and the validation scene, at the
-      # validation set's size and reference count.
-      d=assets/scenes/development
-      args=(--scene "$d/mri-clip-sweep.toml,$d/phantom-crop-shrink.toml,$d/phantom-clip-toggle.toml,assets/scenes/validation/cloud-oblique-clip-light.toml"
-        --size 128x128 --frames 48 --ref-spp 256 --aux --denoiser none,taa,svgf,ours)
-      timed "$dvr" eval "${args[@]}" --out "$out"
-      oidn "$out"
-      KEEP_METRICS=1 keep cuts "$out"
-      meta cuts "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
-      ;;
     cut-cost)
       # The same view with and without a plane that removes half the volume, profiled
       # alternately (two runs each), so the machine's drift falls on both.
@@ -212,17 +203,6 @@ with open("assets/results/cut-cost/profile.csv", "w", newline="") as f:
             w.writerow(["phantom/orbit", what, run, f"{pt:.3f}", f"{p['total']['median_ms']:.3f}"])
 EOF2
       meta cut-cost "$out" "$secs" "dvr profile --scene S --frames 20 --size 256x256 --denoiser ours, S = phantom/orbit with and without [[clip]] point [0,0,0] normal [1,0,0], alternating, two runs each"
-      ;;
-    labels)
-      # The label-map scenes: two development scenes and the validation scene, at the
-      # validation set's size and reference count.
-      d=assets/scenes/development
-      args=(--scene "$d/phantom-labels-skull-orbit.toml,$d/mri-labels-fade.toml,assets/scenes/validation/mri-labels-solid-orbit.toml"
-        --size 128x128 --frames 48 --ref-spp 256 --aux --denoiser none,taa,svgf,ours)
-      timed "$dvr" eval "${args[@]}" --out "$out"
-      oidn "$out"
-      KEEP_METRICS=1 keep labels "$out"
-      meta labels "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
     channels-cost)
       # What the channels of a medium cost the path tracer: the MNI T1 under the layered
@@ -323,16 +303,6 @@ EOF2
         printf '%s,%s\n' "$name" "$spec" >> "assets/results/mechanisms/overrides.csv"
       done
       meta mechanisms "$out" "$total" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out; for each run,override of overrides.csv: DVR_OURS=override dvr eval --scene development --frames 48 --size 128x128 --ref-spp 256 --denoiser ours --out $out-run"
-      ;;
-    statmap)
-      # The development two-channel head (the T1 and a statistical map over it) under a
-      # moving light, at the channel and time sets' size and reference count.
-      args=(--scene assets/scenes/development/mri-statmap-light.toml
-        --size 128x128 --frames 48 --ref-spp 256 --aux --denoiser none,taa,svgf,ours)
-      timed "$dvr" eval "${args[@]}" --out "$out"
-      oidn "$out"
-      KEEP_METRICS=1 keep statmap "$out"
-      meta statmap "$out" "$secs" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out"
       ;;
     labels-cost)
       # Two heads under opaque TFs, each labelled everywhere it has tissue (label 0 is

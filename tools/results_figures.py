@@ -1,13 +1,15 @@
 """The charts the pages show, drawn as SVG from the runs' CSVs (standard library only, so
 the same files come out on every machine and `tools/results.py --check` can compare
-them): speed against accuracy on the validation set, and the interaction set's
-per-frame PSNR. `FIGURES` maps each file to the function that draws it; the blocks in
-tools/results.py that show a figure also state what it shows in words."""
+them): speed against accuracy on the validation set, and per-frame PSNR of the
+interaction set and of the scenes shown by kind (cuts, channels and time, label maps).
+`FIGURES` maps each file to the function that draws it; the blocks in tools/results.py
+that show a figure also state what it shows in words."""
 
 import math
 from xml.sax.saxutils import escape
 
 from results_io import read_csv, num, frames_by_scene, table, source
+from results_sets import GROUPS, group_frames
 
 # What the chart compares and in which colour; ours is red, as in the eval's charts.
 COLOURS = {
@@ -186,11 +188,10 @@ def speed_accuracy_svg():
     return _svg(760, 440, p.out)
 
 
-def interaction_curves_svg():
-    """Per-frame PSNR of svgf, oidn-aux and ours on every scene of the interaction run,
-    one small chart per scene."""
-    by = frames_by_scene(read_csv("interaction", "metrics.csv"))
-    scenes = sorted(by)
+def curves_svg(by):
+    """Per-frame PSNR of svgf, oidn-aux and ours, one small chart per scene of `by`
+    ({scene: {frame: {method: psnr}}}, charted in its order)."""
+    scenes = list(by)
     cols = 3
     cw, ch = 300, 170
     rows = math.ceil(len(scenes) / cols)
@@ -222,10 +223,18 @@ def interaction_curves_svg():
     return _svg(w, h, body)
 
 
+def interaction_curves_svg():
+    """The interaction run's scenes, by name."""
+    by = frames_by_scene(read_csv("interaction", "metrics.csv"))
+    return curves_svg({sc: by[sc] for sc in sorted(by)})
+
+
 # Each figure: its file under the repository and the function that draws it.
 FIGURES = {
     "assets/results/validation/speed-accuracy.svg": speed_accuracy_svg,
     "assets/results/interaction/curves.svg": interaction_curves_svg,
+    **{f"assets/results/curves/{kind}.svg": (lambda kind=kind: curves_svg(group_frames(kind)))
+       for kind in GROUPS},
 }
 
 

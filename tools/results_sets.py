@@ -1,10 +1,11 @@
-"""The results blocks of the eval sets beside the validation set (the cut scenes, the
-channel and time scenes, the label-map scenes, ours' mechanisms switched off one at a
-time), of what a cut or a label map costs, and
-the time of each step of the two commands on a fresh machine (`tools/results.py` lists
-every block)."""
+"""The results blocks beside the validation set's: the scenes shown by kind (cuts,
+channels and time, label maps; each scene from its set's run), the interaction set, ours'
+mechanisms switched off one at a time, what a cut or a label map costs, and the time of
+each step of the two commands on a fresh machine (`tools/results.py` lists every
+block)."""
 
 from results_io import (
+    Missing,
     read_csv,
     read_json,
     num,
@@ -22,49 +23,6 @@ from results_io import (
     SINGLE_FRAME,
     own_ms,
 )
-
-
-def cut_frames(metrics):
-    """Per scene: the closest frame after frame 4 of ours to the better of svgf and taa,
-    as (margin dB, frame)."""
-    return {sc: worst_margin(frames, ["svgf", "taa"]) for sc, frames in frames_by_scene(metrics).items()}
-
-
-def set_table(folder, skip=()):
-    """Mean PSNR per scene of an eval set run at 128×128 over 48 frames with 256-spp
-    references, with ours' closest frame after frame 4 to the better of svgf and taa, and
-    ours against oidn-aux on the mean; its source line. Scenes in `skip` are left out."""
-    rows = [r for r in read_csv(folder, "summary.csv") if r["scene"] not in skip]
-    metrics = read_csv(folder, "metrics.csv")
-    methods = present(rows, ["none", "taa", "svgf", "oidn", "oidn-aux", "ours"])
-    worst = cut_frames(metrics)
-    body = []
-    for sc in scenes_of(rows):
-        v = {r["method"]: r for r in rows if r["scene"] == sc}
-        bp = best({x: num(v[x]["psnr"]) for x in methods if x in v}, True)
-        cells = [sc] + [bold_if(fmt(num(v[x]["psnr"]), 2), fmt(num(v[x]["psnr"]), 2) == fmt(bp, 2))
-                        for x in methods]
-        w = worst.get(sc)
-        cells.append(f"{w[0]:+.2f} (frame {w[1]})" if w else "")
-        if "oidn-aux" in v:
-            cells.append(f"{num(v['ours']['psnr']) - num(v['oidn-aux']['psnr']):+.2f}")
-        body.append(cells)
-    header = ["scene"] + [f"`{x}`" for x in methods] + [
-        "ours − max(svgf, taa), closest frame after 4", "ours − oidn-aux, mean"]
-    return "\n".join([
-        "Mean PSNR (dB) per scene, 128×128, 48 frames, 256-spp references:",
-        "",
-        table(header, body),
-        "",
-        source(folder, ["summary.csv", "metrics.csv"]),
-    ])
-
-
-def in_validation_run(folder):
-    """The scenes of a set's run that the validation set's run also holds: each scene's
-    figures come from one run, the validation set's."""
-    val = set(scenes_of(read_csv("validation", "summary.csv")))
-    return [sc for sc in scenes_of(read_csv(folder, "summary.csv")) if sc in val]
 
 
 def b_interaction():
@@ -104,72 +62,152 @@ def b_interaction():
     ])
 
 
+# The scenes of each kind the results page shows together, in the order shown. Each
+# scene's figures come from the one run that judges its set: the development set's
+# (`tools/measure.sh mechanisms`) or the validation set's (`tools/measure.sh validation`),
+# so a scene has one number wherever it appears.
+GROUPS = {
+    "cuts": ["dev/mri-clip-sweep", "dev/phantom-crop-shrink", "dev/phantom-clip-toggle",
+             "val/cloud-oblique-clip-light"],
+    "media": ["dev/shell-beat-still", "dev/shell-beat-orbit", "dev/microscopy-orbit",
+              "dev/mri-statmap-light", "val/shell-twobeat-rim",
+              "val/microscopy-tif-marker-light", "val/statmap-opaque-orbit"],
+    "labels": ["dev/phantom-labels-skull-orbit", "dev/mri-labels-fade",
+               "val/mri-labels-solid-orbit"],
+}
+# The run that holds each set's scenes, by the scene name's prefix, and what it is.
+RUNS = {"dev/": "mechanisms", "val/": "validation"}
+RUN_NAMES = {"mechanisms": "the development set's run", "validation": "the validation set's run"}
+# The results page's section that shows each run's own source line.
+RUN_SECTIONS = {"mechanisms": ("every mechanism", "every-mechanism-on-the-development-set"),
+                "validation": ("the validation set", "the-validation-set")}
+
+
+def runs_of(kind):
+    """The runs that hold a group's scenes, in the order of their first scene."""
+    out = []
+    for sc in GROUPS[kind]:
+        run = RUNS[sc[:4]]
+        if run not in out:
+            out.append(run)
+    return out
+
+
+def group_rows(kind, name):
+    """A group's rows of each run's `name` (summary.csv or metrics.csv), in the group's
+    scene order. A scene no run holds is an error naming it."""
+    rows = [r for run in runs_of(kind) for r in read_csv(run, name)]
+    held = set(scenes_of(rows))
+    missing = [sc for sc in GROUPS[kind] if sc not in held]
+    if missing:
+        raise Missing(f"the scene(s) {', '.join(missing)} in {', '.join(runs_of(kind))}")
+    order = {sc: i for i, sc in enumerate(GROUPS[kind])}
+    return sorted((r for r in rows if r["scene"] in order), key=lambda r: order[r["scene"]])
+
+
+def group_frames(kind):
+    """{scene: {frame: {method: psnr}}} of a group, in its scene order."""
+    return frames_by_scene(group_rows(kind, "metrics.csv"))
+
+
+def group_source(kind):
+    """Where a group's figures come from: each run's files, commit and date, and the
+    section whose source line gives its command and machine."""
+    parts = []
+    for run in runs_of(kind):
+        meta = read_json(run, "meta.json")
+        parts.append(f"{RUN_NAMES[run]} (`assets/results/{run}/summary.csv`, `metrics.csv`; "
+                     f"commit {meta['commit']}, {meta['date']}; its command and machine: "
+                     f"[{RUN_SECTIONS[run][0]}](#{RUN_SECTIONS[run][1]}))")
+    return "Sources: " + " and ".join(parts) + "."
+
+
+def cut_frames(frames):
+    """Per scene: the closest frame after frame 4 of ours to the better of svgf and taa,
+    as (margin dB, frame)."""
+    return {sc: worst_margin(f, ["svgf", "taa"]) for sc, f in frames.items()}
+
+
+def group_table(kind):
+    """Mean PSNR per scene of a group (128×128, 48 frames, 256-spp references), with ours'
+    closest frame after frame 4 to the better of svgf and taa and ours against oidn-aux on
+    the mean; the per-frame chart of ours, oidn-aux and svgf; the sources."""
+    rows = group_rows(kind, "summary.csv")
+    methods = present(rows, ["none", "taa", "svgf", "oidn", "oidn-aux", "ours"])
+    worst = cut_frames(group_frames(kind))
+    body = []
+    for sc in scenes_of(rows):
+        v = {r["method"]: r for r in rows if r["scene"] == sc}
+        bp = best({x: num(v[x]["psnr"]) for x in methods if x in v}, True)
+        cells = [sc] + [bold_if(fmt(num(v[x]["psnr"]), 2), fmt(num(v[x]["psnr"]), 2) == fmt(bp, 2))
+                        for x in methods]
+        w = worst.get(sc)
+        cells.append(f"{w[0]:+.2f} (frame {w[1]})" if w else "")
+        if "oidn-aux" in v:
+            cells.append(f"{num(v['ours']['psnr']) - num(v['oidn-aux']['psnr']):+.2f}")
+        body.append(cells)
+    header = ["scene"] + [f"`{x}`" for x in methods] + [
+        "ours − max(svgf, taa), closest frame after 4", "ours − oidn-aux, mean"]
+    return "\n".join([
+        "Mean PSNR (dB) per scene, 128×128, 48 frames, 256-spp references, each scene from "
+        "its set's run:",
+        "",
+        table(header, body),
+        "",
+        f"![Per-frame PSNR of svgf, oidn-aux and ours on each scene](../../assets/results/curves/{kind}.svg)",
+        "",
+        group_source(kind),
+    ])
+
+
+def group_line(kind, what):
+    """README's sentence on a group: ours against oidn-aux per scene, and its closest
+    frame to the better of svgf and taa after frame 4."""
+    rows = group_rows(kind, "summary.csv")
+    worst = cut_frames(group_frames(kind))
+    psnr = {(r["scene"], r["method"]): num(r["psnr"]) for r in rows}
+    pairs = ", ".join(f"`{sc}` {fmt(psnr[(sc, 'ours')], 2)} / {fmt(psnr.get((sc, 'oidn-aux')), 2)}"
+                      for sc in scenes_of(rows))
+    closest = min((w for w in worst.values() if w), key=lambda w: w[0])
+    versus = (f"is above the better of `svgf` and `taa` on every frame (closest {closest[0]:+.2f} dB)"
+              if closest[0] >= 0 else
+              f"falls below the better of `svgf` and `taa` (at worst {closest[0]:+.2f} dB, frame {closest[1]})")
+    commits = {run: read_json(run, "meta.json")["commit"] for run in runs_of(kind)}
+    runs = " and ".join(f"{RUN_NAMES[run]}" for run in commits)
+    made = (f"commit {next(iter(commits.values()))} ({runs})" if len(set(commits.values())) == 1
+            else "; ".join(f"{RUN_NAMES[run]} at commit {c}" for run, c in commits.items()))
+    sources = ", ".join(f"`assets/results/{run}/`" for run in commits)
+    return (
+        f"Mean PSNR (dB) of `ours` / `oidn-aux` on {what}, 128×128, 48 frames, 256-spp "
+        f"references: {pairs}. After frame 4, `ours` {versus}. From the runs that judge "
+        f"each set, {made}; sources: {sources}."
+    )
+
+
 def b_cuts():
-    shared = in_validation_run("cuts")
-    return "\n".join([set_table("cuts", shared), "", validation_run_note("cuts", shared)])
+    return group_table("cuts")
+
+
+def b_cuts_line():
+    return group_line("cuts", "the cut scenes")
 
 
 def b_media():
     """The channel and time scenes: several fields in one medium, 4D series played."""
-    return set_table("media")
-
-
-def b_statmap():
-    """The development two-channel head under a moving light, run on its own."""
-    return set_table("statmap")
-
-
-def validation_run_note(folder, shared):
-    """Where the table leaves out a scene the validation set's run holds: where its
-    figures are, and that the images below are this run's."""
-    if not shared:
-        return ""
-    val = read_json("validation", "meta.json")
-    names = ", ".join(f"`{sc}`" for sc in shared)
-    return (f"{names}, a validation scene, is in [the validation set's table](#the-validation-set) "
-            f"(commit {val['commit']}) and not repeated here; the frames and the per-frame chart "
-            f"below are this run's (commit {read_json(folder, 'meta.json')['commit']}).")
-
-
-def set_line(folder, what, skip=()):
-    """README's sentence on an eval set: ours against oidn-aux per scene, and its closest
-    frame to the better of svgf and taa after frame 4. Scenes in `skip` are left out."""
-    rows = [r for r in read_csv(folder, "summary.csv") if r["scene"] not in skip]
-    worst = cut_frames([r for r in read_csv(folder, "metrics.csv") if r["scene"] not in skip])
-    psnr = {(r["scene"], r["method"]): num(r["psnr"]) for r in rows}
-    scenes = scenes_of(rows)
-    pairs = ", ".join(f"`{sc}` {fmt(psnr[(sc, 'ours')], 2)} / {fmt(psnr.get((sc, 'oidn-aux')), 2)}"
-                      for sc in scenes)
-    closest = min((w for w in worst.values() if w), key=lambda w: w[0])
-    meta = read_json(folder, "meta.json")
-    versus = (f"is above the better of `svgf` and `taa` on every frame (closest {closest[0]:+.2f} dB)"
-              if closest[0] >= 0 else
-              f"falls below the better of `svgf` and `taa` (at worst {closest[0]:+.2f} dB, frame {closest[1]})")
-    return (
-        f"Mean PSNR (dB) of `ours` / `oidn-aux` on {what}, 128×128, 48 frames, 256-spp "
-        f"references: {pairs}. After frame 4, `ours` {versus}. Commit {meta['commit']}"
-    )
-
-
-def b_cuts_line():
-    shared = in_validation_run("cuts")
-    also = (f"; {', '.join(f'`{sc}`' for sc in shared)} is among the validation set's means above "
-            "([per scene](docs/src/results.md#the-validation-set))") if shared else ""
-    return (set_line("cuts", "the development set's cut scenes", shared)
-            + f"; source: `assets/results/cuts/`{also}.")
+    return group_table("media")
 
 
 def b_media_line():
-    return set_line("media", "the channel and time scenes") + "; source: `assets/results/media/`."
+    return group_line("media", "the channel and time scenes")
 
 
 def b_labels():
     """The label-map scenes: segmentations hidden, faded and shown as solid tissue."""
-    return set_table("labels")
+    return group_table("labels")
 
 
 def b_labels_line():
-    return set_line("labels", "the label-map scenes") + "; source: `assets/results/labels/`."
+    return group_line("labels", "the label-map scenes")
 
 
 def b_labels_cost():

@@ -11,6 +11,7 @@ import csv
 import importlib
 import json
 import re
+import shutil
 import sys
 
 import numpy as np
@@ -246,6 +247,32 @@ def test_the_strip_has_a_labelled_tile_per_scene_and_method_holding_that_frame(r
             band = img[y : y + label, x : x + w]
             assert (band != strip.BACKGROUND).any(axis=-1).sum() > 5, (scene, method)
             assert ((band == strip.BACKGROUND).all(axis=-1)).mean() > 0.3, (scene, method)
+
+
+def test_the_strip_takes_the_named_scenes_of_two_evals_in_the_order_named(root, tmp_path):
+    from PIL import Image
+
+    strip = _tool(root, "strip")
+    # Two evals: "head" in one, "brain" in the other; named head first.
+    _fake_eval_for_strip(tmp_path / "a", 4)
+    _fake_eval_for_strip(tmp_path / "b", 4)
+    shutil.rmtree(tmp_path / "a" / "brain")
+    shutil.rmtree(tmp_path / "b" / "head")
+    out = tmp_path / "strip.png"
+    strip.main([str(tmp_path / "a"), str(tmp_path / "b"), "--scenes", "head,brain", "--frame", "4",
+                "--methods", "ours", "--strip", str(out), "--scale", "1"])
+    img = np.asarray(Image.open(out).convert("RGB"))
+    w, h, label = 20, 6, strip.LABEL
+    assert img.shape == (2 * (h + label), 2 * w, 3)
+    for r, scene in enumerate(("head", "brain")):
+        tile = img[r * (h + label) + label : (r + 1) * (h + label), w : 2 * w]
+        assert (tile == STRIP_COLOURS[scene, "ours"]).all(), scene
+    # A scene no eval holds, or one both hold, is named.
+    with pytest.raises(SystemExit, match="scene lung is in 0 of the evals"):
+        strip.strip([tmp_path / "a", tmp_path / "b"], 4, ["ours"], names=["lung"])
+    _fake_eval_for_strip(tmp_path / "c", 4)
+    with pytest.raises(SystemExit, match="scene head is in 2 of the evals"):
+        strip.strip([tmp_path / "a", tmp_path / "c"], 4, ["ours"], names=["head"])
 
 
 def test_a_missing_method_frame_is_an_error_naming_it(root, tmp_path):
