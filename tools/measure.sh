@@ -296,13 +296,14 @@ EOF2
       for o in "${overrides[@]}"; do
         IFS='|' read -r name spec <<< "$o"
         share_references "$out" "$out-$name"
+        # --no-baseline: these runs' scores are read, not the accumulation curve.
         DVR_OURS=$spec timed "$dvr" eval --scene development --frames 48 --size 128x128 \
-          --ref-spp 256 --denoiser ours --out "$out-$name"
+          --ref-spp 256 --denoiser ours --no-baseline --out "$out-$name"
         total=$(echo "$total + $secs" | bc)
         cp "$out-$name/metrics.csv" "assets/results/mechanisms/$name.csv"
         printf '%s,%s\n' "$name" "$spec" >> "assets/results/mechanisms/overrides.csv"
       done
-      meta mechanisms "$out" "$total" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out; for each run,override of overrides.csv: DVR_OURS=override dvr eval --scene development --frames 48 --size 128x128 --ref-spp 256 --denoiser ours --out $out-run"
+      meta mechanisms "$out" "$total" "dvr eval ${args[*]} --out $out && tools/oidn_eval.py $out; for each run,override of overrides.csv: DVR_OURS=override dvr eval --scene development --frames 48 --size 128x128 --ref-spp 256 --denoiser ours --no-baseline --out $out-run"
       ;;
     labels-cost)
       # Two heads under opaque TFs, each labelled everywhere it has tissue (label 0 is

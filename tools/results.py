@@ -70,7 +70,8 @@ from results_sets import (
     b_development_cost,
     b_setup_times,
 )
-from results_experiments import b_experiments_prior, b_experiments_strata, b_experiments_motion
+from results_experiments import (b_experiments_prior, b_experiments_strata, b_experiments_motion,
+                                 b_experiments_young)
 from results_figures import (
     FIGURES,
     b_speed_accuracy,
@@ -593,6 +594,9 @@ BLOCKS = {
                                                   "experiments-prior/base-development.csv",
                                                   "experiments-prior/rivals-development.csv",
                                                   "experiments-prior/base-validation.csv"]),
+    "experiments-young": (b_experiments_young, ["experiments-young/*.csv",
+                                                "experiments-young/meta.json",
+                                                "mechanisms/metrics.csv"]),
     "experiments-motion": (b_experiments_motion, ["experiments-motion/*.csv",
                                                   "experiments-motion/meta.json",
                                                   "mechanisms/no-clip.csv",

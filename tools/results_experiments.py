@@ -11,6 +11,7 @@ from results_io import (
     table,
     frames_by_scene,
     below_best,
+    gap_at,
     SINGLE_FRAME,
     own_ms,
 )
@@ -18,7 +19,8 @@ from results_io import (
 
 def experiment_runs(folder, validation_base=True):
     """The table of an experiments section's runs of ours' variants: each run's mean PSNR
-    and FLIP and its frames more than 1 dB below the best single-frame method.
+    and FLIP, its frames after frame 4 more than 1 dB below the best single-frame method,
+    and its mean gap to that method over the scenes at frames 0 and 1.
     `folder/runs.csv` names each run (run, set, build, change, and optionally file: a CSV
     under assets/results another section keeps, such as a base run on the same code);
     the validation set's base is `experiments-prior/base-validation.csv`: ours' and the
@@ -43,10 +45,13 @@ def experiment_runs(folder, validation_base=True):
             by_scene.setdefault(r["scene"], []).append(num(r["psnr"]))
         frames = frames_by_scene(rows + rivals[set_])
         below = sum(below_best(f, SINGLE_FRAME)[0] for f in frames.values())
+        first = [f"{g:+.2f}" if g is not None else "" for g in
+                 (mean(gap_at(f, k) for f in frames.values()) for k in (0, 1))]
         body.append([change, set_, build,
                      fmt(mean(mean(v) for v in by_scene.values()), 3),
-                     fmt(mean(num(r["flip"]) for r in rows), 4), str(below)])
-    return table(["change", "set", "build", "PSNR", "FLIP", "frames > 1 dB below"], body)
+                     fmt(mean(num(r["flip"]) for r in rows), 4), str(below)] + first)
+    return table(["change", "set", "build", "PSNR", "FLIP", "frames > 1 dB below",
+                  "frame 0", "frame 1"], body)
 
 
 def b_experiments_prior():
@@ -117,6 +122,37 @@ def b_experiments_motion():
         f"Source: `assets/results/experiments-motion/` (`runs.csv`, each run's CSV, "
         f"`costs.csv` and the timed runs it names; the base is "
         f"`assets/results/mechanisms/no-clip.csv`, ours' code of 387a560) and the "
+        f"mechanisms run's single-frame rows, made by `{meta['command']}` from commit "
+        f"{meta['commit']} ({meta['date']}) on {meta['machine']}.",
+    ])
+
+
+def b_experiments_young():
+    """Ours' à-trous range and reach and its gradients' pooling, density and process noise,
+    each moved alone from ours' values (at cdbdaa6), on the development set at 128²: the
+    runs' scores, then each scene's mean PSNR against ours' values."""
+    meta = read_json("experiments-young", "meta.json")
+    runs = read_csv("experiments-young", "runs.csv")
+
+    def scene_means(file):
+        by = {}
+        for r in read_csv(*file.split("/")):
+            by.setdefault(r["scene"], []).append(num(r["psnr"]))
+        return {sc: mean(v) for sc, v in by.items()}
+
+    base = scene_means(runs[0]["file"])
+    others = [(r["run"], scene_means(r["file"])) for r in runs[1:]]
+    body = [[sc] + [f"{m[sc] - base[sc]:+.2f}" for _, m in others] for sc in sorted(base)]
+    return "\n".join([
+        experiment_runs("experiments-young", validation_base=False),
+        "",
+        "Each scene's mean PSNR less ours' on main (dB), by the runs' names in "
+        "`runs.csv` (`k` the range κ, `lv5` five levels, `shr` the shrinkage, `cq7` "
+        "`change_q` 7, `s1` `stratum` 1):",
+        "",
+        table(["scene"] + [f"`{run}`" for run, _ in others], body),
+        "",
+        f"Source: `assets/results/experiments-young/` (`runs.csv` and each run's CSV) and the "
         f"mechanisms run's single-frame rows, made by `{meta['command']}` from commit "
         f"{meta['commit']} ({meta['date']}) on {meta['machine']}.",
     ])

@@ -192,6 +192,14 @@ def worst_margin(frames, rivals, after=4):
 SINGLE_FRAME = ("oidn", "oidn-aux", "rae")
 
 
+def gap_at(frames, frame, rivals=SINGLE_FRAME):
+    """Ours minus the best of `rivals` present at one frame of a scene's
+    {frame: {method: psnr}}, or None where either is missing."""
+    v = frames.get(frame, {})
+    have = [v[x] for x in rivals if v.get(x) is not None]
+    return None if v.get("ours") is None or not have else v["ours"] - max(have)
+
+
 def below_best(frames, rivals, by=1.0, after=4):
     """(frames after `after` more than `by` dB below the best of `rivals` present, frames
     compared) of one scene's {frame: {method: psnr}}."""

@@ -20,6 +20,7 @@ from results_io import (
     frames_by_scene,
     worst_margin,
     below_best,
+    gap_at,
     SINGLE_FRAME,
     own_ms,
 )
@@ -30,16 +31,11 @@ def b_interaction():
     single-frame method (oidn, oidn-aux, rae) at frame 0, at frame 1 and from frame 2 on,
     and the means over the scenes of the first two."""
     by = frames_by_scene(read_csv("interaction", "metrics.csv"))
-
-    def margin(v):
-        have = [v[x] for x in SINGLE_FRAME if v.get(x) is not None]
-        return None if v.get("ours") is None or not have else v["ours"] - max(have)
-
     body, first = [], {0: [], 1: []}
     for sc, frames in sorted(by.items()):
         cells = [sc]
         for f in (0, 1):
-            m = margin(frames.get(f, {}))
+            m = gap_at(frames, f)
             if m is not None:
                 first[f].append(m)
             cells.append("" if m is None else f"{m:+.2f}")
