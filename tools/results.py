@@ -71,7 +71,7 @@ from results_sets import (
     b_setup_times,
 )
 from results_experiments import (b_experiments_prior, b_experiments_strata, b_experiments_motion,
-                                 b_experiments_young)
+                                 b_experiments_young, b_experiments_guided)
 from results_figures import (
     FIGURES,
     b_speed_accuracy,
@@ -597,6 +597,10 @@ BLOCKS = {
     "experiments-young": (b_experiments_young, ["experiments-young/*.csv",
                                                 "experiments-young/meta.json",
                                                 "mechanisms/metrics.csv"]),
+    "experiments-guided": (b_experiments_guided, ["experiments-guided/*.csv",
+                                                  "experiments-guided/*.json",
+                                                  "experiments-young/base.csv",
+                                                  "mechanisms/metrics.csv"]),
     "experiments-motion": (b_experiments_motion, ["experiments-motion/*.csv",
                                                   "experiments-motion/meta.json",
                                                   "mechanisms/no-clip.csv",

@@ -66,32 +66,40 @@ def b_experiments_prior():
     ])
 
 
+def profile_table(folder, pass_header, pass_prefix):
+    """The profiles of `folder/profiles.csv` (change, files: two or more `dvr profile
+    --json` runs of each, alternated): the mean ms of ours' passes named `pass_prefix…`,
+    ours' cost with its features, svgf's, their ratio and ours' bytes per pixel per frame,
+    each the mean of the runs."""
+    def method(d, m):
+        return next(x for x in d["methods"] if x["method"] == m)
+
+    def passes(d):
+        return sum(x["mean_ms"] for x in d["passes"] if x["pass"].startswith(pass_prefix))
+
+    body = []
+    for r in read_csv(folder, "profiles.csv"):
+        runs = [read_json(folder, f) for f in r["files"].split()]
+        ours = mean(method(d, "ours")["cost_ms"] for d in runs)
+        svgf = mean(method(d, "svgf")["cost_ms"] for d in runs)
+        body.append([r["change"], runs[0]["scene"], str(len(runs)),
+                     fmt(mean(passes(d) for d in runs), 1), fmt(ours, 1), fmt(svgf, 1),
+                     fmt(ours / svgf, 2),
+                     fmt(mean(method(d, "ours")["bytes_per_pixel"] for d in runs), 0)])
+    return table(["change", "scene", "runs", pass_header, "ours ms (features counted)",
+                  "svgf ms", "ours / svgf", "ours bytes per pixel"], body)
+
+
 def b_experiments_strata():
     """The gradients' strata at full density (`DVR_OURS=stratum=1`) against the stratum
     on main: the runs' scores, then the profiles (two runs of each, alternated): ours'
     cost with its features, svgf's, their ratio, the gradient pass and ours' bytes per
     pixel per frame, each the mean of the runs."""
-    def method(d, m):
-        return next(x for x in d["methods"] if x["method"] == m)
-
-    def gradient(d):
-        return next(x["mean_ms"] for x in d["passes"] if x["pass"] == "ours.gradient")
-
-    body = []
-    for r in read_csv("experiments-strata", "profiles.csv"):
-        runs = [read_json("experiments-strata", f) for f in r["files"].split()]
-        ours = mean(method(d, "ours")["cost_ms"] for d in runs)
-        svgf = mean(method(d, "svgf")["cost_ms"] for d in runs)
-        body.append([r["change"], runs[0]["scene"], str(len(runs)),
-                     fmt(mean(gradient(d) for d in runs), 1), fmt(ours, 1), fmt(svgf, 1),
-                     fmt(ours / svgf, 2),
-                     fmt(mean(method(d, "ours")["bytes_per_pixel"] for d in runs), 0)])
     meta = read_json("experiments-strata", "meta.json")
     return "\n".join([
         experiment_runs("experiments-strata"),
         "",
-        table(["change", "scene", "runs", "`ours.gradient` ms", "ours ms (features counted)",
-               "svgf ms", "ours / svgf", "ours bytes per pixel"], body),
+        profile_table("experiments-strata", "`ours.gradient` ms", "ours.gradient"),
         "",
         f"Source: `assets/results/experiments-strata/` (`runs.csv` and each run's CSV, "
         f"`profiles.csv` and the profiles it names), `assets/results/experiments-prior/` "
@@ -127,22 +135,28 @@ def b_experiments_motion():
     ])
 
 
+def scene_means(file):
+    """{scene: mean PSNR} of a run's CSV (`folder/name.csv` under assets/results)."""
+    by = {}
+    for r in read_csv(*file.split("/")):
+        by.setdefault(r["scene"], []).append(num(r["psnr"]))
+    return {sc: mean(v) for sc, v in by.items()}
+
+
+def scene_table(runs):
+    """Each scene's mean PSNR less the first run's, by the other runs' names (`runs`: rows
+    of a runs.csv with run and file)."""
+    base = scene_means(runs[0]["file"])
+    others = [(r["run"], scene_means(r["file"])) for r in runs[1:]]
+    body = [[sc] + [f"{m[sc] - base[sc]:+.2f}" for _, m in others] for sc in sorted(base)]
+    return table(["scene"] + [f"`{run}`" for run, _ in others], body)
+
+
 def b_experiments_young():
     """Ours' à-trous range and reach and its gradients' pooling, density and process noise,
     each moved alone from ours' values (at cdbdaa6), on the development set at 128²: the
     runs' scores, then each scene's mean PSNR against ours' values."""
     meta = read_json("experiments-young", "meta.json")
-    runs = read_csv("experiments-young", "runs.csv")
-
-    def scene_means(file):
-        by = {}
-        for r in read_csv(*file.split("/")):
-            by.setdefault(r["scene"], []).append(num(r["psnr"]))
-        return {sc: mean(v) for sc, v in by.items()}
-
-    base = scene_means(runs[0]["file"])
-    others = [(r["run"], scene_means(r["file"])) for r in runs[1:]]
-    body = [[sc] + [f"{m[sc] - base[sc]:+.2f}" for _, m in others] for sc in sorted(base)]
     return "\n".join([
         experiment_runs("experiments-young", validation_base=False),
         "",
@@ -150,9 +164,56 @@ def b_experiments_young():
         "`runs.csv` (`k` the range κ, `lv5` five levels, `shr` the shrinkage, `cq7` "
         "`change_q` 7, `s1` `stratum` 1):",
         "",
-        table(["scene"] + [f"`{run}`" for run, _ in others], body),
+        scene_table(read_csv("experiments-young", "runs.csv")),
         "",
         f"Source: `assets/results/experiments-young/` (`runs.csv` and each run's CSV) and the "
         f"mechanisms run's single-frame rows, made by `{meta['command']}` from commit "
         f"{meta['commit']} ({meta['date']}) on {meta['machine']}.",
+    ])
+
+
+def b_experiments_guided():
+    """A second à-trous pass whose range compares the first pass's output (at 5364ed7): the
+    development set's runs and each scene's mean, the cloud scenes' first frames, and the
+    passes' cost."""
+    folder = "experiments-guided"
+    meta = read_json(folder, "meta.json")
+    clouds = read_csv(folder, "clouds.csv")
+
+    def frames(file):
+        by = {}
+        for r in read_csv(*file.split("/")):
+            by.setdefault(int(r["frame"]), []).append(num(r["psnr"]))
+        return by
+
+    def spans(file):
+        by = frames(file)
+        later = [v for f, vs in by.items() if f >= 2 for v in vs]
+        return [mean(by[0]), mean(by[1]), mean(later), mean(v for vs in by.values() for v in vs)]
+
+    base = spans(clouds[0]["file"])
+    body = [[clouds[0]["change"], clouds[0]["build"]] + [fmt(v, 2) for v in base]]
+    for r in clouds[1:]:
+        body.append([r["change"], r["build"]]
+                    + [f"{v - b:+.2f}" for v, b in zip(spans(r["file"]), base)])
+    return "\n".join([
+        experiment_runs(folder, validation_base=False),
+        "",
+        "Each scene's mean PSNR less ours' on main (dB), by the runs' names in `runs.csv`:",
+        "",
+        scene_table(read_csv(folder, "runs.csv")),
+        "",
+        "The semi-transparent cloud (`cloud/orbit`, `cloud/point-light`, `cloud/dolly`, "
+        "`cloud/tf-sweep`, built-in scenes of the development set, at 128², 16 frames, "
+        "256-spp references), ours' mean PSNR over the four scenes at frame 0, frame 1, "
+        "frames 2–15 and all frames (the first row in dB, the others less it):",
+        "",
+        table(["change", "build", "frame 0", "frame 1", "frames 2–15", "mean"], body),
+        "",
+        profile_table(folder, "`ours.atrous*` ms", "ours.atrous"),
+        "",
+        f"Source: `assets/results/{folder}/` (`runs.csv`, `clouds.csv` and the CSVs they "
+        f"name, `profiles.csv` and the profiles it names), the mechanisms run's "
+        f"single-frame rows, made by `{meta['command']}` from commit {meta['commit']} "
+        f"({meta['date']}) on {meta['machine']}.",
     ])

@@ -17,23 +17,17 @@
 // structure it explains.
 #include "common.glsl"
 #include "atrous_tile.glsl"
-#include "ours_constants.glsl"
 
 layout(local_size_x = TILE, local_size_y = TILE) in;
 
 layout(binding = 0, rgba32f) uniform readonly image2D color_in;   // rgb prediction, a variance
 layout(binding = 1, rgba32f) uniform writeonly image2D color_out; // the same, filtered
 layout(binding = 2, rgba32f) uniform readonly image2D prediction;  // rgb x̂ (CARRY), a 0 where none
-layout(binding = 3, rgba32f) uniform readonly image2D guide;       // rgb, a variance (GUIDED)
-layout(binding = 4, rgba32f) uniform readonly image2D state_model; // (GUIDED) rgb, a P
-layout(binding = 5, rg32f) uniform readonly image2D state_noise;   // (GUIDED) R, D
 
 layout(constant_id = 16) const bool CARRY = false;
 // The input is a filter's state, radiance clamped at zero as it is read (ours: the update
 // writes no clamped copy).
 layout(constant_id = 17) const bool NONNEGATIVE = false;
-// The range term compares a guide's values (a first filtered estimate) in its variances.
-layout(constant_id = 18) const bool GUIDED = false;
 
 layout(push_constant) uniform VarianceAtrousPush {
     uint width;
@@ -81,14 +75,6 @@ void main() {
     }
     if (p.x >= size.x || p.y >= size.y) return;
     vec4 centre = tap(win, p);
-    if (GUIDED && pc.last != 0u && (pc.pad1 & 2u) != 0u) {
-        float r = imageLoad(state_noise, p).r;
-        float P = imageLoad(state_model, p).a;
-        if (P * FEEDBACK_HISTORY > r && r > 0.0) {
-            imageStore(color_out, p, vec4(max(imageLoad(guide, p).rgb, vec3(0.0)), 1.0));
-            return;
-        }
-    }
     // A pixel whose prediction is already precise (standard error below `keep` of its
     // value: a converged model) is kept as it is. Blending could only pull it towards
     // neighbours whose larger variances let their values in (the range term sums both),
@@ -99,7 +85,6 @@ void main() {
         return;
     }
     vec4 model = CARRY ? prediction_tap(win, p) : vec4(0.0);
-    vec4 gp = GUIDED ? imageLoad(guide, p) : vec4(0.0);
     float k0 = B3[0] * B3[0];
     vec3 sum = k0 * centre.rgb;
     float var_sum = k0 * k0 * centre.a;
@@ -117,15 +102,7 @@ void main() {
                                    max(cq.rgb, centre.rgb));
                 }
             }
-            float range;
-            if (GUIDED) {
-                vec4 gq = imageLoad(guide, q);
-                vec3 dg = gq.rgb - gp.rgb;
-                float gv = (pc.pad1 & 1u) != 0u ? centre.a + cq.a : (gp.a + gq.a) * uintBitsToFloat(pc.pad2);
-                range = dot(dg, dg) / 3.0 / (pc.kappa * pc.kappa * gv + RANGE_FLOOR);
-            } else {
-                range = dot(d, d) / 3.0 / (pc.kappa * pc.kappa * (centre.a + cq.a) + RANGE_FLOOR);
-            }
+            float range = dot(d, d) / 3.0 / (pc.kappa * pc.kappa * (centre.a + cq.a) + RANGE_FLOOR);
             float w = B3[abs(dx)] * B3[abs(dy)] * exp(-range);
             sum += w * cq.rgb;
             var_sum += w * w * cq.a;

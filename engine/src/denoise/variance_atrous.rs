@@ -28,23 +28,12 @@ pub fn pipeline(
     carry: bool,
     nonnegative: bool,
 ) -> Result<Pipeline<VarianceAtrousPush>> {
-    guided_pipeline(ctx, carry, nonnegative, false)
-}
-
-/// As [`pipeline`], with the range term on a guide image when `guided`.
-pub fn guided_pipeline(
-    ctx: &GpuContext,
-    carry: bool,
-    nonnegative: bool,
-    guided: bool,
-) -> Result<Pipeline<VarianceAtrousPush>> {
     ctx.pipeline(
         "variance_atrous",
         &[
             ("SHARED_TILES", SpecValue::Bool(ctx.shared_tiles)),
             ("CARRY", SpecValue::Bool(carry)),
             ("NONNEGATIVE", SpecValue::Bool(nonnegative)),
-            ("GUIDED", SpecValue::Bool(guided)),
         ],
     )
 }
@@ -60,12 +49,6 @@ pub struct Level {
     pub keep: f32,
     /// The last level writes the denoiser's output (alpha 1).
     pub last: bool,
-    /// Experiment: a guided level's range in the estimates' variances, not the guide's.
-    pub own_variance: bool,
-    /// Experiment: a guided last level keeps the guide where the state restarted.
-    pub select_fresh: bool,
-    /// Experiment: the guide's variance scaled by this in the range term.
-    pub guide_scale: f32,
 }
 
 /// Adds one level `name` from `src` into `dst` (with `prediction` for a `carry` pipeline).
@@ -80,43 +63,6 @@ pub fn add_level<'f>(
     dst: ImageHandle,
     prediction: Option<ImageHandle>,
 ) {
-    add_guided_level(
-        frame, pipeline, name, size, level, src, dst, prediction, None,
-    );
-}
-
-/// As [`add_level`], with a guide image for a guided pipeline.
-#[allow(clippy::too_many_arguments)]
-pub fn add_guided_level<'f>(
-    frame: &mut Frame<'f>,
-    pipeline: &'f Pipeline<VarianceAtrousPush>,
-    name: String,
-    size: Extent,
-    level: Level,
-    src: ImageHandle,
-    dst: ImageHandle,
-    prediction: Option<ImageHandle>,
-    guide: Option<ImageHandle>,
-) {
-    add_guided_level_state(
-        frame, pipeline, name, size, level, src, dst, prediction, guide, None,
-    );
-}
-
-/// As [`add_guided_level`], with the filter's state (model, noise).
-#[allow(clippy::too_many_arguments)]
-pub fn add_guided_level_state<'f>(
-    frame: &mut Frame<'f>,
-    pipeline: &'f Pipeline<VarianceAtrousPush>,
-    name: String,
-    size: Extent,
-    level: Level,
-    src: ImageHandle,
-    dst: ImageHandle,
-    prediction: Option<ImageHandle>,
-    guide: Option<ImageHandle>,
-    state: Option<(ImageHandle, ImageHandle)>,
-) {
     let push = VarianceAtrousPush {
         width: size.width,
         height: size.height,
@@ -124,16 +70,13 @@ pub fn add_guided_level_state<'f>(
         kappa: level.kappa,
         last: level.last as u32,
         keep: level.keep,
-        pad1: level.own_variance as u32 | (level.select_fresh as u32) << 1,
-        pad2: level.guide_scale.to_bits(),
+        pad1: 0,
+        pad2: 0,
     };
     frame.add_compute(name, pipeline, push, size, |b| {
         // Without CARRY the shader never reads `prediction`, but the binding exists.
         b.read("color_in", src)
             .write("color_out", dst)
-            .read("prediction", prediction.unwrap_or(src))
-            .read("guide", guide.unwrap_or(src))
-            .read("state_model", state.map_or(src, |s| s.0))
-            .read("state_noise", state.map_or(src, |s| s.1));
+            .read("prediction", prediction.unwrap_or(src));
     });
 }

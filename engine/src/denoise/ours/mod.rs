@@ -87,15 +87,6 @@ pub struct OursParams {
     /// pixel as it is (blending could only pull a converged estimate towards noisier
     /// neighbours).
     pub keep: f32,
-    /// Experiment: a second à-trous pass whose range term compares the first pass's
-    /// output (0: none; 1: feedback from the first pass; 2: from the second).
-    pub guided: f32,
-    /// Experiment: the guide's variance scale in the guided pass's range term.
-    pub gscale: f32,
-    /// Experiment: keep the first pass where the state restarted.
-    pub gselect: f32,
-    /// Experiment: the guided pass's levels (0: as the first).
-    pub glevels: f32,
 }
 
 impl Default for OursParams {
@@ -109,10 +100,6 @@ impl Default for OursParams {
             jump_z: 6.0,
             kappa: 6.0,
             keep: 0.02,
-            guided: 0.0,
-            gscale: 1.0,
-            gselect: 0.0,
-            glevels: 0.0,
         }
     }
 }
@@ -128,10 +115,6 @@ const OVERRIDABLE: &[Overridable<OursParams>] = &[
     ("jump_z", 0.5, 1e3, |p, v| p.jump_z = v),
     ("kappa", 0.5, 1e3, |p, v| p.kappa = v),
     ("keep", 0.0, 1.0, |p, v| p.keep = v),
-    ("guided", 0.0, 3.0, |p, v| p.guided = v),
-    ("gscale", 0.0, 1e6, |p, v| p.gscale = v),
-    ("gselect", 0.0, 1.0, |p, v| p.gselect = v),
-    ("glevels", 0.0, 6.0, |p, v| p.glevels = v),
 ];
 
 /// `DVR_OURS="change_q=2,keep=0.1"` sets parameters for a study with `dvr eval`.
@@ -189,7 +172,6 @@ pub struct Ours {
     atrous: Option<Pipeline<VarianceAtrousPush>>,
     /// The à-trous that carries neighbours by the prior's prediction (where there is one).
     atrous_carry: Option<Pipeline<VarianceAtrousPush>>,
-    atrous_guided: Option<Pipeline<VarianceAtrousPush>>,
     prior: PriorPipelines,
 }
 
@@ -236,9 +218,6 @@ impl Ours {
             atrous_carry: variant
                 .atrous
                 .then(|| variance_atrous::pipeline(ctx, true, true))
-                .transpose()?,
-            atrous_guided: (variant.atrous && params.guided > 0.0)
-                .then(|| variance_atrous::guided_pipeline(ctx, true, true, true))
                 .transpose()?,
             prior: PriorPipelines::new(ctx)?,
         })

@@ -40,9 +40,6 @@ impl Wrls {
             kappa: self.params.kappa,
             keep: 0.0,
             last: true,
-            own_variance: false,
-            guide_scale: 1.0,
-            select_fresh: false,
         };
         let name = format!("{}.atrous0", self.name);
         add_level(frame, pipeline, name, size, level, prediction, out, None);
