@@ -157,22 +157,6 @@ vec4 history_fetch_sharp(sampler2D history, Reprojection r) {
     return finite ? vec4(clamp(sum, lo, up), bilinear.a) : bilinear;
 }
 
-// Experiment: R over 15×15 (three row sums of 5 across, 15 rows), in the unit.
-float wide_noise(ivec2 p, ivec2 size) {
-    vec4 s = vec4(0.0);
-    for (int dy = -7; dy <= 7; ++dy) {
-        for (int dx = -5; dx <= 5; dx += 5) {
-            s += imageLoad(noise_rows, clamp(p + ivec2(dx, dy), ivec2(0), size - 1));
-        }
-    }
-    const float n = 225.0;
-    vec3 m = s.yzw / n;
-    float level2 = dot(m, m) / 3.0;
-    float L = luminance(m);
-    float colour_share = L * L > VARIANCE_FLOOR ? level2 / (L * L) : 1.0;
-    return s.x / n * colour_share + VARIANCE_FLOOR;
-}
-
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = ivec2(pc.width, pc.height);
@@ -192,7 +176,6 @@ void main() {
     if (fresh) {
         x = y;
         R = fresh_noise(sums);
-        if (pc.pad0 != 0u && pc.spp >= 2.0) R = max(R, wide_noise(p, size));
         P = R;
     } else {
         vec2 noise_state = history_fetch(noise_prev, r).xy;

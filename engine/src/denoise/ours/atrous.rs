@@ -32,11 +32,7 @@ impl Ours {
         // Scratch images of their own: without the prior the input is the filter's state
         // (a history), and no level may write into it.
         let ping = graph.image(ctx, &format!("{n}.atrous"), desc)?;
-        let levels = if self.params.lv > 0.0 {
-            self.params.lv as u32
-        } else {
-            super::ATROUS_LEVELS
-        };
+        let levels = super::ATROUS_LEVELS;
         let mut src = estimate;
         for i in 0..levels {
             let last = i + 1 == levels;
@@ -47,7 +43,7 @@ impl Ours {
             };
             let level = Level {
                 step: 1 << i,
-                kappa: self.params.kappa * if i >= 2 { self.params.kc } else { 1.0 },
+                kappa: self.params.kappa,
                 keep: self.params.keep,
                 last,
             };

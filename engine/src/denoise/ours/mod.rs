@@ -87,12 +87,6 @@ pub struct OursParams {
     /// pixel as it is (blending could only pull a converged estimate towards noisier
     /// neighbours).
     pub keep: f32,
-    /// Experiment: à-trous levels (0: ATROUS_LEVELS).
-    pub lv: f32,
-    /// Experiment: κ multiplier for levels from the third on.
-    pub kc: f32,
-    /// Experiment: a fresh pixel's R at least the 15×15 neighbourhood's.
-    pub wide: f32,
 }
 
 impl Default for OursParams {
@@ -106,9 +100,6 @@ impl Default for OursParams {
             jump_z: 6.0,
             kappa: 6.0,
             keep: 0.02,
-            lv: 0.0,
-            kc: 1.0,
-            wide: 0.0,
         }
     }
 }
@@ -124,9 +115,6 @@ const OVERRIDABLE: &[Overridable<OursParams>] = &[
     ("jump_z", 0.5, 1e3, |p, v| p.jump_z = v),
     ("kappa", 0.5, 1e3, |p, v| p.kappa = v),
     ("keep", 0.0, 1.0, |p, v| p.keep = v),
-    ("lv", 0.0, 6.0, |p, v| p.lv = v),
-    ("kc", 0.0, 100.0, |p, v| p.kc = v),
-    ("wide", 0.0, 1.0, |p, v| p.wide = v),
 ];
 
 /// `DVR_OURS="change_q=2,keep=0.1"` sets parameters for a study with `dvr eval`.

@@ -87,7 +87,7 @@ impl Ours {
             lag_z: p.lag_z,
             jump_z: p.jump_z,
             shift: self.variant.lag as u32,
-            pad0: (self.params.wide > 0.0) as u32,
+            pad0: 0,
             pad1: 0,
             pad2: 0,
         };
