@@ -2,6 +2,8 @@
 the single-frame methods, and the profiles of the strata (`tools/results.py` lists every
 block)."""
 
+import re
+
 from results_io import (
     read_csv,
     read_json,
@@ -66,16 +68,17 @@ def b_experiments_prior():
     ])
 
 
-def profile_table(folder, pass_header, pass_prefix):
+def profile_table(folder, pass_header, pass_name):
     """The profiles of `folder/profiles.csv` (change, files: two or more `dvr profile
-    --json` runs of each, alternated): the mean ms of ours' passes named `pass_prefix…`,
+    --json` runs of each, alternated): the mean ms of ours' passes whose whole name the
+    regular expression `pass_name` matches (`ours.gradient` is not `ours.gradient_pool`),
     ours' cost with its features, svgf's, their ratio and ours' bytes per pixel per frame,
     each the mean of the runs."""
     def method(d, m):
         return next(x for x in d["methods"] if x["method"] == m)
 
     def passes(d):
-        return sum(x["mean_ms"] for x in d["passes"] if x["pass"].startswith(pass_prefix))
+        return sum(x["mean_ms"] for x in d["passes"] if re.fullmatch(pass_name, x["pass"]))
 
     body = []
     for r in read_csv(folder, "profiles.csv"):
@@ -99,7 +102,7 @@ def b_experiments_strata():
     return "\n".join([
         experiment_runs("experiments-strata"),
         "",
-        profile_table("experiments-strata", "`ours.gradient` ms", "ours.gradient"),
+        profile_table("experiments-strata", "`ours.gradient` ms", r"ours\.gradient"),
         "",
         f"Source: `assets/results/experiments-strata/` (`runs.csv` and each run's CSV, "
         f"`profiles.csv` and the profiles it names), `assets/results/experiments-prior/` "
@@ -135,12 +138,17 @@ def b_experiments_motion():
     ])
 
 
-def scene_means(file):
-    """{scene: mean PSNR} of a run's CSV (`folder/name.csv` under assets/results)."""
+def psnr_by(file, key):
+    """{key(row): [PSNR, …]} of a run's CSV (`folder/name.csv` under assets/results)."""
     by = {}
     for r in read_csv(*file.split("/")):
-        by.setdefault(r["scene"], []).append(num(r["psnr"]))
-    return {sc: mean(v) for sc, v in by.items()}
+        by.setdefault(key(r), []).append(num(r["psnr"]))
+    return by
+
+
+def scene_means(file):
+    """{scene: mean PSNR} of a run's CSV."""
+    return {sc: mean(v) for sc, v in psnr_by(file, lambda r: r["scene"]).items()}
 
 
 def scene_table(runs):
@@ -173,25 +181,19 @@ def b_experiments_young():
 
 
 def b_experiments_guided():
-    """A second à-trous pass whose range compares the first pass's output (at 5364ed7): the
-    development set's runs and each scene's mean, the cloud scenes' first frames, and the
-    passes' cost."""
+    """Young pixels' spatial estimate (at 5364ed7 and 2b545c3): the development set's runs
+    and each scene's mean, the cloud scenes' first frames, and the guided pass's cost."""
     folder = "experiments-guided"
     meta = read_json(folder, "meta.json")
     clouds = read_csv(folder, "clouds.csv")
 
-    def frames(file):
-        by = {}
-        for r in read_csv(*file.split("/")):
-            by.setdefault(int(r["frame"]), []).append(num(r["psnr"]))
-        return by
-
     def spans(file):
-        by = frames(file)
+        by = psnr_by(file, lambda r: int(r["frame"]))
         later = [v for f, vs in by.items() if f >= 2 for v in vs]
         return [mean(by[0]), mean(by[1]), mean(later), mean(v for vs in by.values() for v in vs)]
 
     base = spans(clouds[0]["file"])
+    last = max(psnr_by(clouds[0]["file"], lambda r: int(r["frame"])))
     body = [[clouds[0]["change"], clouds[0]["build"]] + [fmt(v, 2) for v in base]]
     for r in clouds[1:]:
         body.append([r["change"], r["build"]]
@@ -204,13 +206,13 @@ def b_experiments_guided():
         scene_table(read_csv(folder, "runs.csv")),
         "",
         "The semi-transparent cloud (`cloud/orbit`, `cloud/point-light`, `cloud/dolly`, "
-        "`cloud/tf-sweep`, built-in scenes of the development set, at 128², 16 frames, "
-        "256-spp references), ours' mean PSNR over the four scenes at frame 0, frame 1, "
-        "frames 2–15 and all frames (the first row in dB, the others less it):",
+        f"`cloud/tf-sweep`, built-in scenes of the development set, at 128², {last + 1} "
+        f"frames, 256-spp references), ours' mean PSNR over the four scenes at frame 0, "
+        f"frame 1, frames 2–{last} and all frames (the first row in dB, the others less it):",
         "",
-        table(["change", "build", "frame 0", "frame 1", "frames 2–15", "mean"], body),
+        table(["change", "build", "frame 0", "frame 1", f"frames 2–{last}", "mean"], body),
         "",
-        profile_table(folder, "`ours.atrous*` ms", "ours.atrous"),
+        profile_table(folder, "`ours.atrous*` ms", r"ours\.atrous\d+"),
         "",
         f"Source: `assets/results/{folder}/` (`runs.csv`, `clouds.csv` and the CSVs they "
         f"name, `profiles.csv` and the profiles it names), the mechanisms run's "
