@@ -71,7 +71,7 @@ from results_sets import (
     b_setup_times,
 )
 from results_experiments import (b_experiments_prior, b_experiments_strata, b_experiments_motion,
-                                 b_experiments_young, b_experiments_guided)
+                                 b_experiments_young, b_experiments_guided, b_experiments_learned)
 from results_figures import (
     FIGURES,
     b_speed_accuracy,
@@ -601,6 +601,8 @@ BLOCKS = {
                                                   "experiments-guided/*.json",
                                                   "experiments-young/base.csv",
                                                   "mechanisms/metrics.csv"]),
+    "experiments-learned": (b_experiments_learned, ["experiments-learned/*.csv",
+                                                    "experiments-learned/meta.json"]),
     "experiments-motion": (b_experiments_motion, ["experiments-motion/*.csv",
                                                   "experiments-motion/meta.json",
                                                   "mechanisms/no-clip.csv",

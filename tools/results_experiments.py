@@ -219,3 +219,48 @@ def b_experiments_guided():
         f"single-frame rows, made by `{meta['command']}` from commit {meta['commit']} "
         f"({meta['date']}) on {meta['machine']}.",
     ])
+
+
+def b_experiments_learned():
+    """A learned single-frame estimate for young pixels (tools/young/, offline in torch):
+    each network's frame 0 on the development set at 128² and the cloud scenes, against
+    ours' frame 0 and the single-frame methods, then each scene for every network."""
+    folder = "experiments-learned"
+    meta = read_json(folder, "meta.json")
+    runs = read_csv(folder, "runs.csv")
+    body, per_scene = [], {}
+    for r in runs:
+        rows = [x for x in read_csv(folder, r["file"]) if int(x["frame"]) == 0]
+        for x in rows:
+            rivals = [num(x[m]) for m in SINGLE_FRAME if x.get(m) not in (None, "", "nan")]
+            per_scene.setdefault(x["scene"], {"ours": num(x["ours"]), "best": max(rivals)})[r["run"]] = num(x["young"])
+        # A half-resolution trunk does a quarter of the multiply-adds per output pixel;
+        # a convolution's multiply-adds per pixel are its weights.
+        macs = int(r["parameters"]) // (4 if r["half"] == "yes" else 1)
+        cells = []
+        for prefix in ("dev/", "cloud/"):
+            sel = [x for x in rows if x["scene"].startswith(prefix)]
+            young = [num(x["young"]) for x in sel]
+            own = [num(x["own"]) - num(x["ours"]) for x in sel if x.get("own")]
+            cells += [fmt(mean(young), 2),
+                      f"{mean(y - num(x['ours']) for y, x in zip(young, sel)):+.2f}",
+                      f"{mean(y - per_scene[x['scene']]['best'] for y, x in zip(young, sel)):+.2f}",
+                      f"{mean(own):+.2f}" if own else ""]
+        body.append([f"`{r['run']}`", r["change"], f"{macs:,}", r["clips"], r["minutes"]] + cells)
+    head = ["run", "network", "multiply-adds per pixel", "training clips", "training min"]
+    for s in ("development", "cloud"):
+        head += [f"{s} PSNR", "less ours", "less the best single-frame", "its own estimate less ours"]
+    names = [r["run"] for r in runs]
+    scene_rows = [[sc, fmt(v["ours"], 2), fmt(v["best"], 2)] + [fmt(v[n], 2) if n in v else "" for n in names]
+                  for sc, v in sorted(per_scene.items())]
+    return "\n".join([
+        table(head, body),
+        "",
+        "Each scene's frame 0 (PSNR, dB): ours, the best of `oidn`, `oidn-aux` and `rae`, "
+        "and each network (the fused ones' output):",
+        "",
+        table(["scene", "ours", "best single-frame"] + [f"`{n}`" for n in names], scene_rows),
+        "",
+        f"Source: `assets/results/{folder}/` (`runs.csv` and the CSVs it names), made by "
+        f"`{meta['command']}` from commit {meta['commit']} ({meta['date']}) on {meta['machine']}.",
+    ])
