@@ -234,8 +234,10 @@ def b_experiments_learned():
         for x in rows:
             rivals = [num(x[m]) for m in SINGLE_FRAME if x.get(m) not in (None, "", "nan")]
             per_scene.setdefault(x["scene"], {"ours": num(x["ours"]), "best": max(rivals)})[r["run"]] = num(x["young"])
-        # A half-resolution trunk does a quarter of the multiply-adds per output pixel;
-        # a convolution's multiply-adds per pixel are its weights.
+        # A convolution does one multiply-add per weight per pixel; the count below is the
+        # parameters (the biases, a few percent, counted as weights) and leaves out the
+        # kernels' application (4 levels × 9 taps × 3 channels). A half-resolution trunk
+        # does a quarter of them per output pixel.
         macs = int(r["parameters"]) // (4 if r["half"] == "yes" else 1)
         cells = []
         for prefix in ("dev/", "cloud/"):

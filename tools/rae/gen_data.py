@@ -43,18 +43,29 @@ def r4(v):
     return [round(float(x), 4) for x in v]
 
 
-def scene_of(dataset, rng, frames, spp):
-    """A random scene of `dataset` and what was drawn for it."""
-    tf = TFS[dataset][rng.integers(len(TFS[dataset]))]
-    # More and less transparent: the density scale spans 4x around the built-ins' 150.
-    density = float(np.exp(rng.uniform(np.log(60.0), np.log(300.0))))
+def camera_of(rng):
+    """A random viewpoint around the volume: distance, azimuth, elevation, a target near
+    the centre and a field of view."""
     dist = rng.uniform(1.2, 2.0)
     az = rng.uniform(0, 2 * math.pi)
     el = rng.uniform(-0.35, 0.7)
     cam = [dist * math.cos(el) * math.cos(az), dist * math.cos(el) * math.sin(az), dist * math.sin(el)]
     target = rng.uniform(-0.08, 0.08, 3)
-    fov = rng.uniform(30, 45)
-    speed = rng.choice([0.0, 1.0, 2.0, 4.0, 8.0]) * rng.choice([-1.0, 1.0])
+    return dvr.Camera(r4(cam), r4(target), fov_y_degrees=round(rng.uniform(30, 45), 2))
+
+
+def orbit_speed(rng):
+    """A random orbit speed in degrees per frame, either way round (0: still)."""
+    return float(rng.choice([0.0, 1.0, 2.0, 4.0, 8.0]) * rng.choice([-1.0, 1.0]))
+
+
+def scene_of(dataset, rng, frames, spp):
+    """A random scene of `dataset` and what was drawn for it."""
+    tf = TFS[dataset][rng.integers(len(TFS[dataset]))]
+    # More and less transparent: the density scale spans 4x around the built-ins' 150.
+    density = float(np.exp(rng.uniform(np.log(60.0), np.log(300.0))))
+    camera = camera_of(rng)
+    speed = orbit_speed(rng)
     # A key light of a random kind, direction, colour and intensity (order-1 radiance on
     # lit surfaces, like the built-ins), plus (usually) a dim environment fill.
     laz = rng.uniform(0, 2 * math.pi)
@@ -77,7 +88,7 @@ def scene_of(dataset, rng, frames, spp):
     render = {"spp": spp, "max_bounces": 4, "phase": str(rng.choice(["isotropic", "hg"])),
               "hg_g": round(float(rng.uniform(-0.3, 0.6)), 2)}
     scene = dvr.Scene(dataset, tf=dvr.TransferFunction.preset(tf), lights=lights, frames=frames,
-                      camera=dvr.Camera(r4(cam), r4(target), fov_y_degrees=round(fov, 2)),
+                      camera=camera,
                       density_scale=round(density, 2),
                       render=render, name=f"rae-{dataset}")
     if speed != 0.0:

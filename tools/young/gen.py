@@ -16,7 +16,6 @@ Needs the dvr package in the Python that runs it (a release wheel: `maturin buil
 import argparse
 import io
 import json
-import math
 import os
 import sys
 import time
@@ -38,15 +37,11 @@ FILES = {
 def file_scene(ds, rng, frames):
     scene = dvr.Scene.load(FILES[ds])
     scene.frames = frames
-    dist = rng.uniform(1.2, 2.0)
-    az, el = rng.uniform(0, 2 * math.pi), rng.uniform(-0.35, 0.7)
-    cam = [dist * math.cos(el) * math.cos(az), dist * math.cos(el) * math.sin(az), dist * math.sin(el)]
-    scene.camera = dvr.Camera(gen_data.r4(cam), gen_data.r4(rng.uniform(-0.08, 0.08, 3)),
-                              fov_y_degrees=round(rng.uniform(30, 45), 2))
+    scene.camera = gen_data.camera_of(rng)
     scale = rng.uniform(0.5, 2.0)
     for light in scene.lights:
         light.intensity = round(light.intensity * scale, 3)
-    speed = float(rng.choice([0.0, 1.0, 2.0, 4.0, 8.0]) * rng.choice([-1.0, 1.0]))
+    speed = gen_data.orbit_speed(rng)
     if speed != 0.0:
         scene.orbit(degrees_per_frame=speed)
     return scene, dict(file=FILES[ds], light_scale=scale, speed=speed)
