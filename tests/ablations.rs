@@ -6,7 +6,8 @@
 //! for bit, frame by frame. What the switched stage does not reach must be identical; what
 //! it does must differ, and only where it acted. The feedback carries the first à-trous
 //! level, and with it the prior's combination, into the states that restarted: the state
-//! is then downstream of every spatial stage.
+//! is then downstream of every spatial stage. The young-pixel network, on the first
+//! frame, reaches only that frame's output.
 
 mod common;
 
@@ -115,8 +116,9 @@ fn without_the_atrous_only_the_output_changes() {
     for stage in STAGES {
         assert_same(&run, pair, stage, 0..run.len());
     }
-    // Its output is the prior's combination as the base computed it.
-    for (f, frame) in run.iter().enumerate() {
+    // Its output is the prior's combination as the base computed it (after the first
+    // frame, whose output is the young-pixel network's in both).
+    for (f, frame) in run.iter().enumerate().skip(1) {
         assert_eq!(
             frame.images[ablation],
             frame.images[&format!("{base}.prior")],
@@ -248,4 +250,20 @@ fn without_gradients_nothing_changes_until_a_light_or_the_tf_does() {
         assert_same(&light, ("ours", ablation), stage, 0..first);
     }
     assert!(!same(&light, first, "ours", ablation, "model"));
+}
+
+#[test]
+fn without_the_young_network_only_the_first_frames_output_changes() {
+    let pair @ (base, ablation) = ("ours", "ours-no-young");
+    let run = run("phantom/orbit", base, ablation, &[]);
+    // The network runs where every state restarted (the first frame) and reaches the
+    // output alone: every stage of every frame, and every later output, are the same.
+    for stage in STAGES {
+        assert_same(&run, pair, stage, 0..run.len());
+    }
+    assert_same(&run, pair, "", 1..run.len());
+    assert!(
+        !same(&run, 0, base, ablation, ""),
+        "the network changed nothing"
+    );
 }

@@ -109,7 +109,7 @@ for set in "$@"; do
       ;;
     development)
       args=(--scene development --frames 48 --size 64x64 --ref-spp 1024 --aux
-        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,wrls-paper,rae)
+        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,ours-no-young,wrls-paper,rae)
       timed "$dvr" eval "${args[@]}" --out "$out"
       oidn "$out"
       keep development "$out"
@@ -119,7 +119,7 @@ for set in "$@"; do
       # At 2 spp with every method; then the methods of the speed-against-accuracy chart
       # at 1 and 4 spp, each into its own folder on the same references (share_references).
       args=(--scene validation --size 128x128 --ref-spp 256 --aux
-        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,rae)
+        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,ours-no-young,rae)
       timed "$dvr" eval "${args[@]}" --out "$out"
       total=$secs
       oidn "$out"
@@ -136,7 +136,7 @@ for set in "$@"; do
       ;;
     suite)
       args=(--scene suite --frames 48 --size 64x64 --ref-spp 1024 --aux
-        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,wrls-paper,rls-paper,wrls,rls,wrls-nf,rls-nf,rae)
+        --denoiser none,taa,svgf,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,ours-no-young,wrls-paper,rls-paper,wrls,rls,wrls-nf,rls-nf,rae)
       timed "$dvr" eval "${args[@]}" --out "$out"
       oidn "$out"
       keep suite "$out"
@@ -285,7 +285,7 @@ EOF2
       # method ours is judged against, then ours with each parameter-borne mechanism off
       # (DVR_OURS), on the same references and the same noisy frames.
       args=(--scene development --frames 48 --size 128x128 --ref-spp 256 --aux
-        --denoiser none,taa,svgf,rae,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback)
+        --denoiser none,taa,svgf,rae,ours,ours-no-gradient,ours-no-lag,ours-no-prior,ours-no-atrous,ours-no-feedback,ours-no-young)
       timed "$dvr" eval "${args[@]}" --out "$out"
       total=$secs
       oidn "$out"

@@ -71,7 +71,8 @@ from results_sets import (
     b_setup_times,
 )
 from results_experiments import (b_experiments_prior, b_experiments_strata, b_experiments_motion,
-                                 b_experiments_young, b_experiments_guided, b_experiments_learned)
+                                 b_experiments_young, b_experiments_guided, b_experiments_learned,
+                                 b_experiments_young_net)
 from results_figures import (
     FIGURES,
     b_speed_accuracy,
@@ -151,7 +152,7 @@ def b_ablations():
     base = m["ours"]
     body = []
     for x in ["ours-no-gradient", "ours-no-lag", "ours-no-prior", "ours-no-atrous",
-              "ours-no-feedback"]:
+              "ours-no-feedback", "ours-no-young"]:
         if x in m:
             body.append([f"`{x}`", fmt(m[x]["psnr"], 2), f"{base['psnr'] - m[x]['psnr']:+.2f}",
                          fmt(m[x]["flip"], 4), f"{base['flip'] - m[x]['flip']:+.4f}"])
@@ -603,6 +604,10 @@ BLOCKS = {
                                                   "mechanisms/metrics.csv"]),
     "experiments-learned": (b_experiments_learned, ["experiments-learned/*.csv",
                                                     "experiments-learned/meta.json"]),
+    "experiments-young-net": (b_experiments_young_net, ["experiments-young-net/*.csv",
+                                                        "experiments-young-net/meta.json",
+                                                        "experiments-young/base.csv",
+                                                        "mechanisms/metrics.csv"]),
     "experiments-motion": (b_experiments_motion, ["experiments-motion/*.csv",
                                                   "experiments-motion/meta.json",
                                                   "mechanisms/no-clip.csv",

@@ -180,6 +180,19 @@ def b_experiments_young():
     ])
 
 
+def b_experiments_young_net():
+    """Ours' young-pixel network in the engine, with the first à-trous level or its own
+    estimate fed back into the restarted states, against ours without it."""
+    meta = read_json("experiments-young-net", "meta.json")
+    return "\n".join([
+        experiment_runs("experiments-young-net", validation_base=False),
+        "",
+        f"Source: `assets/results/experiments-young-net/` (`runs.csv` and each run's CSV) and "
+        f"the mechanisms run's single-frame rows, made by `{meta['command']}` from "
+        f"{meta['commit']} ({meta['date']}) on {meta['machine']}.",
+    ])
+
+
 def b_experiments_guided():
     """Young pixels' spatial estimate (at 5364ed7 and 2b545c3): the development set's runs
     and each scene's mean, the cloud scenes' first frames, and the guided pass's cost."""

@@ -23,7 +23,7 @@ BLOCK = re.compile(
 COMPARED = ["none", "taa", "svgf", "wrls-paper", "rls-paper", "wrls", "rls", "wrls-nf",
             "rls-nf", "rae", "rae-phantom", "rae-mri", "rae-fp16", "oidn", "oidn-aux", "ours"]
 ORDER = ["none", "accum", "taa", "svgf", "ours", "ours-no-gradient", "ours-no-lag",
-         "ours-no-prior", "ours-no-atrous", "ours-no-feedback", "wrls-paper", "rls-paper",
+         "ours-no-prior", "ours-no-atrous", "ours-no-feedback", "ours-no-young", "wrls-paper", "rls-paper",
          "wrls", "rls", "wrls-nf", "rls-nf", "rae", "rae-phantom", "rae-mri", "rae-fp16", "oidn", "oidn-aux"]
 # metric: (column title, digits, higher is better)
 METRICS = {

@@ -357,6 +357,7 @@ MECHANISMS = [
     ("ours-no-atrous", "the à-trous (and with it the feedback)"),
     ("no-keep", "keeping converged estimates out of the prior and the à-trous"),
     ("ours-no-feedback", "the feedback into restarted states"),
+    ("ours-no-young", "the young-pixel network on the first frame"),
 ]
 
 

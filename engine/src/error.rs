@@ -44,7 +44,7 @@ pub enum EngineError {
     Pass { pass: String, problem: String },
     #[error("render graph: resource {resource:?}: {problem}")]
     Resource { resource: String, problem: String },
-    #[error("RAE weights {file}: {problem}")]
+    #[error("network weights {file}: {problem}")]
     Weights { file: String, problem: String },
     #[error("{what} needs {needed} bytes but the device allows {limit} ({device})")]
     TooLarge {

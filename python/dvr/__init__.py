@@ -22,7 +22,7 @@ import pathlib as _pathlib
 
 from . import _native
 
-# The wheel carries the presets, the MRI and the RAE networks (python/dvr/assets links
+# The wheel carries the presets, the MRI and the networks (python/dvr/assets links
 # to the repository's assets/, followed when the wheel is built): the engine reads them
 # from here, not from the checkout it was built in. $DVR_ASSETS still overrides.
 _PACKAGED_ASSETS = _pathlib.Path(__file__).resolve().parent / "assets"

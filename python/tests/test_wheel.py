@@ -1,5 +1,5 @@
 """The wheel stands alone: installed into a fresh virtual environment, away from the
-checkout, it finds its presets, the bundled MRI and the RAE networks inside itself.
+checkout, it finds its presets, the bundled MRI and the networks inside itself.
 
 The wheel is ``$DVR_WHEEL``, else the one tools/test.sh builds (``target/wheels``)."""
 
@@ -14,7 +14,8 @@ import pytest
 
 from conftest import ROOT
 
-# Its presets, the MRI with its licence and the RAE networks (weights + manifests).
+# Its presets, the MRI with its licence, the RAE networks and ours' young-pixel network
+# (weights + manifests).
 PACKAGED = [
     "dvr/assets/transfer/phantom-opaque.toml",
     "dvr/assets/transfer/ct-bone.toml",
@@ -23,6 +24,8 @@ PACKAGED = [
     "dvr/assets/rae/mri.json",
     "dvr/assets/rae/mri.bin",
     "dvr/assets/rae/phantom.bin",
+    "dvr/assets/young/young.json",
+    "dvr/assets/young/young.bin",
 ]
 
 SCRIPT = r"""

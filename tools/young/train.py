@@ -4,7 +4,8 @@ sixth clip held out, the best held-out checkpoint kept.
 
     .venv/bin/python tools/young/train.py --minutes 20 --fuse --half --width 12 --out out/young-models/w12fh.pt
 
-(--fuse needs the clips' `ours`, from gen.py --ours.)
+(--fuse needs the clips' `ours`, from gen.py --ours.) --normal surface trains on the
+surface features' normal, the one the engine's `ours` has, instead of the composited one.
 """
 import argparse
 import glob
@@ -19,12 +20,12 @@ sys.path.insert(0, os.path.dirname(__file__))
 from model import Young, psnr, tonemap  # noqa: E402
 
 
-def load(data, fuse):
+def load(data, fuse, normal):
     files = sorted(glob.glob(os.path.join(data, "*.npz")))
     train, held = [], []
     for i, path in enumerate(files):
         with np.load(path) as f:
-            keys = ("noisy", "albedo", "normal", "ref") + (("ours",) if fuse else ())
+            keys = ("noisy", "albedo", normal, "ref") + (("ours",) if fuse else ())
             fr = [torch.from_numpy(np.moveaxis(f[k], -1, 1).copy()) for k in keys]
         (held if i % 6 == 5 else train).append(torch.stack(fr, 1))  # (T, 4, 3, H, W)
     cat = lambda xs: torch.cat(xs, 0) if xs else None  # noqa: E731
@@ -69,6 +70,8 @@ def main():
     ap.add_argument("--half", action="store_true")
     ap.add_argument("--demod", type=float, default=0.0)
     ap.add_argument("--fuse", action="store_true")
+    ap.add_argument("--normal", choices=("normal", "surface"), default="normal",
+                    help="the normal guide: composited along the ray (OIDN's) or the surface's")
     ap.add_argument("--batch", type=int, default=8)
     ap.add_argument("--crop", type=int, default=64)
     ap.add_argument("--lr", type=float, default=2e-3)
@@ -78,7 +81,7 @@ def main():
     torch.set_num_threads(a.threads)
     torch.manual_seed(a.seed)
     rng = np.random.default_rng(a.seed)
-    train, held, nfiles = load(a.data, a.fuse)
+    train, held, nfiles = load(a.data, a.fuse, a.normal)
     print(f"{nfiles} clips: {train.shape[0]} training frames, {held.shape[0]} held out", flush=True)
     model = Young(width=a.width, half=a.half, demod=a.demod, fuse=a.fuse)
     print(f"{sum(p.numel() for p in model.parameters())} parameters", flush=True)
@@ -107,7 +110,8 @@ def main():
             if p > best:
                 best = p
                 os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
-                torch.save({"state": model.state_dict(), "width": a.width, "half": a.half, "demod": a.demod, "fuse": a.fuse}, a.out)
+                torch.save({"state": model.state_dict(), "width": a.width, "half": a.half, "demod": a.demod, "fuse": a.fuse,
+                            "normal": a.normal}, a.out)
                 tag = " *"
             print(f"it {it} {time.time() - t0:.0f}s loss {loss.item():.4f} held {p:.2f} dB (input {p0:.2f}){tag}",
                   flush=True)

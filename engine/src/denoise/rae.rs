@@ -32,7 +32,7 @@ use super::{Build, Built, DenoiseFrame, Denoiser, DenoiserConfig};
 use crate::error::{EngineError, Result};
 use crate::gpu::{GpuContext, ImageDesc, Pipeline};
 use crate::gpu_block;
-use crate::graph::{BufferHandle, Frame, ImageHandle};
+use crate::graph::{BufferHandle, Frame, ImageHandle, RenderGraph};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use std::cell::Cell;
@@ -205,11 +205,67 @@ pub struct RaeWeights {
     pub floats: Vec<f32>,
 }
 
-fn weights_error(file: &Path, problem: impl Into<String>) -> EngineError {
+pub(crate) fn weights_error(file: &Path, problem: impl Into<String>) -> EngineError {
     EngineError::Weights {
         file: file.display().to_string(),
         problem: problem.into(),
     }
+}
+
+/// A network's weight buffer `name`, filled with `floats` when the graph made it anew
+/// (`uploaded` remembers the buffer last filled).
+pub(crate) fn weight_buffer(
+    ctx: &GpuContext,
+    graph: &mut RenderGraph,
+    name: &str,
+    floats: &[f32],
+    uploaded: &Cell<Option<BufferHandle>>,
+) -> Result<BufferHandle> {
+    let size = std::mem::size_of_val(floats) as u64;
+    let weights = graph.buffer(ctx, name, size, MemoryLocation::CpuToGpu)?;
+    if uploaded.get() != Some(weights) {
+        graph
+            .buffer_mut(weights)
+            .write(bytemuck::cast_slice(floats))?;
+        uploaded.set(Some(weights));
+    }
+    Ok(weights)
+}
+
+/// The `count` little-endian f32 of the weight file `weights`, named by (and beside)
+/// the manifest `manifest_path`: a file of another length (truncated, or another
+/// network's) or a non-finite weight is an error naming the file. A longer file is
+/// refused unread.
+pub(crate) fn read_weight_floats(
+    manifest_path: &Path,
+    weights: &str,
+    count: u64,
+) -> Result<Vec<f32>> {
+    let bin = manifest_path
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join(weights);
+    let bytes = crate::files::read_bounded(&bin, count * 4)
+        .map_err(|e| weights_error(&bin, format!("cannot read: {e}")))?;
+    if bytes.len() as u64 != count * 4 {
+        return Err(weights_error(
+            &bin,
+            format!(
+                "{} bytes, the network of {} needs {} ({count} f32); truncated or from another network?",
+                bytes.len(),
+                manifest_path.display(),
+                count * 4
+            ),
+        ));
+    }
+    let floats: Vec<f32> = bytes
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    if let Some(i) = floats.iter().position(|v| !v.is_finite()) {
+        return Err(weights_error(&bin, format!("float {i} is not finite")));
+    }
+    Ok(floats)
 }
 
 impl RaeWeights {
@@ -276,31 +332,7 @@ impl RaeWeights {
                 format!("manifest says {} floats, its layers need {end}", m.floats),
             ));
         }
-        let bin = manifest_path
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join(&m.weights);
-        // The manifest says how many floats to expect; a longer file is refused unread.
-        let bytes = crate::files::read_bounded(&bin, end * 4)
-            .map_err(|e| weights_error(&bin, format!("cannot read: {e}")))?;
-        if bytes.len() as u64 != end * 4 {
-            return Err(weights_error(
-                &bin,
-                format!(
-                    "{} bytes, the network of {} needs {} ({end} f32); truncated or from another network?",
-                    bytes.len(),
-                    manifest_path.display(),
-                    end * 4
-                ),
-            ));
-        }
-        let floats: Vec<f32> = bytes
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
-        if let Some(i) = floats.iter().position(|v| !v.is_finite()) {
-            return Err(weights_error(&bin, format!("float {i} is not finite")));
-        }
+        let floats = read_weight_floats(manifest_path, &m.weights, end)?;
         Ok(Self {
             manifest: manifest_path.to_path_buf(),
             widths: m.widths,
@@ -421,18 +453,13 @@ impl Denoiser for Rae {
         let (pw, ph) = (fw.div_ceil(mult) * mult, fh.div_ceil(mult) * mult);
         let size = |l: u32| (pw >> l, ph >> l);
 
-        let weights = graph.buffer(
+        let weights = weight_buffer(
             ctx,
+            graph,
             &format!("{n}.weights"),
-            (wts.floats.len() * 4) as u64,
-            MemoryLocation::CpuToGpu,
+            &wts.floats,
+            &self.uploaded,
         )?;
-        if self.uploaded.get() != Some(weights) {
-            graph
-                .buffer_mut(weights)
-                .write(bytemuck::cast_slice(&wts.floats))?;
-            self.uploaded.set(Some(weights));
-        }
 
         let x0 = graph.image(ctx, &format!("{n}.x0"), self.tensor(pw, ph, IN_CHANNELS))?;
         add_io_pass(

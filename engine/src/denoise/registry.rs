@@ -103,6 +103,11 @@ pub const DENOISERS: &[DenoiserInfo] = &[
         &OursVariant { atrous: false, ..OURS },
     ),
     ours(
+        "ours-no-young",
+        "ours without the young-pixel network on frames where every state restarted",
+        &OursVariant { young: false, ..OURS },
+    ),
+    ours(
         "ours-no-feedback",
         "ours without the first à-trous level fed back into the states that restarted",
         &OursVariant { feedback: false, ..OURS },
@@ -264,7 +269,7 @@ mod tests {
 
     #[test]
     fn each_ablation_of_ours_switches_one_part_off() {
-        let parts = |v: OursVariant| [v.gradients, v.lag, v.prior, v.atrous, v.feedback];
+        let parts = |v: OursVariant| [v.gradients, v.lag, v.prior, v.atrous, v.feedback, v.young];
         let ours = parts(OURS);
         assert!(ours.iter().all(|&on| on), "ours has every part");
         let mut ablations = 0;
@@ -276,7 +281,7 @@ mod tests {
                 ablations += expected;
             }
         }
-        assert_eq!(ablations, 5, "one ablation per part");
+        assert_eq!(ablations, 6, "one ablation per part");
     }
 
     #[test]

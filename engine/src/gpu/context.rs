@@ -35,6 +35,8 @@ pub struct DeviceInfo {
     /// Nanoseconds per timestamp tick.
     pub timestamp_period: f64,
     pub max_image_dimension_3d: u32,
+    /// `maxImageDimension2D`: the widest and tallest 2D image.
+    pub max_image_dimension_2d: u32,
     pub max_memory_allocation_size: u64,
     pub max_storage_buffer_range: u32,
     pub max_push_constants_size: u32,
@@ -385,6 +387,7 @@ fn pick_device(
             driver_id: driver_id(instance, p),
             timestamp_period: props.limits.timestamp_period as f64,
             max_image_dimension_3d: props.limits.max_image_dimension3_d,
+            max_image_dimension_2d: props.limits.max_image_dimension2_d,
             max_memory_allocation_size: max_allocation(instance, p),
             max_storage_buffer_range: props.limits.max_storage_buffer_range,
             max_push_constants_size: props.limits.max_push_constants_size,

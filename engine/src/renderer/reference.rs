@@ -131,6 +131,7 @@ mod tests {
             driver_id,
             timestamp_period: 1.0,
             max_image_dimension_3d: 2048,
+            max_image_dimension_2d: 16384,
             max_memory_allocation_size: 1 << 30,
             max_storage_buffer_range: 1 << 27,
             max_push_constants_size: 128,

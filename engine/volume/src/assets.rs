@@ -58,6 +58,12 @@ pub fn rae_manifest(net: &str) -> PathBuf {
     assets_dir().join("rae").join(format!("{net}.json"))
 }
 
+/// The manifest of ours' shipped young-pixel network (`young/young.json`, naming its
+/// weights).
+pub fn young_manifest() -> PathBuf {
+    assets_dir().join("young").join("young.json")
+}
+
 /// The folder of a shipped scene set (`assets/scenes/<set>/`, one scene file each):
 /// `validation`, `static` and `paper`, the sets `dvr eval --scene <set>` runs.
 pub fn scene_set(set: &str) -> PathBuf {

@@ -16,7 +16,7 @@ const SIZE: (u32, u32) = (640, 400);
 
 /// Colours of the registry's rows, in its order (`dvr_engine::denoise::DENOISERS`):
 /// grey for the noisy input, red for ours, the rest a categorical palette.
-const PALETTE: [RGBColor; 20] = [
+const PALETTE: [RGBColor; 21] = [
     RGBColor(127, 127, 127),
     RGBColor(31, 119, 180),
     RGBColor(227, 119, 194),
@@ -37,6 +37,7 @@ const PALETTE: [RGBColor; 20] = [
     RGBColor(247, 182, 210),
     RGBColor(255, 187, 120),
     RGBColor(199, 199, 199),
+    RGBColor(57, 59, 121),
 ];
 
 /// A method's colour, the same in every chart and on the page: by its row in the

@@ -24,6 +24,9 @@ pub(super) struct State {
     pub model: ImageHandle,
     /// R, and D, the part of P that process noise put there.
     pub noise: ImageHandle,
+    /// Every state restarted: there was no history to predict from (the first frame,
+    /// after a reset or a resize).
+    pub fresh: bool,
 }
 
 impl Ours {

@@ -26,11 +26,16 @@
 //!   (`aux_features.comp`, shared with svgf) and the surface's gradient normal
 //!   (`surface_features.comp`); a frame without them (synthetic inputs) goes without;
 //! - `<name>.atrous0..2` ([`atrous`], `variance_atrous.comp`): the à-trous spatial filter;
+//! - `<name>.young_*` ([`young`], `ours_young_*.comp`): on a frame where every state
+//!   restarted (the first, after a reset or a resize) and the guides are there, a small
+//!   trained network's estimate of the frame from its samples, its guides and ours'
+//!   estimate, which it blends with ours' (the output; the filter's states do not see
+//!   it);
 //! - `<name>.feedback` ([`feedback`], `ours_feedback.comp`): the first level's estimate
 //!   into the states that restarted this frame, read by next frame's update.
 //!
 //! The ablations (`ours-no-gradient`, `ours-no-lag`, `ours-no-prior`, `ours-no-atrous`,
-//! `ours-no-feedback`)
+//! `ours-no-feedback`, `ours-no-young`)
 //! switch one stage off each ([`OursVariant`]); every other pass runs as in `ours`, and
 //! `tests/ablations.rs` checks by the stages' images that only that stage changed.
 
@@ -43,6 +48,7 @@ mod gradient_pool;
 mod lag;
 mod prior;
 mod update;
+pub mod young;
 
 use super::variance_atrous::{self, VarianceAtrousPush};
 use super::{Build, Built, Tunables};
@@ -56,6 +62,7 @@ use gradient_pool::OursGradientPoolPush;
 use lag::OursLagPush;
 use prior::PriorPipelines;
 use update::{OursNoisePush, OursUpdatePush};
+use young::{YoungInputs, YoungNet, YoungWeights};
 
 /// Ours' tunables, each with what it is (the book's denoisers page, "ours").
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -144,6 +151,9 @@ pub struct OursVariant {
     /// The feedback of the first à-trous level into states that restarted this frame
     /// (without it next frame's update starts from the restarted state's own mean).
     pub feedback: bool,
+    /// The young-pixel network on frames where every state restarted (without it the
+    /// à-trous output is the frame's estimate there, as on every other frame).
+    pub young: bool,
 }
 
 impl OursVariant {
@@ -153,6 +163,7 @@ impl OursVariant {
         atrous: true,
         prior: true,
         feedback: true,
+        young: true,
     };
 }
 
@@ -173,6 +184,7 @@ pub struct Ours {
     /// The à-trous that carries neighbours by the prior's prediction (where there is one).
     atrous_carry: Option<Pipeline<VarianceAtrousPush>>,
     prior: PriorPipelines,
+    young: Option<YoungNet>,
 }
 
 /// The pooled lag test's window radius (5×5).
@@ -220,6 +232,10 @@ impl Ours {
                 .then(|| variance_atrous::pipeline(ctx, true, true))
                 .transpose()?,
             prior: PriorPipelines::new(ctx)?,
+            young: variant
+                .young
+                .then(|| YoungNet::new(ctx, YoungWeights::builtin()?))
+                .transpose()?,
         })
     }
 }
@@ -246,15 +262,38 @@ impl Denoiser for Ours {
         let estimate = state.model;
         self.add_lag(f.frame, input.size, &lag);
         let normal = input.features.map(|f| f.normal);
-        let (estimate, prediction) = match (input.guides, normal) {
-            (Some(albedo), Some(normal)) => {
-                let guides = prior::PriorGuides { albedo, normal };
+        let guides = match (input.guides, normal) {
+            (Some(albedo), Some(normal)) => Some(prior::PriorGuides { albedo, normal }),
+            _ => None,
+        };
+        let (estimate, prediction) = match guides {
+            Some(guides) => {
                 let (e, p) = self.add_prior(&mut f, estimate, guides)?;
                 (e, Some(p))
             }
-            _ => (estimate, None),
+            None => (estimate, None),
         };
-        self.add_atrous(&mut f, estimate, prediction, state)
+        // The network runs where every state restarted and it has the guides it reads
+        // (and its tensors fit the device's images).
+        let young = match (&self.young, guides) {
+            (Some(net), Some(guides)) if state.fresh => {
+                let layout = net.layout(f.ctx, f.input.size);
+                layout.map(|layout| (net, guides, layout))
+            }
+            _ => None,
+        };
+        let out = self.add_atrous(&mut f, estimate, prediction, state)?;
+        let Some((net, guides, layout)) = young else {
+            return Ok(out);
+        };
+        let (ctx, graph, frame, input) = f.parts();
+        let inputs = YoungInputs {
+            noisy: input.noisy,
+            albedo: guides.albedo,
+            normal: guides.normal,
+            ours: out,
+        };
+        net.add(ctx, graph, frame, n, input.size, layout, inputs)
     }
 }
 

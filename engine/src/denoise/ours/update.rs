@@ -119,6 +119,7 @@ impl Ours {
         Ok(State {
             model: model.cur,
             noise: noise.cur,
+            fresh: !(model.valid && reproj.valid),
         })
     }
 }
