@@ -56,12 +56,13 @@ def test_the_wheel_carries_its_assets_and_stays_small():
     names = zipfile.ZipFile(wheel).namelist()
     missing = [p for p in PACKAGED if p not in names]
     assert not missing, f"{wheel.name} lacks {missing}"
-    # Only the three folders the engine reads, not assets/ whole (results, gallery, scenes).
-    assert not [n for n in names if n.startswith("dvr/assets/") and n.split("/")[2] not in ("transfer", "volumes", "rae")]
+    # Only the folders the engine reads, not assets/ whole (results, gallery, scenes).
+    read = ("transfer", "volumes", "rae", "young")
+    assert not [n for n in names if n.startswith("dvr/assets/") and n.split("/")[2] not in read]
     assert wheel.stat().st_size < 60 << 20
     # python/dvr/assets links file by file: a new preset or network needs its link, and a
     # volume stored as a folder (OME-Zarr) a link per file inside it.
-    shipped = {f"dvr/assets/{p.relative_to(ROOT / 'assets')}" for d in ("transfer", "rae", "volumes")
+    shipped = {f"dvr/assets/{p.relative_to(ROOT / 'assets')}" for d in read
                for p in (ROOT / "assets" / d).rglob("*") if p.is_file() and p.name != "README.md"}
     assert not shipped - set(names), f"not linked under python/dvr/assets: {sorted(shipped - set(names))}"
 
